@@ -1,0 +1,1 @@
+//! Fresnel equations for unpolarised light at a dielectric interface.

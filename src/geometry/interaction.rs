@@ -1,0 +1,2 @@
+//! The surface interaction (the seed's HitInfo).
+pub struct Interaction;

@@ -1,0 +1,31 @@
+//! Geometry as heron stores it: shapes indexed by Embree's geomID, the ray, and the
+//! surface interaction record (the lecture's HitInfo).
+pub mod interaction;
+pub mod ray;
+
+pub use interaction::Interaction;
+pub use ray::Ray;
+
+use glam::Vec3;
+
+/// A triangle mesh in world space. Planes, quads and single triangles from scene files
+/// become meshes too, so Embree sees one triangle type.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+#[derive(Clone, Debug)]
+pub enum ShapeKind {
+    Sphere { center: Vec3, radius: f32 },
+    Mesh(Mesh),
+}
+
+/// One shape of the scene; its index in `Scene::shapes` is its Embree geomID.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    pub kind: ShapeKind,
+    /// Index into `Scene::materials`.
+    pub material: u32,
+}

@@ -1,0 +1,16 @@
+//! heron: a physically faithful spectral ray tracer for optics research, on Intel Embree.
+//!
+//! See ARCHITECTURE.md for the map of the code and how one sample flows.
+#![deny(unsafe_code)]
+
+pub mod accel;
+pub mod bsdf;
+pub mod camera;
+pub mod error;
+pub mod geometry;
+pub mod light;
+pub mod math;
+pub mod scene;
+pub mod spectrum;
+
+pub use error::{HeronError, Result};

@@ -1,0 +1,82 @@
+//! A spectrum tabulated every 1 nm over 360–830 nm. Every spectrum a scene defines
+//! (reflectances, emitters, background) is turned into one of these on load, so the
+//! transport has a single, branch-free way to evaluate a spectrum.
+use super::{DENSE_LEN, LAMBDA_MIN};
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseSpectrum {
+    values: Box<[f32; DENSE_LEN]>,
+}
+
+impl DenseSpectrum {
+    pub fn constant(c: f32) -> Self {
+        DenseSpectrum {
+            values: Box::new([c; DENSE_LEN]),
+        }
+    }
+
+    /// Builds a table by evaluating `f(λ)` at 360, 361, …, 830 nm.
+    pub fn from_fn(f: impl Fn(f32) -> f32) -> Self {
+        let mut values = Box::new([0.0f32; DENSE_LEN]);
+        for (i, v) in values.iter_mut().enumerate() {
+            *v = f(LAMBDA_MIN + i as f32);
+        }
+        DenseSpectrum { values }
+    }
+
+    /// Piecewise-linear interpolation from (wavelength nm, value) samples sorted by
+    /// wavelength; held constant beyond the first and last sample.
+    pub fn from_samples(samples: &[(f32, f32)]) -> Self {
+        assert!(!samples.is_empty());
+        Self::from_fn(|l| {
+            let i = samples.partition_point(|&(w, _)| w <= l);
+            if i == 0 {
+                samples[0].1
+            } else if i == samples.len() {
+                samples[samples.len() - 1].1
+            } else {
+                let (w0, v0) = samples[i - 1];
+                let (w1, v1) = samples[i];
+                let t = (l - w0) / (w1 - w0);
+                v0 + t * (v1 - v0)
+            }
+        })
+    }
+
+    pub fn values(&self) -> &[f32; DENSE_LEN] {
+        &self.values
+    }
+
+    /// Value at `lambda` nm by linear interpolation; clamped to the table's ends.
+    #[inline]
+    pub fn eval(&self, lambda: f32) -> f32 {
+        let x = (lambda - LAMBDA_MIN).clamp(0.0, (DENSE_LEN - 1) as f32);
+        let i = (x as usize).min(DENSE_LEN - 2);
+        let t = x - i as f32;
+        let a = self.values[i];
+        let b = self.values[i + 1];
+        a + t * (b - a)
+    }
+
+    pub fn scaled(&self, s: f32) -> Self {
+        Self::from_fn(|l| self.eval(l) * s)
+    }
+
+    pub fn mul(&self, other: &DenseSpectrum) -> Self {
+        Self::from_fn(|l| self.eval(l) * other.eval(l))
+    }
+
+    pub fn max_value(&self) -> f32 {
+        self.values.iter().copied().fold(f32::MIN, f32::max)
+    }
+
+    pub fn min_value(&self) -> f32 {
+        self.values.iter().copied().fold(f32::MAX, f32::min)
+    }
+
+    /// True when the table is the same value at every wavelength.
+    pub fn is_constant(&self) -> bool {
+        let v0 = self.values[0];
+        self.values.iter().all(|&v| v == v0)
+    }
+}
