@@ -7,9 +7,12 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod error;
+pub mod film;
 pub mod geometry;
+pub mod integrator;
 pub mod light;
 pub mod math;
+pub mod render;
 pub mod scene;
 pub mod spectrum;
 

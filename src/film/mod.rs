@@ -1,0 +1,88 @@
+//! The film: per-pixel CIE XYZ accumulated from spectral samples, converted to linear
+//! sRGB for output.
+//!
+//! Each sample adds (1/N) Σ_i L(λ_i) x̄(λ_i) / p(λ_i) / Σ ȳ Δλ over its N lanes, the
+//! Monte Carlo estimate of XYZ = ∫ L x̄ dλ / ∫ ȳ dλ (a constant L = 1 has Y = 1).
+//! Lanes with pdf 0 (terminated wavelengths) add nothing.
+pub mod exr;
+pub mod png;
+
+use crate::spectrum::cie::cie1931;
+use crate::spectrum::color::xyz_to_linear_srgb;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// Weights that turn one sample's lanes into XYZ: x̄(λ)/(N p(λ) Σȳ) for each lane.
+#[inline]
+pub fn xyz_of_sample<const N: usize>(
+    l: &SampledSpectrum<N>,
+    wl: &SampledWavelengths<N>,
+) -> [f32; 3] {
+    let obs = cie1931();
+    let k = 1.0 / (N as f32 * obs.y_integral);
+    let mut xyz = [0.0f32; 3];
+    for i in 0..N {
+        let p = wl.pdf[i];
+        if p == 0.0 {
+            continue;
+        }
+        let w = l.0[i] * k / p;
+        let lambda = wl.lambda[i];
+        xyz[0] += w * obs.x.eval(lambda);
+        xyz[1] += w * obs.y.eval(lambda);
+        xyz[2] += w * obs.z.eval(lambda);
+    }
+    xyz
+}
+
+/// A finished image: mean XYZ per pixel, row-major from the top-left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    pub xyz: Vec<[f32; 3]>,
+}
+
+impl Film {
+    pub fn linear_srgb(&self) -> Vec<[f32; 3]> {
+        self.xyz.iter().map(|&c| xyz_to_linear_srgb(c)).collect()
+    }
+}
+
+/// Writes through a temporary file in the target's folder and renames it into place,
+/// so a failed or interrupted write never leaves a partial output.
+pub(crate) fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> crate::Result<()> {
+    let err = |message: String| crate::HeronError::Io {
+        path: path.to_path_buf(),
+        message,
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| err("not a file path".into()))?;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(err(format!(
+            "output folder {} does not exist",
+            dir.display()
+        )));
+    }
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = write(&tmp).and_then(|()| {
+        std::fs::rename(&tmp, path).map_err(|e: io::Error| format!("cannot rename into place: {e}"))
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(err)
+}

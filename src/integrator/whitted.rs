@@ -1,0 +1,165 @@
+//! The seed lecture's Whitted-style tracer, spectral.
+//!
+//! Per the seed: shadow rays start at t_min = ε and stop at ‖p − x‖ − ε (directional
+//! lights: no cutoff); mirrors reflect, dielectrics refract with n_i/n_t and reflect on
+//! total internal reflection; glossy surfaces add the modified Phong highlight. A shader
+//! that continues the path overwrites the ray and increments the depth ("Exercises").
+//!
+//! heron's one addition: with Fresnel on, a dielectric picks reflection with probability
+//! R and refraction with 1 − R (R from the Fresnel equations), so one ray per path is
+//! still enough and the estimate of R·L_r + (1 − R)·L_t stays unbiased.
+use super::{Context, TraceCounters};
+use crate::accel::embree::{Hit, RayQuery};
+use crate::bsdf::dielectric::refract;
+use crate::bsdf::fresnel::fresnel_dielectric;
+use crate::bsdf::mirror::reflect;
+use crate::bsdf::phong::phong_specular;
+use crate::bsdf::Material;
+use crate::geometry::{Interaction, Ray};
+use crate::light::Light;
+use crate::math::Rng;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::Vec3;
+use std::f32::consts::FRAC_1_PI;
+
+#[inline]
+fn query(ray: &Ray) -> RayQuery {
+    RayQuery {
+        origin: ray.origin,
+        dir: ray.dir,
+        tnear: ray.t_min,
+        tfar: ray.t_max,
+    }
+}
+
+/// Radiance arriving along `ray` at the wavelengths `wl`.
+///
+/// `first_hit` is the camera ray's closest hit when it was already traced (in an Embree
+/// packet); `None` traces it here.
+pub fn radiance<const N: usize>(
+    ctx: &Context,
+    mut ray: Ray,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    rng: &mut Rng,
+    counters: &mut TraceCounters,
+) -> SampledSpectrum<N> {
+    let scene = ctx.scene;
+    let eps = scene.settings.epsilon;
+    let mut beta = SampledSpectrum::<N>::splat(1.0);
+    let mut l = SampledSpectrum::<N>::zero();
+    let mut pending = first_hit;
+    let mut depth = 0u32;
+    loop {
+        let hit = match pending.take() {
+            Some(h) => h,
+            None => {
+                counters.rays += 1;
+                ctx.accel.intersect1(&query(&ray))
+            }
+        };
+        let Some(hit) = hit else {
+            l += beta * wl.eval(&scene.background);
+            break;
+        };
+        let shape = &scene.shapes[hit.geom_id as usize];
+        let material = &scene.materials[shape.material as usize];
+        let mut it = Interaction::new(&ray, &hit, shape, material, depth);
+        let wo = -ray.dir;
+        let next = match material {
+            Material::Lambertian(m) => {
+                let f = wl.eval(&m.rho_d) * FRAC_1_PI;
+                let mut e = SampledSpectrum::<N>::zero();
+                direct_lighting(ctx, &it, wl, counters, |_, li_cos| e += li_cos);
+                l += beta * f * e;
+                None
+            }
+            Material::Mirror(m) => {
+                beta *= wl.eval(&m.rho_s);
+                Some(reflect(wo, it.normal))
+            }
+            Material::Dielectric(d) => Some(scatter_dielectric(&it, wo, d.fresnel, rng)),
+            Material::Glossy(g) => {
+                let fd = wl.eval(&g.rho_d) * FRAC_1_PI;
+                let (rho_s, s, n) = (it.specular, it.shininess, it.normal);
+                let mut lr = SampledSpectrum::<N>::zero();
+                direct_lighting(ctx, &it, wl, counters, |wi, li_cos| {
+                    let fs = phong_specular(rho_s, s, wi, wo, n);
+                    lr += (fd + SampledSpectrum::splat(fs)) * li_cos;
+                });
+                l += beta * lr;
+                g.base
+                    .as_ref()
+                    .map(|b| scatter_dielectric(&it, wo, b.fresnel, rng))
+            }
+        };
+        let Some(dir) = next else { break };
+        // The lecture's continuation: overwrite the ray, clear has_hit, increment depth.
+        it.has_hit = false;
+        depth += 1;
+        if depth > scene.settings.max_depth {
+            break;
+        }
+        ray = Ray::new(it.position, dir, eps, f32::INFINITY);
+    }
+    l
+}
+
+/// Calls `visit(ωi, L_i cos θi)` for every light that reaches the shading point
+/// unoccluded, ωi being the unit direction toward the light.
+///
+/// Shadow rays follow the seed: t_min = ε, t_max = ‖p − x‖ − ε for a point light at p,
+/// and no cutoff for a directional light.
+#[inline]
+fn direct_lighting<const N: usize>(
+    ctx: &Context,
+    it: &Interaction,
+    wl: &SampledWavelengths<N>,
+    counters: &mut TraceCounters,
+    mut visit: impl FnMut(Vec3, SampledSpectrum<N>),
+) {
+    let eps = ctx.scene.settings.epsilon;
+    let x = it.position;
+    let n = it.normal;
+    for light in &ctx.scene.lights {
+        let (wi, t_max, li) = match light {
+            Light::Point(p) => {
+                let to = p.position - x;
+                let d2 = to.length_squared();
+                let d = d2.sqrt();
+                (to / d, d - eps, wl.eval(&p.intensity) * (1.0 / d2))
+            }
+            Light::Directional(dl) => (-dl.direction, f32::INFINITY, wl.eval(&dl.radiance)),
+        };
+        let cos = wi.dot(n);
+        if cos <= 0.0 || t_max <= eps {
+            continue;
+        }
+        counters.shadow_rays += 1;
+        let shadow = RayQuery {
+            origin: x,
+            dir: wi,
+            tnear: eps,
+            tfar: t_max,
+        };
+        if !ctx.accel.occluded1(&shadow) {
+            visit(wi, li * cos);
+        }
+    }
+}
+
+/// Chooses the continuation at a dielectric: the seed's refraction with n_i/n_t from the
+/// interaction, reflection on total internal reflection, and (with `fresnel`) reflection
+/// with probability R otherwise.
+#[inline]
+fn scatter_dielectric(it: &Interaction, wo: Vec3, fresnel: bool, rng: &mut Rng) -> Vec3 {
+    let n = it.normal;
+    let eta = it.ior1_over_ior2;
+    if fresnel {
+        let r = fresnel_dielectric(wo.dot(n), eta);
+        if r >= 1.0 || rng.uniform() < r {
+            return reflect(wo, n);
+        }
+    }
+    refract(wo, n, eta).unwrap_or_else(|| reflect(wo, n))
+}
