@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# heron set-up: installs what is missing on a Debian 12 machine (Embree and the tools
+# from apt, the pinned Python test environment in .venv), builds heron in release mode
+# and renders the default scene to out/default.exr and out/default.png.
+#
+#   scripts/setup.sh           install, build, render the default scene
+#   scripts/setup.sh --deps    install only (used by scripts/test.sh)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+APT_PACKAGES=(libembree-dev embree-tools pkg-config python3-venv python3-pip)
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
+}
+
+missing=()
+for p in "${APT_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing apt packages: ${missing[*]}"
+  as_root apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "${missing[@]}"
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  echo "setup: cargo not found; install a Rust toolchain (1.80 or newer) and run again" >&2
+  exit 1
+fi
+
+scripts/setup-python.sh
+
+if [ "${1:-}" = "--deps" ]; then
+  exit 0
+fi
+
+cargo build --release
+mkdir -p out
+target/release/heron render scenes/default.toml -o out/default.exr
+echo "setup: rendered out/default.exr and out/default.png"
