@@ -1,0 +1,225 @@
+//! The `heron` binary: bad input gets a one-line error naming the file, key and
+//! expectation, a non-zero exit and no output file; good input gives byte-identical
+//! EXR files whatever the thread count.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn heron(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_heron"))
+        .args(args)
+        .output()
+        .expect("run heron")
+}
+
+fn repo(p: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(p)
+        .display()
+        .to_string()
+}
+
+const SMALL: &str = r#"
+background = [0.1, 0.3, 0.6]
+[camera]
+eye = [2.0, 1.5, 2.0]
+look_at = [0.0, 0.5, 0.0]
+resolution = [24, 16]
+[render]
+spp = 2
+[materials.white]
+type = "lambertian"
+rho_d = [0.8, 0.8, 0.8]
+[materials.glass]
+type = "dielectric"
+ior = 1.5
+[[shapes]]
+type = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+material = "white"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.5, 0.0]
+radius = 0.3
+material = "glass"
+[[lights]]
+type = "point"
+position = [0.0, 1.0, 0.0]
+intensity = 3.14159265
+"#;
+
+fn write_scene(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Asserts failure with a single-line message containing every `needle`, and that the
+/// folder holds no file but the scene.
+fn assert_bad(dir: &Path, args: &[&str], needles: &[&str]) {
+    let out = heron(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    let line = err.trim_end();
+    assert_eq!(line.lines().count(), 1, "one line expected: {err}");
+    for n in needles {
+        assert!(line.contains(n), "{args:?}: {line:?} should mention {n:?}");
+    }
+    let outputs: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.ends_with(".toml"))
+        .collect();
+    assert!(outputs.is_empty(), "{args:?} left files: {outputs:?}");
+}
+
+#[test]
+fn bad_scenes_give_clear_errors_and_no_files() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o.exr");
+    let out = out.to_str().unwrap();
+    let cases: &[(&str, &[&str])] = &[
+        ("radius = 0.3", &["radius = -0.3"]),
+        ("type = \"dielectric\"", &["type = \"glas\""]),
+        ("spp = 2", &["colour = 2"]),
+        ("ior = 1.5", &["ior = nan"]),
+        ("resolution = [24, 16]", &["resolution = [24, 0]"]),
+        ("material = \"glass\"", &["material = \"gold\""]),
+    ];
+    let expect: &[&[&str]] = &[
+        &["shapes[1].radius", "-0.3"],
+        &["materials.glass.type", "glas"],
+        &["colour", "render"],
+        &["materials.glass.ior"],
+        &["camera.resolution"],
+        &["shapes[1].material", "gold"],
+    ];
+    for ((from, to), needles) in cases.iter().zip(expect) {
+        let text = SMALL.replacen(from, to[0], 1);
+        assert_ne!(text, SMALL);
+        let scene = write_scene(d.path(), "bad.toml", &text);
+        let mut n: Vec<&str> = needles.to_vec();
+        n.push("bad.toml");
+        assert_bad(
+            d.path(),
+            &["render", scene.to_str().unwrap(), "-o", out],
+            &n,
+        );
+    }
+    let scene = write_scene(
+        d.path(),
+        "mesh.toml",
+        &format!(
+            "{SMALL}\n[[shapes]]\ntype = \"mesh\"\nfile = \"nowhere.obj\"\nmaterial = \"white\"\n"
+        ),
+    );
+    assert_bad(
+        d.path(),
+        &["render", scene.to_str().unwrap(), "-o", out],
+        &["nowhere.obj"],
+    );
+    let scene = write_scene(d.path(), "syntax.toml", "[camera\neye = [1, 2, 3]\n");
+    assert_bad(
+        d.path(),
+        &["render", scene.to_str().unwrap(), "-o", out],
+        &["syntax.toml", "line"],
+    );
+    assert_bad(
+        d.path(),
+        &[
+            "render",
+            d.path().join("missing.toml").to_str().unwrap(),
+            "-o",
+            out,
+        ],
+        &["missing.toml"],
+    );
+}
+
+#[test]
+fn bad_flags_give_clear_errors_and_no_files() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write_scene(d.path(), "s.toml", SMALL);
+    let s = scene.to_str().unwrap();
+    let out = d.path().join("o.exr");
+    let o = out.to_str().unwrap();
+    let png = d.path().join("o.png");
+    assert_bad(
+        d.path(),
+        &["render", s, "-o", png.to_str().unwrap()],
+        &["--output", ".exr"],
+    );
+    assert_bad(d.path(), &["render", s, "-o", o, "--spp", "0"], &["--spp"]);
+    assert_bad(
+        d.path(),
+        &["render", s, "-o", o, "--threads", "0"],
+        &["--threads"],
+    );
+    assert_bad(
+        d.path(),
+        &["render", s, "-o", "/nonexistent/dir/x.exr"],
+        &["does not exist"],
+    );
+}
+
+#[test]
+fn exr_bytes_do_not_depend_on_thread_count() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write_scene(d.path(), "s.toml", SMALL);
+    let mut bytes = vec![];
+    for t in ["1", "2", "5"] {
+        let out = d.path().join(format!("t{t}.exr"));
+        let r = heron(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--threads",
+            t,
+            "--quiet",
+        ]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let summary = String::from_utf8_lossy(&r.stderr);
+        assert!(
+            summary.contains("Mrays/s") && summary.contains("non-finite"),
+            "{summary}"
+        );
+        assert!(d.path().join(format!("t{t}.png")).is_file());
+        bytes.push(std::fs::read(&out).unwrap());
+    }
+    assert!(
+        bytes[0] == bytes[1] && bytes[1] == bytes[2],
+        "EXR bytes differ"
+    );
+}
+
+#[test]
+fn the_course_scenes_render() {
+    let d = tempfile::tempdir().unwrap();
+    for s in [
+        "default",
+        "default-mirror",
+        "default-glass",
+        "default-glossy",
+        "cornell",
+    ] {
+        let out = d.path().join(format!("{s}.exr"));
+        let r = heron(&[
+            "render",
+            &repo(&format!("scenes/{s}.toml")),
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "1",
+            "--quiet",
+        ]);
+        assert!(
+            r.status.success(),
+            "{s}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert!(out.is_file());
+    }
+}
