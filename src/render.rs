@@ -92,22 +92,55 @@ struct TileResult {
     nonfinite: u64,
 }
 
+/// A scene ready to trace: the Embree device and committed scene, built once and
+/// reused across renders (benchmarks, progressive runs).
+pub struct Renderer<'s> {
+    scene: &'s Scene,
+    accel: embree::Scene,
+    // Kept alive for as long as the committed scene.
+    _device: embree::Device,
+}
+
+impl<'s> Renderer<'s> {
+    pub fn new(scene: &'s Scene) -> Result<Self> {
+        let device = embree::Device::new("")?;
+        let accel = build_accel(scene, &device)?;
+        Ok(Renderer {
+            scene,
+            accel,
+            _device: device,
+        })
+    }
+
+    pub fn accel(&self) -> &embree::Scene {
+        &self.accel
+    }
+
+    /// Renders the image; returns the film and statistics.
+    pub fn render(&self, opts: &RenderOptions) -> Result<(Film, RenderStats)> {
+        render_with(self.scene, &self.accel, opts)
+    }
+}
+
 /// Renders `scene`; returns the film and statistics.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<(Film, RenderStats)> {
+    Renderer::new(scene)?.render(opts)
+}
+
+fn render_with(
+    scene: &Scene,
+    accel: &embree::Scene,
+    opts: &RenderOptions,
+) -> Result<(Film, RenderStats)> {
     if opts.spp == 0 {
         return Err(HeronError::Invalid("spp must be at least 1".into()));
     }
-    let device = embree::Device::new("")?;
-    let accel = build_accel(scene, &device)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .start_handler(|_| embree::set_flush_denormals())
         .build()
         .map_err(|e| HeronError::Invalid(format!("cannot start worker threads: {e}")))?;
-    let ctx = Context {
-        scene,
-        accel: &accel,
-    };
+    let ctx = Context { scene, accel };
     let cam = &scene.camera;
     let (tw, th) = (cam.width.div_ceil(TILE), cam.height.div_ceil(TILE));
     let tiles: Vec<(u32, u32)> = (0..th)
