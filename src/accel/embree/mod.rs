@@ -8,6 +8,8 @@
 //! API CONTRACT (filled in by the Embree work; signatures are fixed):
 #![allow(unsafe_code)]
 
+mod sys;
+
 use glam::Vec3;
 
 /// Errors reported by Embree, through the device error callback or return codes.
