@@ -1,3 +1,174 @@
+//! Finds Intel Embree and tells rustc how to link it.
+//!
+//! heron talks to Embree through its own FFI layer (`src/accel/embree/sys.rs`). Embree 3
+//! (Debian 12: `libembree-dev` 3.13.5, header `embree3/rtcore.h`, library `-lembree3`) is
+//! the supported version; Embree 4 (Debian 13, Ubuntu 24.04) differs in the ray-query
+//! argument lists and in `RTCHit`, and is selected with `--cfg heron_embree4`, which only
+//! `sys.rs` looks at.
+//!
+//! Probing order: the `HERON_EMBREE_DIR` prefix (`$dir/include`, `$dir/lib`) if set, then
+//! `pkg-config` (if the tool and an `embree3`/`embree4` .pc file exist), then the usual
+//! system include directories. Embree 3 is preferred when both are installed, unless
+//! `HERON_EMBREE_VERSION=4` is set. If no Embree is found the build fails with one line
+//! naming the package to install.
+//!
+//! The header's `rtcore_config.h` is read to check the compile-time options that change
+//! struct layouts or symbol names (`RTC_MAX_INSTANCE_LEVEL_COUNT`, `RTC_MIN_WIDTH`,
+//! `EMBREE_API_NAMESPACE`); sys.rs is written for Debian's defaults.
+use std::env;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const MISSING: &str = "heron needs Intel Embree: apt-get install libembree-dev";
+
+struct Found {
+    major: u32,
+    /// Directory containing `embreeN/rtcore.h`.
+    include: PathBuf,
+    /// Extra library directories (from HERON_EMBREE_DIR or pkg-config).
+    lib_dirs: Vec<PathBuf>,
+}
+
 fn main() {
-    println!("cargo:rustc-link-lib=embree3");
+    println!("cargo::rustc-check-cfg=cfg(heron_embree4)");
+    println!("cargo::rerun-if-changed=build.rs");
+    println!("cargo::rerun-if-env-changed=HERON_EMBREE_DIR");
+    println!("cargo::rerun-if-env-changed=HERON_EMBREE_VERSION");
+    println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
+
+    let preferred: &[u32] = match env::var("HERON_EMBREE_VERSION").as_deref() {
+        Ok("4") => &[4, 3],
+        _ => &[3, 4],
+    };
+    let found = preferred.iter().find_map(|&major| probe(major));
+    let Some(found) = found else {
+        fail(MISSING);
+    };
+
+    let config_h = found
+        .include
+        .join(format!("embree{}", found.major))
+        .join("rtcore_config.h");
+    // Track only files that exist: a missing path would make cargo rerun this script (and
+    // rebuild heron) on every build.
+    println!("cargo::rerun-if-changed={}", config_h.display());
+    check_config(&config_h, found.major);
+
+    for dir in &found.lib_dirs {
+        println!("cargo::rustc-link-search=native={}", dir.display());
+    }
+    println!("cargo::rustc-link-lib=dylib=embree{}", found.major);
+    if found.major == 4 {
+        println!("cargo::rustc-cfg=heron_embree4");
+    }
+}
+
+/// Prints one line and stops the build.
+fn fail(message: &str) -> ! {
+    eprintln!("{message}");
+    std::process::exit(1);
+}
+
+fn probe(major: u32) -> Option<Found> {
+    let header = |dir: &Path| dir.join(format!("embree{major}")).join("rtcore.h");
+
+    if let Some(prefix) = env::var_os("HERON_EMBREE_DIR").map(PathBuf::from) {
+        let include = prefix.join("include");
+        if header(&include).is_file() {
+            let lib_dirs = ["lib", "lib64"]
+                .iter()
+                .map(|l| prefix.join(l))
+                .filter(|d| d.is_dir())
+                .collect();
+            return Some(Found {
+                major,
+                include,
+                lib_dirs,
+            });
+        }
+    }
+
+    if let Some((includes, lib_dirs)) = pkg_config(&format!("embree{major}")) {
+        if let Some(include) = includes.into_iter().find(|d| header(d).is_file()) {
+            return Some(Found {
+                major,
+                include,
+                lib_dirs,
+            });
+        }
+    }
+
+    [
+        "/usr/include",
+        "/usr/local/include",
+        "/opt/homebrew/include",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|d| header(d).is_file())
+    .map(|include| Found {
+        major,
+        include,
+        lib_dirs: Vec::new(),
+    })
+}
+
+/// `pkg-config --cflags-only-I --libs-only-L NAME`, parsed; None if the tool or the .pc
+/// file is missing. The directories the .pc names (and the default include directory,
+/// which pkg-config leaves out) are returned.
+fn pkg_config(name: &str) -> Option<(Vec<PathBuf>, Vec<PathBuf>)> {
+    let out = Command::new("pkg-config")
+        .args(["--cflags-only-I", "--libs-only-L", name])
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut includes = Vec::new();
+    let mut libs = Vec::new();
+    for word in text.split_whitespace() {
+        if let Some(dir) = word.strip_prefix("-I") {
+            includes.push(PathBuf::from(dir));
+        } else if let Some(dir) = word.strip_prefix("-L") {
+            libs.push(PathBuf::from(dir));
+        }
+    }
+    includes.push(PathBuf::from("/usr/include"));
+    Some((includes, libs))
+}
+
+/// Checks the compile-time options in `rtcore_config.h` that sys.rs hard-codes.
+fn check_config(config_h: &Path, major: u32) {
+    let text = std::fs::read_to_string(config_h)
+        .unwrap_or_else(|e| fail(&format!("heron: cannot read {}: {e}", config_h.display())));
+    let define = |name: &str| -> Option<String> {
+        text.lines().find_map(|line| {
+            let mut words = line.split_whitespace();
+            (words.next() == Some("#define") && words.next() == Some(name))
+                .then(|| words.next().unwrap_or("").to_string())
+        })
+    };
+    let expect = |name: &str, want: &str| {
+        let got = define(name);
+        if got.as_deref() != Some(want) {
+            fail(&format!(
+                "heron: {} has {name} = {}, but heron's Embree bindings assume {want} \
+                 (Debian's libembree-dev default)",
+                config_h.display(),
+                got.as_deref().unwrap_or("<undefined>")
+            ));
+        }
+    };
+    expect("RTC_VERSION_MAJOR", &major.to_string());
+    expect("RTC_MAX_INSTANCE_LEVEL_COUNT", "1");
+    // RTC_MIN_WIDTH is defined as EMBREE_MIN_WIDTH, which is 0 or 1.
+    expect("EMBREE_MIN_WIDTH", "0");
+    if define("EMBREE_API_NAMESPACE").is_some() {
+        fail(&format!(
+            "heron: {} defines EMBREE_API_NAMESPACE (C++-mangled symbols); heron needs \
+             Embree built with its C API",
+            config_h.display()
+        ));
+    }
 }

@@ -5,8 +5,27 @@
 //! committed (so it can be shared by all worker threads), and query functions for single
 //! rays and 8-wide packets.
 //!
-//! API CONTRACT (filled in by the Embree work; signatures are fixed):
+//! * `sys.rs` (private): the `extern "C"` declarations and `#[repr(C)]` structs, with the
+//!   Embree 3/4 difference behind `cfg(heron_embree4)` (set by build.rs).
+//! * [`Device`] (device.rs): `rtcNewDevice`, the error callback, error checks.
+//! * [`SceneBuilder`], [`Scene`] (scene.rs): geometry, commit, queries.
+//!
+//! References are to the Embree 3 API man pages shipped in `libembree-dev`
+//! (`man rtcIntersect1`), the same text as the "Embree API" chapter of the Embree 3
+//! documentation.
+//!
+//! Usage: one [`Device`] per process; build a scene with [`Device::scene_builder`], add
+//! shapes (their geometry IDs are 0, 1, 2, … in insertion order), [`SceneBuilder::commit`],
+//! then share the [`Scene`] (e.g. in an `Arc`) with the worker threads, each of which
+//! calls [`set_flush_denormals`] once.
 #![allow(unsafe_code)]
+
+mod device;
+mod scene;
+mod sys;
+
+pub use device::Device;
+pub use scene::{Scene, SceneBuilder};
 
 use glam::Vec3;
 
@@ -20,6 +39,10 @@ pub enum EmbreeError {
 }
 
 /// One ray for a query. `tnear` is the lecture's epsilon offset, `tfar` the cutoff.
+///
+/// `dir` need not be normalised; `t` is measured in units of `dir`. Embree needs a finite
+/// origin and direction, a non-zero direction and `0 <= tnear <= tfar` (`tfar` may be
+/// infinite); queries answer other rays with "no hit" / "not occluded" without tracing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayQuery {
     pub origin: Vec3,
@@ -30,6 +53,10 @@ pub struct RayQuery {
 
 /// A closest hit. `ng` is Embree's unnormalised geometric normal; `u`, `v` are the
 /// barycentric coordinates for triangles.
+///
+/// Triangles: `ng = (p1 - p0) × (p2 - p0)` (counter-clockwise front face), hit point
+/// `(1-u-v) p0 + u p1 + v p2`. Spheres: `ng` points outwards (from the centre through the
+/// hit point, length ≈ radius), also for a ray that starts inside; `u = v = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     pub t: f32,
@@ -40,71 +67,61 @@ pub struct Hit {
     pub v: f32,
 }
 
-/// An Embree device (`rtcNewDevice`), released on drop.
-pub struct Device {/* private */}
-
-/// A scene being built. Geometry IDs are assigned in insertion order starting at 0, so
-/// they index heron's own per-shape Vecs.
-pub struct SceneBuilder<'d> {
-    _device: &'d Device,
+/// Hint for Embree's traversal (`RTC_INTERSECT_CONTEXT_FLAG_COHERENT/INCOHERENT`,
+/// `rtcInitIntersectContext(3)`): coherent rays (camera rays of one tile, shadow rays to
+/// one light) may traverse faster with `Coherent`. Results are the same either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RayCoherence {
+    #[default]
+    Incoherent,
+    Coherent,
 }
 
-/// A committed scene: immutable, `Send + Sync`, queried concurrently by all workers.
-pub struct Scene {/* private */}
-
-impl Device {
-    /// Creates a device; `config` is Embree's configuration string (may be empty).
-    pub fn new(config: &str) -> Result<Device, EmbreeError> {
-        let _ = config;
-        unimplemented!()
-    }
-    pub fn scene_builder(&self) -> SceneBuilder<'_> {
-        unimplemented!()
-    }
-}
-
-impl<'d> SceneBuilder<'d> {
-    /// Adds a triangle mesh; returns its geometry ID.
-    pub fn add_triangle_mesh(
-        &mut self,
-        positions: &[Vec3],
-        indices: &[[u32; 3]],
-    ) -> Result<u32, EmbreeError> {
-        let _ = (positions, indices);
-        unimplemented!()
-    }
-    /// Adds one sphere; returns its geometry ID.
-    pub fn add_sphere(&mut self, center: Vec3, radius: f32) -> Result<u32, EmbreeError> {
-        let _ = (center, radius);
-        unimplemented!()
-    }
-    /// Commits (builds the BVH). After this the scene cannot be modified.
-    pub fn commit(self) -> Result<Scene, EmbreeError> {
-        unimplemented!()
-    }
-}
-
-impl Scene {
-    pub fn intersect1(&self, ray: &RayQuery) -> Option<Hit> {
-        let _ = ray;
-        unimplemented!()
-    }
-    pub fn occluded1(&self, ray: &RayQuery) -> bool {
-        let _ = ray;
-        unimplemented!()
-    }
-    /// Coherent 8-wide packet; lanes whose bit in `active` is 0 are ignored and get None.
-    pub fn intersect8(&self, rays: &[RayQuery; 8], active: u8) -> [Option<Hit>; 8] {
-        let _ = (rays, active);
-        unimplemented!()
-    }
-    /// Returns a bit mask of the active lanes that are occluded.
-    pub fn occluded8(&self, rays: &[RayQuery; 8], active: u8) -> u8 {
-        let _ = (rays, active);
-        unimplemented!()
-    }
-}
+/// MXCSR bit 15: flush-to-zero (denormal results become 0).
+#[cfg(target_arch = "x86_64")]
+const MXCSR_FTZ: u32 = 1 << 15;
+/// MXCSR bit 6: denormals-are-zero (denormal inputs are read as 0).
+#[cfg(target_arch = "x86_64")]
+const MXCSR_DAZ: u32 = 1 << 6;
 
 /// Sets the flush-to-zero and denormals-are-zero bits of the calling thread's MXCSR, as
 /// Embree asks of every thread that traces rays. Call once per worker thread.
-pub fn set_flush_denormals() {}
+///
+/// Embree's performance recommendations ("Embree API", section "Performance
+/// Recommendations: MXCSR control and status register") ask for FTZ and DAZ so that
+/// denormal numbers do not slow traversal down. No-op on targets other than x86_64.
+pub fn set_flush_denormals() {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[allow(deprecated)]
+        use std::arch::x86_64::{_mm_getcsr, _mm_setcsr};
+        // SAFETY: reads MXCSR; SSE is part of the x86_64 baseline.
+        #[allow(deprecated)]
+        let csr = unsafe { _mm_getcsr() };
+        // SAFETY: SSE is part of the x86_64 baseline. Only the FTZ and DAZ bits change;
+        // rounding mode and exception masks are kept, so no floating-point exception is
+        // unmasked. Denormal handling is a numerical effect, not a memory-safety one.
+        #[allow(deprecated)]
+        unsafe {
+            _mm_setcsr(csr | MXCSR_FTZ | MXCSR_DAZ)
+        };
+    }
+}
+
+/// Whether both flush-to-zero and denormals-are-zero are set on the calling thread (always
+/// false on targets other than x86_64). For debug assertions in render workers.
+pub fn flush_denormals_enabled() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[allow(deprecated)]
+        use std::arch::x86_64::_mm_getcsr;
+        // SAFETY: reads MXCSR; SSE is part of the x86_64 baseline.
+        #[allow(deprecated)]
+        let csr = unsafe { _mm_getcsr() };
+        csr & (MXCSR_FTZ | MXCSR_DAZ) == MXCSR_FTZ | MXCSR_DAZ
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
