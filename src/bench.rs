@@ -62,7 +62,8 @@ pub fn load_obj_mesh(path: &Path) -> Result<Mesh> {
         single_index: false,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| err(format!("cannot read OBJ: {e}")))?;
+    let (models, _) =
+        tobj::load_obj(path, &opts).map_err(|e| err(format!("cannot read OBJ: {e}")))?;
     let mut mesh = Mesh::default();
     for m in models {
         let base = mesh.positions.len() as u32;
@@ -99,7 +100,11 @@ pub fn procedural_mesh(n: u32) -> Mesh {
             let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
             let r = 1.0 + 0.05 * (7.0 * theta).sin() * (9.0 * phi).cos();
             mesh.positions.push(
-                r * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()),
+                r * Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                ),
             );
         }
     }
@@ -313,7 +318,11 @@ fn trace_batch(scene: &embree::Scene, rays: &[RayQuery], packet: usize) -> u64 {
         for c in rays.chunks(8) {
             let mut p = [c[0]; 8];
             p[..c.len()].copy_from_slice(c);
-            let active = if c.len() == 8 { 0xff } else { (1u8 << c.len()) - 1 };
+            let active = if c.len() == 8 {
+                0xff
+            } else {
+                (1u8 << c.len()) - 1
+            };
             hits += scene
                 .intersect8(&p, active)
                 .iter()
@@ -322,7 +331,10 @@ fn trace_batch(scene: &embree::Scene, rays: &[RayQuery], packet: usize) -> u64 {
                 .count() as u64;
         }
     } else {
-        hits = rays.iter().filter(|r| scene.intersect1(r).is_some()).count() as u64;
+        hits = rays
+            .iter()
+            .filter(|r| scene.intersect1(r).is_some())
+            .count() as u64;
     }
     hits
 }

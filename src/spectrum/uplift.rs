@@ -66,18 +66,25 @@ fn smits_terms(rgb: [f32; 3]) -> [(&'static DenseSpectrum, f32); 3] {
     }
 }
 
-/// Reflectance spectrum for a linear sRGB reflectance (components expected in [0, 1];
-/// the scene loader checks that).
-pub fn rgb_to_reflectance(rgb: [f32; 3]) -> DenseSpectrum {
+fn smits(rgb: [f32; 3]) -> DenseSpectrum {
     let t = smits_terms(rgb);
     DenseSpectrum::from_fn(|l| t.iter().map(|(s, w)| w * s.eval(l)).sum::<f32>().max(0.0))
+}
+
+/// Reflectance spectrum for a linear sRGB reflectance (components expected in [0, 1];
+/// the scene loader checks that). Smits' red and cyan bases exceed 1 slightly (up to
+/// 1.015), so the result is clamped to [0, 1]: a surface must not reflect more than it
+/// receives at any wavelength.
+pub fn rgb_to_reflectance(rgb: [f32; 3]) -> DenseSpectrum {
+    let s = smits(rgb);
+    DenseSpectrum::from_fn(|l| s.eval(l).min(1.0))
 }
 
 /// Emission spectrum for a linear sRGB emitter colour (components ≥ 0): the Smits
 /// uplift times D65 scaled to luminance Y = 1, so (1, 1, 1) is the sRGB white point
 /// with Y = 1, and the colour scales linearly with the components.
 pub fn rgb_to_illuminant(rgb: [f32; 3]) -> DenseSpectrum {
-    rgb_to_reflectance(rgb).mul(d65_unit())
+    smits(rgb).mul(d65_unit())
 }
 
 /// Named spectra a scene may use: "E" (equal energy, 1 at every wavelength) and "D65"
@@ -89,5 +96,56 @@ pub fn named(name: &str) -> Option<DenseSpectrum> {
         "E" => Some(DenseSpectrum::constant(1.0)),
         "D65" => Some(d65_unit().clone()),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::cie::spectrum_to_xyz;
+    use crate::spectrum::color::xyz_to_linear_srgb;
+
+    #[test]
+    fn reflectances_stay_within_zero_and_one() {
+        for r in 0..=10 {
+            for g in 0..=10 {
+                for b in 0..=10 {
+                    let rgb = [r as f32 / 10.0, g as f32 / 10.0, b as f32 / 10.0];
+                    let s = rgb_to_reflectance(rgb);
+                    assert!(s.min_value() >= 0.0 && s.max_value() <= 1.0, "{rgb:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn white_light_is_srgb_white_with_unit_luminance() {
+        let c = xyz_to_linear_srgb(spectrum_to_xyz(&rgb_to_illuminant([1.0, 1.0, 1.0])));
+        for v in c {
+            assert!((v - 1.0).abs() < 2e-3, "{c:?}");
+        }
+        let d = spectrum_to_xyz(&named("D65").unwrap());
+        assert!((d[1] - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn illuminant_colours_come_back_close_to_their_rgb() {
+        // Smits' basis was fitted for a different RGB space, so it is no exact inverse
+        // of sRGB: the green primary comes back with 0.09 blue. Greys and the course's
+        // background within 0.03, primaries within 0.1.
+        for rgb in [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.5, 0.5, 0.5],
+            [0.1, 0.3, 0.6],
+        ] {
+            let c = xyz_to_linear_srgb(spectrum_to_xyz(&rgb_to_illuminant(rgb)));
+            let grey_or_soft = rgb.iter().all(|&v| v > 0.05);
+            let tol = if grey_or_soft { 0.03 } else { 0.1 };
+            for i in 0..3 {
+                assert!((c[i] - rgb[i]).abs() < tol, "{rgb:?} -> {c:?}");
+            }
+        }
     }
 }
