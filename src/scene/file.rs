@@ -1,1 +1,678 @@
 //! The scene file format (TOML, serde).
+//!
+//! A scene file is a TOML document whose top level is [`SceneFile`]. Materials, shapes
+//! and lights are internally tagged by their `type` key. Every struct denies unknown
+//! keys, so a misspelt key is an error rather than a silently ignored default.
+//!
+//! The leaf types of this module ([`Point3`], [`Direction3`], [`PositiveNumber`],
+//! [`UnitNumber`], [`PositiveCount`], [`Resolution`], [`Reflectance`], [`Emission`])
+//! check their own range while they are deserialized, so that an out-of-range number is
+//! reported with the key path serde is at, in the words "expected …, got …". Checks that
+//! involve several keys (ρd + ρs ≤ 1, zero-area triangles, material names) are in
+//! [`super::load`].
+//!
+//! Example (the seed lecture's default scene is `scenes/default.toml`):
+//!
+//! ```toml
+//! background = [0.1, 0.3, 0.6]      # optional colour (emission), default black
+//!
+//! [camera]
+//! eye = [2.0, 1.5, 2.0]
+//! look_at = [0.0, 0.5, 0.0]
+//! up = [0.0, 1.0, 0.0]              # optional, default [0, 1, 0]
+//! d = 1.0                           # camera constant, optional, default 1
+//! resolution = [512, 512]           # [width, height]
+//!
+//! [render]                          # optional, defaults from RenderSettings::default()
+//! spp = 16
+//! max_depth = 10
+//! epsilon = 1e-4
+//! seed = 0
+//!
+//! [materials.floor]
+//! type = "lambertian"
+//! rho_d = [0.1, 0.7, 0.0]
+//!
+//! [[shapes]]
+//! type = "plane"
+//! point = [0.0, 0.0, 0.0]
+//! normal = [0.0, 1.0, 0.0]
+//! material = "floor"
+//!
+//! [[lights]]
+//! type = "point"
+//! position = [0.0, 1.0, 0.0]
+//! intensity = 3.14159265
+//! ```
+//!
+//! A colour is a number (grey), `[r, g, b]` in linear sRGB, or
+//! `{ spectrum = "E" | "D65", scale = 1.0 }` (scale optional, default 1).
+use crate::spectrum::uplift::{named, rgb_to_illuminant, rgb_to_reflectance, NAMED_SPECTRA};
+use crate::spectrum::DenseSpectrum;
+use glam::Vec3;
+use serde::de::{Deserialize, Deserializer, Error as _};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// Largest accepted image width or height.
+pub const MAX_RESOLUTION: u32 = 16384;
+
+/// The whole scene file.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Radiance of rays that leave the scene; default black.
+    #[serde(default)]
+    pub background: Option<Emission>,
+    pub camera: CameraFile,
+    #[serde(default)]
+    pub render: Option<RenderFile>,
+    /// Materials by name. A TOML table has no order that survives parsing, so the loaded
+    /// scene lists materials sorted by name (the order of this map).
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialFile>,
+    #[serde(default)]
+    pub shapes: Vec<ShapeFile>,
+    #[serde(default)]
+    pub lights: Vec<LightFile>,
+}
+
+/// `[camera]`: the seed's pinhole camera.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraFile {
+    pub eye: Point3,
+    pub look_at: Point3,
+    /// Default `[0, 1, 0]`.
+    #[serde(default)]
+    pub up: Option<Direction3>,
+    /// Camera constant d (distance to an image plane of height 1); default 1.
+    #[serde(default)]
+    pub d: Option<PositiveNumber>,
+    pub resolution: Resolution,
+}
+
+/// `[render]`: every key optional, defaults from `RenderSettings::default()`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderFile {
+    #[serde(default)]
+    pub spp: Option<PositiveCount>,
+    #[serde(default)]
+    pub max_depth: Option<PositiveCount>,
+    /// The seed's ray offset ε.
+    #[serde(default)]
+    pub epsilon: Option<PositiveNumber>,
+    #[serde(default)]
+    pub seed: Option<u64>,
+}
+
+/// `[materials.NAME]`, tagged by `type`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum MaterialFile {
+    Lambertian(LambertianFile),
+    Mirror(MirrorFile),
+    Dielectric(DielectricFile),
+    Glossy(GlossyFile),
+}
+
+/// The `type` values of [`MaterialFile`], in declaration order.
+pub const MATERIAL_TYPES: &[&str] = &["lambertian", "mirror", "dielectric", "glossy"];
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LambertianFile {
+    pub rho_d: Reflectance,
+}
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MirrorFile {
+    /// Default 1 (the lecture's ideal mirror).
+    #[serde(default)]
+    pub rho_s: Option<Reflectance>,
+}
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DielectricFile {
+    pub ior: PositiveNumber,
+    /// Default true; false is the lecture's pure refraction.
+    #[serde(default)]
+    pub fresnel: Option<bool>,
+}
+
+/// The seed's modified Phong model, optionally over a refractive base (`ior`).
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GlossyFile {
+    pub rho_d: Reflectance,
+    pub rho_s: UnitNumber,
+    pub shininess: PositiveNumber,
+    #[serde(default)]
+    pub ior: Option<PositiveNumber>,
+    /// Only allowed together with `ior`; default true.
+    #[serde(default)]
+    pub fresnel: Option<bool>,
+}
+
+/// `[[shapes]]`, tagged by `type`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum ShapeFile {
+    Sphere(SphereFile),
+    Triangle(TriangleFile),
+    Plane(PlaneFile),
+    Quad(QuadFile),
+    Mesh(MeshFile),
+}
+
+/// The `type` values of [`ShapeFile`], in declaration order.
+pub const SHAPE_TYPES: &[&str] = &["sphere", "triangle", "plane", "quad", "mesh"];
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereFile {
+    pub center: Point3,
+    pub radius: PositiveNumber,
+    pub material: String,
+}
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TriangleFile {
+    /// Counter-clockwise seen from the front: the geometric normal is
+    /// (v1 − v0) × (v2 − v0).
+    pub vertices: [Point3; 3],
+    pub material: String,
+}
+
+/// An infinite plane, stored as a square of half-extent `size` centred at `point`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneFile {
+    pub point: Point3,
+    pub normal: Direction3,
+    /// Half-extent of the square; default 1000.
+    #[serde(default)]
+    pub size: Option<PositiveNumber>,
+    pub material: String,
+}
+
+/// The parallelogram origin + s·edge1 + t·edge2, s, t ∈ [0, 1]; normal edge1 × edge2.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadFile {
+    pub origin: Point3,
+    pub edge1: Direction3,
+    pub edge2: Direction3,
+    pub material: String,
+}
+
+/// A Wavefront OBJ triangle mesh.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshFile {
+    /// Relative to the folder of the scene file.
+    pub file: String,
+    /// Material of the OBJ objects/groups not listed in `groups`; may be left out when
+    /// `groups` covers every object of the file.
+    #[serde(default)]
+    pub material: Option<String>,
+    /// OBJ object or group name (`o NAME` / `g NAME`) -> material name.
+    #[serde(default)]
+    pub groups: BTreeMap<String, String>,
+    /// Uniform scale, applied before the translation; default 1.
+    #[serde(default)]
+    pub scale: Option<PositiveNumber>,
+    /// Default `[0, 0, 0]`.
+    #[serde(default)]
+    pub translate: Option<Point3>,
+}
+
+/// `[[lights]]`, tagged by `type`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum LightFile {
+    Point(PointLightFile),
+    Directional(DirectionalLightFile),
+}
+
+/// The `type` values of [`LightFile`], in declaration order.
+pub const LIGHT_TYPES: &[&str] = &["point", "directional"];
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightFile {
+    pub position: Point3,
+    /// Radiant intensity, a colour.
+    pub intensity: Emission,
+}
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalLightFile {
+    /// The direction the light travels; normalised on load.
+    pub direction: Direction3,
+    pub radiance: Emission,
+}
+
+// ---------------------------------------------------------------------------------------
+// Leaf types: each is read as a raw TOML value and checked, so that its error message is
+// ours ("expected …, got …") and sits at the key path of the value.
+
+/// `[x, y, z]`, three numbers finite in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point3(pub Vec3);
+
+/// `[x, y, z]`, finite and not the zero vector (not normalised).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Direction3(pub Vec3);
+
+impl Direction3 {
+    /// The unit vector, computed without overflow or underflow for any finite non-zero
+    /// vector (scaled by its largest component first).
+    pub fn unit(&self) -> Vec3 {
+        (self.0 / self.0.abs().max_element()).normalize()
+    }
+}
+
+/// A number > 0, finite in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositiveNumber(pub f32);
+
+/// A number in [0, 1].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnitNumber(pub f32);
+
+/// An integer ≥ 1 that fits in u32.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PositiveCount(pub u32);
+
+/// `[width, height]`, each in 1..=[`MAX_RESOLUTION`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolution {
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A colour as written in a file, before it is known whether it is a reflectance or an
+/// emission.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Colour {
+    Grey(f32),
+    Rgb([f32; 3]),
+    /// One of [`NAMED_SPECTRA`] times `scale`.
+    Named {
+        spectrum: String,
+        scale: f32,
+    },
+}
+
+/// A colour that is a reflectance: every RGB component in [0, 1], or a named spectrum
+/// whose maximum times `scale` is at most 1.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reflectance(pub Colour);
+
+/// A colour that is an emission: every RGB component ≥ 0, or a named spectrum with
+/// `scale` ≥ 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Emission(pub Colour);
+
+impl Colour {
+    /// The colour's RGB components if it is given as RGB (grey is `[g, g, g]`).
+    pub fn rgb(&self) -> Option<[f32; 3]> {
+        match *self {
+            Colour::Grey(g) => Some([g; 3]),
+            Colour::Rgb(c) => Some(c),
+            Colour::Named { .. } => None,
+        }
+    }
+
+    /// The named spectrum times its scale, for `Colour::Named` (the name was checked on
+    /// load, so it exists).
+    fn named_spectrum(&self) -> Option<DenseSpectrum> {
+        match self {
+            Colour::Named { spectrum, scale } => named(spectrum).map(|s| s.scaled(*scale)),
+            _ => None,
+        }
+    }
+
+    /// Largest value the colour reaches: its largest RGB component, or the maximum of the
+    /// named spectrum over wavelength.
+    pub fn max_value(&self) -> f32 {
+        match self.rgb() {
+            Some([r, g, b]) => r.max(g).max(b),
+            None => self.named_spectrum().map_or(0.0, |s| s.max_value()),
+        }
+    }
+}
+
+impl Reflectance {
+    /// Spectral reflectance: a single number g is the neutral reflectance, exactly g at
+    /// every wavelength; `[r, g, b]` is uplifted after Smits (1999) (`[g, g, g]` comes
+    /// out within 1e-3 of g, the precision of Smits' table); a named spectrum is itself
+    /// times its scale.
+    pub fn spectrum(&self) -> DenseSpectrum {
+        match &self.0 {
+            Colour::Grey(g) => DenseSpectrum::constant(*g),
+            Colour::Rgb(rgb) => rgb_to_reflectance(*rgb),
+            Colour::Named { .. } => self
+                .0
+                .named_spectrum()
+                .unwrap_or_else(|| DenseSpectrum::constant(0.0)),
+        }
+    }
+}
+
+impl Emission {
+    /// Emission spectrum: a single number g is g times the sRGB white point, D65 scaled
+    /// to luminance Y = 1 (exactly; `rgb_to_illuminant([g, g, g])` is the same within
+    /// Smits' 1e-3); `[r, g, b]` is uplifted with `rgb_to_illuminant`; a named spectrum is
+    /// itself times its scale.
+    pub fn spectrum(&self) -> DenseSpectrum {
+        match &self.0 {
+            Colour::Grey(g) => {
+                named("D65").map_or_else(|| rgb_to_illuminant([*g; 3]), |d65| d65.scaled(*g))
+            }
+            Colour::Rgb(rgb) => rgb_to_illuminant(*rgb),
+            Colour::Named { .. } => self
+                .0
+                .named_spectrum()
+                .unwrap_or_else(|| DenseSpectrum::constant(0.0)),
+        }
+    }
+}
+
+/// A TOML value written back on one line for an error message, shortened when long.
+pub fn show(v: &toml::Value) -> String {
+    let mut s = String::new();
+    show_into(v, &mut s);
+    if s.chars().count() > 80 {
+        let cut: String = s.chars().take(77).collect();
+        format!("{cut}...")
+    } else {
+        s
+    }
+}
+
+fn show_into(v: &toml::Value, s: &mut String) {
+    match v {
+        toml::Value::String(x) => {
+            let _ = write!(s, "{x:?}");
+        }
+        toml::Value::Integer(x) => {
+            let _ = write!(s, "{x}");
+        }
+        toml::Value::Float(x) => {
+            let _ = write!(s, "{}", fmt_f64(*x));
+        }
+        toml::Value::Boolean(x) => {
+            let _ = write!(s, "{x}");
+        }
+        toml::Value::Datetime(x) => {
+            let _ = write!(s, "{x}");
+        }
+        toml::Value::Array(a) => {
+            s.push('[');
+            for (i, x) in a.iter().enumerate() {
+                if i > 0 {
+                    s.push_str(", ");
+                }
+                show_into(x, s);
+            }
+            s.push(']');
+        }
+        toml::Value::Table(t) => {
+            if t.is_empty() {
+                s.push_str("{}");
+                return;
+            }
+            s.push_str("{ ");
+            for (i, (k, x)) in t.iter().enumerate() {
+                if i > 0 {
+                    s.push_str(", ");
+                }
+                let _ = write!(s, "{k} = ");
+                show_into(x, s);
+            }
+            s.push_str(" }");
+        }
+    }
+}
+
+/// TOML's spelling of a float (`nan`, `inf`, `-inf`, else Rust's shortest form).
+fn fmt_f64(x: f64) -> String {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.into()
+    } else {
+        format!("{x}")
+    }
+}
+
+/// A TOML number (integer or float) as f64.
+fn number(v: &toml::Value) -> Option<f64> {
+    match *v {
+        toml::Value::Integer(i) => Some(i as f64),
+        toml::Value::Float(f) => Some(f),
+        _ => None,
+    }
+}
+
+/// A number that is finite in f32 (TOML allows nan and inf, and a finite f64 may
+/// overflow f32).
+fn finite_f32(v: &toml::Value) -> Option<f32> {
+    number(v).map(|x| x as f32).filter(|x| x.is_finite())
+}
+
+fn vec3(v: &toml::Value) -> Option<Vec3> {
+    match v {
+        toml::Value::Array(a) if a.len() == 3 => {
+            let x = finite_f32(&a[0])?;
+            let y = finite_f32(&a[1])?;
+            let z = finite_f32(&a[2])?;
+            Some(Vec3::new(x, y, z))
+        }
+        _ => None,
+    }
+}
+
+fn raw<'de, D: Deserializer<'de>>(d: D) -> Result<toml::Value, D::Error> {
+    toml::Value::deserialize(d)
+}
+
+impl<'de> Deserialize<'de> for Point3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        vec3(&v).map(Point3).ok_or_else(|| {
+            D::Error::custom(format!(
+                "expected [x, y, z] with three finite numbers, got {}",
+                show(&v)
+            ))
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for Direction3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match vec3(&v) {
+            Some(p) if p.abs().max_element() > 0.0 => Ok(Direction3(p)),
+            _ => Err(D::Error::custom(format!(
+                "expected a non-zero vector [x, y, z] of finite numbers, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PositiveNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match finite_f32(&v) {
+            Some(x) if x > 0.0 => Ok(PositiveNumber(x)),
+            _ => Err(D::Error::custom(format!(
+                "expected a positive finite number, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for UnitNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match number(&v) {
+            Some(x) if (0.0..=1.0).contains(&x) => Ok(UnitNumber(x as f32)),
+            _ => Err(D::Error::custom(format!(
+                "expected a number in [0, 1], got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PositiveCount {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match v {
+            toml::Value::Integer(i) if i >= 1 && i <= u32::MAX as i64 => {
+                Ok(PositiveCount(i as u32))
+            }
+            _ => Err(D::Error::custom(format!(
+                "expected a positive integer, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Resolution {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let ok = |x: &toml::Value| match *x {
+            toml::Value::Integer(i) if i >= 1 && i <= MAX_RESOLUTION as i64 => Some(i as u32),
+            _ => None,
+        };
+        if let toml::Value::Array(a) = &v {
+            if let [w, h] = a.as_slice() {
+                if let (Some(width), Some(height)) = (ok(w), ok(h)) {
+                    return Ok(Resolution { width, height });
+                }
+            }
+        }
+        Err(D::Error::custom(format!(
+            "expected [width, height] with positive integers (at most {MAX_RESOLUTION}), got {}",
+            show(&v)
+        )))
+    }
+}
+
+const COLOUR_FORMS: &str =
+    "a colour: a number, [r, g, b], or { spectrum = \"E\" | \"D65\", scale = number }";
+
+/// Reads the shape of a colour; ranges are checked by [`Reflectance`] and [`Emission`].
+fn colour(v: &toml::Value) -> Result<Colour, String> {
+    let shape_err = || format!("expected {COLOUR_FORMS}, got {}", show(v));
+    let comp = |x: &toml::Value| {
+        number(x)
+            .map(|x| x as f32)
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("expected a colour with finite components, got {}", show(v)))
+    };
+    match v {
+        toml::Value::Integer(_) | toml::Value::Float(_) => Ok(Colour::Grey(comp(v)?)),
+        toml::Value::Array(a) if a.len() == 3 => {
+            if a.iter().any(|x| number(x).is_none()) {
+                return Err(shape_err());
+            }
+            Ok(Colour::Rgb([comp(&a[0])?, comp(&a[1])?, comp(&a[2])?]))
+        }
+        toml::Value::Table(t) => {
+            for k in t.keys() {
+                if k != "spectrum" && k != "scale" {
+                    return Err(format!(
+                        "unknown key {k:?} in a named-spectrum colour (expected one of spectrum, scale)"
+                    ));
+                }
+            }
+            let name = match t.get("spectrum") {
+                Some(toml::Value::String(s)) => s.clone(),
+                Some(other) => {
+                    return Err(format!(
+                        "expected spectrum = one of {}, got {}",
+                        NAMED_SPECTRA.join(", "),
+                        show(other)
+                    ))
+                }
+                None => return Err(format!("{}; the key \"spectrum\" is missing", shape_err())),
+            };
+            if named(&name).is_none() {
+                return Err(format!(
+                    "unknown spectrum {name:?}, expected one of {}",
+                    NAMED_SPECTRA.join(", ")
+                ));
+            }
+            let scale = match t.get("scale") {
+                None => 1.0,
+                Some(s) => number(s)
+                    .map(|x| x as f32)
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| format!("expected scale = a finite number, got {}", show(s)))?,
+            };
+            Ok(Colour::Named {
+                spectrum: name,
+                scale,
+            })
+        }
+        _ => Err(shape_err()),
+    }
+}
+
+impl<'de> Deserialize<'de> for Reflectance {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let c = colour(&v).map_err(D::Error::custom)?;
+        let ok = match &c {
+            Colour::Named { scale, .. } => *scale >= 0.0 && c.max_value() <= 1.0,
+            _ => c
+                .rgb()
+                .is_some_and(|x| x.iter().all(|&x| (0.0..=1.0).contains(&x))),
+        };
+        if ok {
+            Ok(Reflectance(c))
+        } else if let Colour::Named { spectrum, scale } = &c {
+            Err(D::Error::custom(format!(
+                "expected a reflectance in [0, 1] at every wavelength, got spectrum {spectrum:?} with scale {scale}, whose maximum is {}",
+                c.max_value()
+            )))
+        } else {
+            Err(D::Error::custom(format!(
+                "expected a reflectance with every component in [0, 1], got {}",
+                show(&v)
+            )))
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Emission {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let c = colour(&v).map_err(D::Error::custom)?;
+        let ok = match &c {
+            Colour::Named { scale, .. } => *scale >= 0.0,
+            _ => c.rgb().is_some_and(|x| x.iter().all(|&x| x >= 0.0)),
+        };
+        if ok {
+            Ok(Emission(c))
+        } else {
+            Err(D::Error::custom(format!(
+                "expected an emission with every component (or the scale) >= 0, got {}",
+                show(&v)
+            )))
+        }
+    }
+}

@@ -1,11 +1,780 @@
 //! Loading and validating a scene file into a [`Scene`](super::Scene).
-use super::Scene;
-use crate::error::Result;
-use std::path::Path;
+//!
+//! Three stages, each failing with `HeronError::Scene { file, message }` and a one-line
+//! message that starts with the key path (or the line and column for TOML syntax):
+//!
+//! 1. TOML syntax: the text is parsed into a table (`line 3, column 9: …`).
+//! 2. Shape of the data: the table is deserialized into [`SceneFile`] through
+//!    `serde_path_to_error`, whose leaf types check ranges (`shapes[2].radius: expected a
+//!    positive finite number, got -0.3`). serde's internally tagged enums buffer the
+//!    item they read, which loses the key path inside `materials.X`, `shapes[i]` and
+//!    `lights[i]`; when an error lands on such an item, the item alone is deserialized
+//!    again into the struct of its `type` to recover the full path.
+//! 3. Cross-key checks while building the [`Scene`]: material names, ρd + ρs ≤ 1,
+//!    zero-area triangles and quads, the camera, and the meshes (whose errors name the
+//!    mesh file and carry the scene's key path in the message).
+//!
+//! Orders: `Scene::materials` is sorted by material name (a TOML table keeps no order);
+//! `Scene::shapes` follows the file, and a mesh entry becomes one shape per material it
+//! uses, in the order in which the materials' OBJ groups first appear in the OBJ file.
+mod obj;
+
+use super::file::{
+    show, Colour, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile, LightFile,
+    MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, SceneFile, ShapeFile,
+    SphereFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
+};
+use super::{RenderSettings, Scene};
+use crate::bsdf::{Dielectric, Glossy, Lambertian, Material, Mirror};
+use crate::camera::Camera;
+use crate::error::{HeronError, Result};
+use crate::geometry::{Mesh, Shape, ShapeKind};
+use crate::light::{DirectionalLight, Light, PointLight};
+use crate::spectrum::DenseSpectrum;
+use glam::Vec3;
+use serde::de::DeserializeOwned;
+use std::collections::{BTreeMap, HashMap};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 /// Reads, parses and validates the scene file at `path` (meshes are resolved relative to
 /// it). Every error names the file, the key path and what was expected.
 pub fn load_scene(path: &Path) -> Result<Scene> {
-    let _ = path;
-    unimplemented!()
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| scene_error(path, format!("cannot read the scene file: {e}")))?;
+    load_scene_from_str(&text, path)
+}
+
+/// Like [`load_scene`] for scene text already in memory; `path` names the file in error
+/// messages and its folder is where relative mesh paths start.
+pub fn load_scene_from_str(text: &str, path: &Path) -> Result<Scene> {
+    let file = parse_scene_file(text).map_err(|m| scene_error(path, m))?;
+    build(path, file)
+}
+
+/// Stages 1 and 2: TOML text to [`SceneFile`]. The error is the one-line message.
+pub fn parse_scene_file(text: &str) -> std::result::Result<SceneFile, String> {
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        let msg = one_line(e.message());
+        match e.span() {
+            Some(span) => {
+                let (line, col) = line_col(text, span.start);
+                format!("line {line}, column {col}: TOML syntax error: {msg}")
+            }
+            None => format!("TOML syntax error: {msg}"),
+        }
+    })?;
+    require_tables(&table)?;
+    match serde_path_to_error::deserialize::<_, SceneFile>(toml::Value::Table(table.clone())) {
+        Ok(f) => Ok(f),
+        Err(e) => {
+            let mut path = segments(e.path());
+            let mut msg = e.inner().message().to_string();
+            if let Some((p, m)) = refine(&table, &path) {
+                path = p;
+                msg = m;
+            }
+            Err(friendly(&path, &msg))
+        }
+    }
+}
+
+/// serde's derived structs (and internally tagged enums) also accept an array of their
+/// fields in order, so `render = [1]` would quietly mean `spp = 1`. A scene file writes
+/// these as tables; anything else is an error.
+fn require_tables(table: &toml::Table) -> std::result::Result<(), String> {
+    let need = |path: String, v: &toml::Value| {
+        if v.is_table() {
+            Ok(())
+        } else {
+            Err(format!("{path}: expected a table, got {}", show(v)))
+        }
+    };
+    for k in ["camera", "render"] {
+        if let Some(v) = table.get(k) {
+            need(k.to_string(), v)?;
+        }
+    }
+    if let Some(toml::Value::Table(m)) = table.get("materials") {
+        for (name, v) in m {
+            need(key("materials", name), v)?;
+        }
+    }
+    for k in ["shapes", "lights"] {
+        if let Some(toml::Value::Array(items)) = table.get(k) {
+            for (i, v) in items.iter().enumerate() {
+                need(format!("{k}[{i}]"), v)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn scene_error(file: &Path, message: impl AsRef<str>) -> HeronError {
+    HeronError::Scene {
+        file: file.to_path_buf(),
+        message: one_line(message.as_ref()),
+    }
+}
+
+/// Joins the lines of a message with "; " so every error is one line.
+fn one_line(s: &str) -> String {
+    s.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// 1-based line and column (in characters) of a byte offset.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = text.get(..offset).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+    (line, col)
+}
+
+// ---------------------------------------------------------------------------------------
+// Key paths
+
+#[derive(Clone, Debug, PartialEq)]
+enum Seg {
+    Key(String),
+    Index(usize),
+}
+
+fn segments(p: &serde_path_to_error::Path) -> Vec<Seg> {
+    p.iter()
+        .filter_map(|s| match s {
+            serde_path_to_error::Segment::Seq { index } => Some(Seg::Index(*index)),
+            serde_path_to_error::Segment::Map { key } => Some(Seg::Key(key.clone())),
+            serde_path_to_error::Segment::Enum { variant } => Some(Seg::Key(variant.clone())),
+            serde_path_to_error::Segment::Unknown => None,
+        })
+        .collect()
+}
+
+/// TOML spelling of a key path: `materials.glass.ior`, `shapes[2].radius`,
+/// `materials."my glass"`.
+fn fmt_path(path: &[Seg]) -> String {
+    let mut s = String::new();
+    for seg in path {
+        match seg {
+            Seg::Index(i) => {
+                let _ = write!(s, "[{i}]");
+            }
+            Seg::Key(k) => {
+                if !s.is_empty() {
+                    s.push('.');
+                }
+                let bare = !k.is_empty()
+                    && k.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+                if bare {
+                    s.push_str(k);
+                } else {
+                    let _ = write!(s, "{k:?}");
+                }
+            }
+        }
+    }
+    s
+}
+
+fn key(base: &str, k: &str) -> String {
+    fmt_path(&[Seg::Key(base.into()), Seg::Key(k.into())])
+}
+
+/// Whether `path` is an item of a collection tagged by `type`, and the type list.
+fn tagged_item(path: &[Seg]) -> Option<&'static [&'static str]> {
+    match path {
+        [Seg::Key(c), Seg::Key(_)] if c == "materials" => Some(MATERIAL_TYPES),
+        [Seg::Key(c), Seg::Index(_)] if c == "shapes" => Some(SHAPE_TYPES),
+        [Seg::Key(c), Seg::Index(_)] if c == "lights" => Some(LIGHT_TYPES),
+        _ => None,
+    }
+}
+
+/// Re-reads a tagged item (whose inner key path serde's buffering lost) as the struct of
+/// its `type`, returning the full path and message of the error found there.
+fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
+    let item_path = path.get(..2)?;
+    tagged_item(item_path)?;
+    let value = match item_path {
+        [Seg::Key(c), Seg::Key(name)] => table.get(c)?.get(name)?,
+        [Seg::Key(c), Seg::Index(i)] => table.get(c)?.get(*i)?,
+        _ => return None,
+    };
+    let mut t = value.as_table()?.clone();
+    let ty = t.remove("type")?;
+    let ty = ty.as_str()?;
+    fn check<T: DeserializeOwned>(t: toml::Table) -> Option<(Vec<Seg>, String)> {
+        serde_path_to_error::deserialize::<_, T>(toml::Value::Table(t))
+            .err()
+            .map(|e| (segments(e.path()), e.inner().message().to_string()))
+    }
+    let Seg::Key(c) = &item_path[0] else {
+        return None;
+    };
+    let (inner, msg) = match (c.as_str(), ty) {
+        ("materials", "lambertian") => check::<LambertianFile>(t),
+        ("materials", "mirror") => check::<MirrorFile>(t),
+        ("materials", "dielectric") => check::<DielectricFile>(t),
+        ("materials", "glossy") => check::<GlossyFile>(t),
+        ("shapes", "sphere") => check::<SphereFile>(t),
+        ("shapes", "triangle") => check::<TriangleFile>(t),
+        ("shapes", "plane") => check::<PlaneFile>(t),
+        ("shapes", "quad") => check::<QuadFile>(t),
+        ("shapes", "mesh") => check::<MeshFile>(t),
+        ("lights", "point") => check::<PointLightFile>(t),
+        ("lights", "directional") => check::<DirectionalLightFile>(t),
+        _ => None,
+    }?;
+    let mut full = item_path.to_vec();
+    full.extend(inner);
+    Some((full, msg))
+}
+
+/// What a key holds, for "missing key" messages.
+fn expectation(parent: &[Seg], field: &str) -> String {
+    let s = match field {
+        "type" => {
+            let list = tagged_item(parent).unwrap_or(&[]);
+            return format!("one of {}", list.join(", "));
+        }
+        "eye" | "look_at" | "center" | "position" | "point" | "origin" | "translate" => {
+            "[x, y, z] with three finite numbers"
+        }
+        "up" | "normal" | "direction" | "edge1" | "edge2" => "a non-zero vector [x, y, z]",
+        "resolution" => "[width, height] with positive integers",
+        "radius" | "ior" | "shininess" | "d" | "size" | "scale" | "epsilon" => {
+            "a positive finite number"
+        }
+        "rho_d" => "a reflectance colour",
+        "rho_s" => "a number in [0, 1]",
+        "intensity" | "radiance" => "an emission colour",
+        "material" => "the name of a material",
+        "file" => "the path of an OBJ file",
+        "vertices" => "three vertices [[x, y, z], [x, y, z], [x, y, z]]",
+        "camera" => "a [camera] table with eye, look_at and resolution",
+        "spp" | "max_depth" => "a positive integer",
+        _ => "a value",
+    };
+    s.to_string()
+}
+
+/// serde's wording of a type ("f32", "struct CameraFile", "a sequence") in ours.
+fn plain_expected(e: &str) -> String {
+    let e = e.trim();
+    match e {
+        "f32" | "f64" => "a number".into(),
+        "u32" | "u64" | "usize" => "a non-negative integer".into(),
+        "i32" | "i64" => "an integer".into(),
+        "a sequence" => "an array".into(),
+        "a map" | "map" => "a table".into(),
+        "a string" | "a boolean" => e.into(),
+        _ if e.starts_with("struct ") || e.starts_with("internally tagged enum") => {
+            "a table".into()
+        }
+        _ if e.starts_with("an array of length") => e.into(),
+        _ => e.replace('`', ""),
+    }
+}
+
+/// serde's wording of a found value ("integer `3`", "map") in ours.
+fn plain_found(f: &str) -> String {
+    let f = f.trim();
+    if let Some(rest) = f.strip_prefix("string ") {
+        return rest.to_string();
+    }
+    for prefix in ["integer ", "floating point ", "boolean "] {
+        if let Some(rest) = f.strip_prefix(prefix) {
+            return rest.trim_matches('`').to_string();
+        }
+    }
+    match f {
+        "map" => "a table".into(),
+        "sequence" => "an array".into(),
+        _ => f.to_string(),
+    }
+}
+
+/// `a`, `b` -> a, b
+fn strip_ticks(s: &str) -> String {
+    s.replace('`', "")
+}
+
+/// serde's list of names after "expected" (`` `a` ``, `` `a` or `b` ``,
+/// `` one of `a`, `b`, `c` ``, "there are no fields") as plain names.
+fn name_list(tail: &str) -> Vec<String> {
+    let t = tail.trim_start_matches(", ");
+    let t = t.strip_prefix("expected ").unwrap_or(t);
+    let t = t.strip_prefix("one of ").unwrap_or(t);
+    t.split(", ")
+        .flat_map(|x| x.split(" or "))
+        .map(|x| strip_ticks(x).trim().to_string())
+        .filter(|x| !x.is_empty() && x != "there are no fields")
+        .collect()
+}
+
+/// Turns a serde/toml error at `path` into the one-line message of heron's style.
+fn friendly(path: &[Seg], msg: &str) -> String {
+    let msg = one_line(msg);
+    let at = |p: &[Seg]| {
+        if p.is_empty() {
+            "the top level".to_string()
+        } else {
+            fmt_path(p)
+        }
+    };
+    // unknown field `x`, expected one of `a`, `b`  |  expected `a`  |  there are no fields
+    if let Some(rest) = msg.strip_prefix("unknown field `") {
+        if let Some((name, tail)) = rest.split_once('`') {
+            let parent = match path.last() {
+                Some(Seg::Key(k)) if k == name => &path[..path.len() - 1],
+                _ => path,
+            };
+            let mut fields = name_list(tail);
+            if tagged_item(parent).is_some() {
+                fields.insert(0, "type".into());
+            }
+            let expected = match fields.len() {
+                0 => "no keys are allowed here".to_string(),
+                1 => format!("expected {}", fields[0]),
+                _ => format!("expected one of {}", fields.join(", ")),
+            };
+            return format!("unknown key {name:?} at {} ({expected})", at(parent));
+        }
+    }
+    let p = at(path);
+    if let Some(rest) = msg.strip_prefix("unknown variant `") {
+        if let Some((name, tail)) = rest.split_once('`') {
+            return format!(
+                "{p}: unknown variant {name:?}, expected one of {}",
+                name_list(tail).join(", ")
+            );
+        }
+    }
+    if let Some(rest) = msg.strip_prefix("missing field `") {
+        let name = rest.trim_end_matches('`');
+        let mut full = path.to_vec();
+        full.push(Seg::Key(name.into()));
+        return format!(
+            "{}: missing required key (expected {})",
+            fmt_path(&full),
+            expectation(path, name)
+        );
+    }
+    for prefix in ["invalid type: ", "invalid value: "] {
+        if let Some(rest) = msg.strip_prefix(prefix) {
+            if let Some((found, expected)) = rest.rsplit_once(", expected ") {
+                let mut expected = plain_expected(expected);
+                if expected == "variant identifier" || expected == "tag" {
+                    expected = format!(
+                        "a type name, one of {}",
+                        tagged_item(&path[..path.len().saturating_sub(1)])
+                            .unwrap_or(&[])
+                            .join(", ")
+                    );
+                }
+                if expected == "an array" {
+                    if let [Seg::Key(c)] = path {
+                        if c == "shapes" || c == "lights" {
+                            expected = format!("an array of tables (write [[{c}]])");
+                        }
+                    }
+                }
+                return format!("{p}: expected {expected}, got {}", plain_found(found));
+            }
+        }
+    }
+    if let Some(rest) = msg.strip_prefix("invalid length ") {
+        if let Some((n, expected)) = rest.split_once(", expected ") {
+            return format!(
+                "{p}: expected {}, got {n} elements",
+                plain_expected(expected)
+            );
+        }
+    }
+    format!("{p}: {}", strip_ticks(&msg))
+}
+
+// ---------------------------------------------------------------------------------------
+// Stage 3: building the scene
+
+fn build(path: &Path, file: SceneFile) -> Result<Scene> {
+    let err = |m: String| scene_error(path, m);
+    let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+
+    // Materials, sorted by name.
+    let mut materials = Vec::with_capacity(file.materials.len());
+    let mut material_names = Vec::with_capacity(file.materials.len());
+    for (name, m) in &file.materials {
+        materials.push(build_material(&key("materials", name), m).map_err(err)?);
+        material_names.push(name.clone());
+    }
+    let index: HashMap<&str, u32> = material_names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.as_str(), i as u32))
+        .collect();
+    let lookup = |at: String, name: &str| -> Result<u32> {
+        index.get(name).copied().ok_or_else(|| {
+            let defined = if material_names.is_empty() {
+                "no materials are defined".to_string()
+            } else {
+                format!("defined: {}", material_names.join(", "))
+            };
+            err(format!("{at}: no material named {name:?} ({defined})"))
+        })
+    };
+
+    // Shapes, in file order.
+    let mut shapes = Vec::with_capacity(file.shapes.len());
+    for (i, s) in file.shapes.iter().enumerate() {
+        let at = format!("shapes[{i}]");
+        match s {
+            ShapeFile::Sphere(sp) => shapes.push(Shape {
+                kind: ShapeKind::Sphere {
+                    center: sp.center.0,
+                    radius: sp.radius.0,
+                },
+                material: lookup(format!("{at}.material"), &sp.material)?,
+            }),
+            ShapeFile::Triangle(t) => {
+                let material = lookup(format!("{at}.material"), &t.material)?;
+                let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
+                if is_degenerate(v[0], v[1], v[2]) {
+                    return Err(err(format!(
+                        "{at}.vertices: expected a triangle with non-zero area, got collinear vertices {}",
+                        fmt_points(&v)
+                    )));
+                }
+                shapes.push(mesh_shape(v.to_vec(), vec![[0, 1, 2]], material));
+            }
+            ShapeFile::Plane(p) => {
+                let material = lookup(format!("{at}.material"), &p.material)?;
+                let n = p.normal.unit();
+                let size = p.size.map_or(1000.0, |s| s.0);
+                // Tangents with t × b = n, so (v1 − v0) × (v2 − v0) points along n.
+                let t = n.any_orthogonal_vector().normalize();
+                let b = n.cross(t);
+                let c = p.point.0;
+                let v = vec![
+                    c - size * t - size * b,
+                    c + size * t - size * b,
+                    c + size * t + size * b,
+                    c - size * t + size * b,
+                ];
+                if v.iter().any(|x| !x.is_finite()) {
+                    return Err(err(format!(
+                        "{at}.size: expected a size whose square has finite corners, got {size}"
+                    )));
+                }
+                shapes.push(mesh_shape(v, vec![[0, 1, 2], [0, 2, 3]], material));
+            }
+            ShapeFile::Quad(q) => {
+                let material = lookup(format!("{at}.material"), &q.material)?;
+                let (o, e1, e2) = (q.origin.0, q.edge1.0, q.edge2.0);
+                let v = vec![o, o + e1, o + e1 + e2, o + e2];
+                if v.iter().any(|x| !x.is_finite()) {
+                    return Err(err(format!(
+                        "{at}: expected a quad with finite corners, got origin + edges overflowing f32"
+                    )));
+                }
+                if is_degenerate(v[0], v[1], v[3]) {
+                    return Err(err(format!(
+                        "{at}: expected edge1 and edge2 spanning a non-zero area, got parallel edges {} and {}",
+                        fmt_points(&[e1]),
+                        fmt_points(&[e2])
+                    )));
+                }
+                shapes.push(mesh_shape(v, vec![[0, 1, 2], [0, 2, 3]], material));
+            }
+            ShapeFile::Mesh(m) => {
+                shapes.extend(build_mesh(path, &base_dir, &at, m, &lookup)?);
+            }
+        }
+    }
+
+    // Lights, in file order.
+    let lights = file
+        .lights
+        .iter()
+        .map(|l| match l {
+            LightFile::Point(p) => Light::Point(PointLight {
+                position: p.position.0,
+                intensity: p.intensity.spectrum(),
+            }),
+            LightFile::Directional(d) => Light::Directional(DirectionalLight {
+                direction: d.direction.unit(),
+                radiance: d.radiance.spectrum(),
+            }),
+        })
+        .collect();
+
+    let background = file
+        .background
+        .as_ref()
+        .map_or_else(|| DenseSpectrum::constant(0.0), |b| b.spectrum());
+
+    let mut settings = RenderSettings::default();
+    if let Some(r) = &file.render {
+        if let Some(x) = r.spp {
+            settings.spp = x.0;
+        }
+        if let Some(x) = r.max_depth {
+            settings.max_depth = x.0;
+        }
+        if let Some(x) = r.epsilon {
+            settings.epsilon = x.0;
+        }
+        if let Some(x) = r.seed {
+            settings.seed = x;
+        }
+    }
+
+    let c = &file.camera;
+    if !(c.look_at.0 - c.eye.0).length().is_finite() {
+        return Err(err(format!(
+            "camera: expected eye and look_at at a distance finite in f32, got eye = {} and look_at = {}",
+            fmt_points(&[c.eye.0]),
+            fmt_points(&[c.look_at.0])
+        )));
+    }
+    let camera = Camera::new(
+        c.eye.0,
+        c.look_at.0,
+        c.up.map_or(Vec3::Y, |u| u.unit()),
+        c.d.map_or(1.0, |d| d.0),
+        c.resolution.width,
+        c.resolution.height,
+    )
+    .map_err(|e| err(format!("camera: {e}")))?;
+
+    Ok(Scene {
+        source: path.to_path_buf(),
+        camera,
+        shapes,
+        materials,
+        material_names,
+        lights,
+        background,
+        settings,
+    })
+}
+
+fn build_material(at: &str, m: &MaterialFile) -> std::result::Result<Material, String> {
+    Ok(match m {
+        MaterialFile::Lambertian(l) => Material::Lambertian(Lambertian {
+            rho_d: l.rho_d.spectrum(),
+        }),
+        MaterialFile::Mirror(mi) => Material::Mirror(Mirror {
+            // Left out: the lecture's ideal mirror, exactly 1 at every wavelength.
+            rho_s: mi
+                .rho_s
+                .as_ref()
+                .map_or_else(|| DenseSpectrum::constant(1.0), |r| r.spectrum()),
+        }),
+        MaterialFile::Dielectric(d) => Material::Dielectric(Dielectric {
+            ior: d.ior.0,
+            fresnel: d.fresnel.unwrap_or(true),
+        }),
+        MaterialFile::Glossy(g) => {
+            if g.fresnel.is_some() && g.ior.is_none() {
+                return Err(format!(
+                    "{at}.fresnel: expected only together with ior (fresnel weights the refractive base), but ior is not given"
+                ));
+            }
+            // Energy conservation, seed "Glossy materials": ρd + ρs ≤ 1.
+            let rho_s = g.rho_s.0;
+            let sum_max = match g.rho_d.0.rgb() {
+                Some(rgb) => rgb.iter().fold(f32::MIN, |a, &c| a.max(c + rho_s)),
+                None => g.rho_d.0.max_value() + rho_s,
+            };
+            if sum_max > 1.0 + 1e-6 {
+                let rho_d = match &g.rho_d.0 {
+                    Colour::Grey(x) => format!("{x}"),
+                    Colour::Rgb(c) => format!("[{}, {}, {}]", c[0], c[1], c[2]),
+                    Colour::Named { spectrum, scale } => {
+                        format!("{{ spectrum = {spectrum:?}, scale = {scale} }}")
+                    }
+                };
+                return Err(format!(
+                    "{at}: expected rho_d + rho_s <= 1 in every channel (energy conservation), got rho_d = {rho_d} and rho_s = {rho_s} (sum up to {sum_max})"
+                ));
+            }
+            Material::Glossy(Glossy {
+                rho_d: g.rho_d.spectrum(),
+                rho_s,
+                shininess: g.shininess.0,
+                base: g.ior.map(|ior| Dielectric {
+                    ior: ior.0,
+                    fresnel: g.fresnel.unwrap_or(true),
+                }),
+            })
+        }
+    })
+}
+
+fn mesh_shape(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, material: u32) -> Shape {
+    Shape {
+        kind: ShapeKind::Mesh(Mesh { positions, indices }),
+        material,
+    }
+}
+
+/// Zero area up to f32 rounding: |e1 × e2| ≤ ε |e1| |e2| (the angle between the edges is
+/// below about 1e-7 rad), or a zero-length edge.
+fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    let (e1, e2) = (b - a, c - a);
+    let cross = e1.cross(e2).length();
+    let limit = f32::EPSILON * e1.length() * e2.length();
+    // Not strictly above the limit, NaN included (overflowing edges).
+    cross.partial_cmp(&limit) != Some(std::cmp::Ordering::Greater)
+}
+
+fn fmt_points(v: &[Vec3]) -> String {
+    let p: Vec<String> = v
+        .iter()
+        .map(|p| format!("[{}, {}, {}]", p.x, p.y, p.z))
+        .collect();
+    if p.len() == 1 {
+        p[0].clone()
+    } else {
+        format!("[{}]", p.join(", "))
+    }
+}
+
+/// A `type = "mesh"` entry: one shape per material it uses. Mesh-file problems are
+/// reported with the mesh file as `file` and the scene's key path in the message.
+fn build_mesh(
+    scene_path: &Path,
+    base_dir: &Path,
+    at: &str,
+    m: &MeshFile,
+    lookup: &dyn Fn(String, &str) -> Result<u32>,
+) -> Result<Vec<Shape>> {
+    // Scene-file checks first: the material names.
+    let default_material = match &m.material {
+        Some(name) => Some(lookup(format!("{at}.material"), name)?),
+        None => None,
+    };
+    let mut group_material = BTreeMap::new();
+    for (group, name) in &m.groups {
+        let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(group.clone())]);
+        group_material.insert(group.as_str(), lookup(format!("{at}.{gk}"), name)?);
+    }
+    if m.file.trim().is_empty() {
+        return Err(scene_error(
+            scene_path,
+            format!("{at}.file: expected the path of an OBJ file, got an empty string"),
+        ));
+    }
+
+    let mesh_path: PathBuf = base_dir.join(&m.file);
+    let merr = |msg: String| scene_error(&mesh_path, format!("{at}.file: {msg}"));
+    let text = std::fs::read_to_string(&mesh_path)
+        .map_err(|e| merr(format!("cannot read the mesh file: {e}")))?;
+    let groups = obj::parse_obj(&text).map_err(merr)?;
+
+    for g in m.groups.keys() {
+        if !groups.iter().any(|x| &x.name == g) {
+            let mut names: Vec<&str> = groups
+                .iter()
+                .filter(|x| !x.indices.is_empty())
+                .map(|x| x.name.as_str())
+                .collect();
+            names.dedup();
+            let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(g.clone())]);
+            return Err(scene_error(
+                &mesh_path,
+                format!(
+                    "{at}.{gk}: no object or group named {g:?} in the mesh (it has: {})",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+
+    let scale = m.scale.map_or(1.0, |s| s.0);
+    let translate = m.translate.map_or(Vec3::ZERO, |t| t.0);
+
+    // Gather the triangles per material, in the order the materials first appear.
+    struct Part {
+        material: u32,
+        positions: Vec<Vec3>,
+        indices: Vec<[u32; 3]>,
+        /// Vertex index by position: OBJ groups come with their own vertex arrays, so
+        /// vertices are shared within a shape by their (exact) coordinates.
+        remap: HashMap<[u32; 3], u32>,
+    }
+    let mut parts: Vec<Part> = Vec::new();
+    let mut any_triangle = false;
+    for g in &groups {
+        if g.indices.is_empty() {
+            continue;
+        }
+        let material = match group_material.get(g.name.as_str()).copied().or(default_material) {
+            Some(mat) => mat,
+            None => {
+                return Err(scene_error(
+                    scene_path,
+                    format!(
+                        "{at}.material: missing required key (expected the name of a material for the mesh's object {:?}, which groups does not list)",
+                        g.name
+                    ),
+                ))
+            }
+        };
+        let part = match parts.iter().position(|p| p.material == material) {
+            Some(k) => &mut parts[k],
+            None => {
+                parts.push(Part {
+                    material,
+                    positions: Vec::new(),
+                    indices: Vec::new(),
+                    remap: HashMap::new(),
+                });
+                parts.last_mut().expect("just pushed")
+            }
+        };
+        for tri in &g.indices {
+            let p = tri.map(|i| g.positions[i as usize] * scale + translate);
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(merr(format!(
+                    "a vertex of object {:?} is not finite after scale {scale} and translate {}",
+                    g.name,
+                    fmt_points(&[translate])
+                )));
+            }
+            // Zero-area triangles are never hit; they are dropped.
+            if is_degenerate(p[0], p[1], p[2]) {
+                continue;
+            }
+            any_triangle = true;
+            let mut out = [0u32; 3];
+            for (o, v) in out.iter_mut().zip(p) {
+                let next = part.positions.len() as u32;
+                // + 0.0 turns −0 into +0, so the two zeros share a vertex.
+                let bits = (v + Vec3::ZERO).to_array().map(f32::to_bits);
+                *o = *part.remap.entry(bits).or_insert_with(|| {
+                    part.positions.push(v);
+                    next
+                });
+            }
+            part.indices.push(out);
+        }
+    }
+    if !any_triangle {
+        return Err(merr(
+            "expected a mesh with at least one triangle of non-zero area, got none".into(),
+        ));
+    }
+    Ok(parts
+        .into_iter()
+        .filter(|p| !p.indices.is_empty())
+        .map(|p| mesh_shape(p.positions, p.indices, p.material))
+        .collect())
 }
