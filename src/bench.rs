@@ -120,6 +120,30 @@ pub fn procedural_mesh(n: u32) -> Mesh {
     mesh
 }
 
+/// Writes a mesh as OBJ (positions and faces), through a temporary file.
+pub fn write_obj(mesh: &Mesh, path: &Path) -> Result<()> {
+    use std::io::Write;
+    crate::film::write_atomically(path, |tmp| {
+        let f = std::fs::File::create(tmp).map_err(|e| e.to_string())?;
+        let mut w = std::io::BufWriter::new(f);
+        let mut go = || -> std::io::Result<()> {
+            writeln!(
+                w,
+                "# heron procedural mesh: {} triangles",
+                mesh.indices.len()
+            )?;
+            for p in &mesh.positions {
+                writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+            }
+            for t in &mesh.indices {
+                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+            }
+            w.flush()
+        };
+        go().map_err(|e| e.to_string())
+    })
+}
+
 /// Camera rays of Embree's viewer camera for pixel (x, y) centres.
 struct ViewCamera {
     eye: Vec3,
@@ -183,7 +207,7 @@ fn hemisphere(n: Vec3, rng: &mut Rng) -> Vec3 {
     (r * phi.cos()) * t + (r * phi.sin()) * b + z * n
 }
 
-/// Traces `frames` frames of primary rays, then one incoherent secondary ray per
+/// Traces one warm-up frame and `frames` timed frames of primary rays, then one incoherent secondary ray per
 /// primary hit of the last frame (repeated `frames` times), on `mesh`.
 pub fn run_traversal(mesh: &Mesh, o: &TraversalOptions) -> Result<TraversalReport> {
     if o.width == 0 || o.height == 0 || o.frames == 0 {
@@ -217,6 +241,11 @@ pub fn run_traversal(mesh: &Mesh, o: &TraversalOptions) -> Result<TraversalRepor
     // Primary rays: rows of 4×2 pixel blocks, so a packet covers a compact patch.
     let rows: Vec<u32> = (0..o.height.div_ceil(2)).collect();
     let mut secondary: Vec<RayQuery> = Vec::new();
+    // One untimed warm-up frame: first touches of the BVH and thread start-up.
+    pool.install(|| {
+        rows.par_iter()
+            .for_each(|&by| drop(trace_primary_row(&scene, &cam, by, o.packet, false)))
+    });
     for frame in 0..o.frames {
         let last = frame + 1 == o.frames;
         let t = Instant::now();

@@ -23,6 +23,94 @@ struct Cli {
 enum Command {
     /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview.
     Render(RenderArgs),
+    /// Measure throughput.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Embree traversal throughput (Mrays/s) for primary and incoherent secondary rays
+    /// on an OBJ, with a camera like Embree's `viewer --benchmark`.
+    Traversal(TraversalArgs),
+    /// Write the deterministic procedural test mesh (a bumpy sphere of 2·N² triangles,
+    /// the one the criterion traversal bench uses) as OBJ, for side-by-side runs with
+    /// Embree's own viewer.
+    Mesh {
+        /// Grid resolution N; 708 gives about one million triangles.
+        #[arg(long, default_value_t = 708, value_parser = clap::value_parser!(u32).range(4..=8192))]
+        n: u32,
+        /// Output OBJ path.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct TraversalArgs {
+    /// OBJ mesh; every object is loaded into one triangle mesh.
+    #[arg(long)]
+    mesh: PathBuf,
+    /// Camera position X,Y,Z (Embree viewer: --vp).
+    #[arg(long, value_parser = parse_vec3)]
+    eye: [f32; 3],
+    /// Point looked at X,Y,Z (Embree viewer: --vi).
+    #[arg(long, value_parser = parse_vec3)]
+    look_at: [f32; 3],
+    /// Up vector X,Y,Z (Embree viewer: --vu).
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0")]
+    up: [f32; 3],
+    /// Vertical field of view in degrees (Embree viewer: --fov).
+    #[arg(long, default_value_t = 90.0)]
+    fov: f32,
+    /// Image size W,H (Embree viewer: --size W H).
+    #[arg(long, value_parser = parse_size, default_value = "1024,1024")]
+    size: (u32, u32),
+    /// Rays per Embree call: 1 (rtcIntersect1) or 8 (rtcIntersect8).
+    #[arg(long, default_value_t = 8, value_parser = parse_packet)]
+    packet: usize,
+    /// Frames to time (after one warm-up frame).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+    frames: u32,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
+}
+
+fn parse_vec3(s: &str) -> std::result::Result<[f32; 3], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 3 {
+        return Err(format!("expected X,Y,Z (three numbers), got {s:?}"));
+    }
+    let mut out = [0.0; 3];
+    for (o, t) in out.iter_mut().zip(v) {
+        *o = t
+            .trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("expected a finite number, got {t:?}"))?;
+    }
+    Ok(out)
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("expected W,H (two positive integers), got {s:?}");
+    let (w, h) = s.split_once(',').ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+fn parse_packet(s: &str) -> std::result::Result<usize, String> {
+    match s {
+        "1" => Ok(1),
+        "8" => Ok(8),
+        _ => Err(format!("expected 1 or 8, got {s}")),
+    }
 }
 
 #[derive(clap::Args)]
@@ -68,6 +156,10 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => cmd_render(args),
+        Command::Bench(BenchCommand::Traversal(args)) => cmd_bench_traversal(args),
+        Command::Bench(BenchCommand::Mesh { n, output }) => {
+            heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
+        }
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
@@ -140,6 +232,50 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         stats.counters.shadow_rays,
         stats.mrays_per_s(),
         stats.nonfinite
+    );
+    Ok(())
+}
+
+fn cmd_bench_traversal(a: TraversalArgs) -> Result<()> {
+    let mesh = heron::bench::load_obj_mesh(&a.mesh)?;
+    let opts = heron::bench::TraversalOptions {
+        eye: a.eye.into(),
+        look_at: a.look_at.into(),
+        up: a.up.into(),
+        fov_deg: a.fov,
+        width: a.size.0,
+        height: a.size.1,
+        packet: a.packet,
+        frames: a.frames,
+        threads: a.threads.map_or(0, usize::from),
+    };
+    let r = heron::bench::run_traversal(&mesh, &opts)?;
+    let threads = a
+        .threads
+        .map_or_else(rayon::current_num_threads, usize::from);
+    println!(
+        "mesh {} ({} triangles), {}x{}, packet {}, {} frames, {} threads, BVH build {:.1} ms",
+        a.mesh.display(),
+        r.triangles,
+        opts.width,
+        opts.height,
+        opts.packet,
+        opts.frames,
+        threads,
+        r.build.as_secs_f64() * 1e3
+    );
+    println!(
+        "primary:   {:8.2} Mrays/s  ({} rays, {:.1}% hit, {:.2} frames/s)",
+        r.primary_mrays(),
+        r.primary_rays,
+        100.0 * r.primary_hits as f64 / r.primary_rays.max(1) as f64,
+        opts.frames as f64 / r.primary_time.as_secs_f64().max(1e-12)
+    );
+    println!(
+        "secondary: {:8.2} Mrays/s  ({} incoherent rays, {:.1}% hit)",
+        r.secondary_mrays(),
+        r.secondary_rays,
+        100.0 * r.secondary_hits as f64 / r.secondary_rays.max(1) as f64
     );
     Ok(())
 }
