@@ -1,13 +1,22 @@
 #!/usr/bin/env python3
 """Generate heron's spectral tables in spectra/ from colour-science.
 
-Run once (from the repository root, in the project's virtual environment):
+Run from the repository root, in the project's virtual environment
+(scripts/setup-python.sh creates it):
 
     .venv/bin/python scripts/gen_spectra.py
 
+`--out DIR` writes the tables somewhere else (tests/python/test_spectra_tables.py uses
+it to check that the committed tables are exactly what this script produces).
+
 The tables are committed; heron embeds them at compile time, so nothing is read or
 downloaded at run time. spectra/README.md names the source of every table.
+
+Number format: every value is written with Python's repr(float), the shortest decimal
+string that parses back to the same float64, so the CSVs hold colour-science's numbers
+exactly. Wavelengths that are whole numbers are written without a decimal point.
 """
+import argparse
 import pathlib
 import warnings
 
@@ -17,33 +26,51 @@ import numpy as np
 warnings.filterwarnings("ignore")
 OUT = pathlib.Path(__file__).resolve().parent.parent / "spectra"
 SHAPE = colour.SpectralShape(360, 830, 1)
+SMITS_NAMES = ["white", "cyan", "magenta", "yellow", "red", "green", "blue"]
 
 
-def write(name, header, rows):
-    path = OUT / name
+def fmt(v):
+    v = float(v)
+    return str(int(v)) if v.is_integer() else repr(v)
+
+
+def write(out, name, header, rows):
+    path = out / name
     with path.open("w", newline="\n") as f:
         f.write(",".join(header) + "\n")
         for row in rows:
-            f.write(",".join(repr(float(v)) if i else f"{v:g}" for i, v in enumerate(row)) + "\n")
+            f.write(",".join(fmt(v) for v in row) + "\n")
     print("wrote", path)
 
 
 def main():
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(SHAPE)
-    write("cie1931_2deg.csv", ["wavelength_nm", "x_bar", "y_bar", "z_bar"],
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=pathlib.Path, default=OUT, help="output folder (default: spectra/)")
+    out = ap.parse_args().out
+    out.mkdir(parents=True, exist_ok=True)
+
+    # CIE 1931 2° observer: colour-science holds it at 1 nm over 360-830 nm already, so
+    # the values are written as tabulated. (Calling .align(SHAPE) would re-evaluate them
+    # through the Sprague interpolator and add float round-off of up to 1.3e-15, one
+    # value of it negative, so it is not called.)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    if cmfs.shape != SHAPE:
+        raise SystemExit(f"expected the CIE 1931 observer on {SHAPE}, got {cmfs.shape}")
+    write(out, "cie1931_2deg.csv", ["wavelength_nm", "x_bar", "y_bar", "z_bar"],
           np.column_stack([cmfs.wavelengths, cmfs.values]))
 
-    # CIE D65 relative spectral power (5 nm, 300-780 nm in colour-science), aligned to
-    # 1 nm over 360-830 nm with colour-science's default interpolation and extrapolation.
+    # CIE D65 relative spectral power: 5 nm over 300-780 nm in colour-science, aligned
+    # to 1 nm over 360-830 nm with the distribution's own interpolator (linear) and
+    # colour-science's default extrapolator (constant: 781-830 nm repeat the 780 nm value).
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(SHAPE)
-    write("cie_d65.csv", ["wavelength_nm", "value"], np.column_stack([d65.wavelengths, d65.values]))
+    write(out, "cie_d65.csv", ["wavelength_nm", "value"],
+          np.column_stack([d65.wavelengths, d65.values]))
 
-    # Smits (1999) RGB-to-spectrum basis: 10 bins over 380-720 nm.
+    # Smits (1999) RGB-to-spectrum basis: 10 samples over 380-720 nm, as tabulated.
     basis = colour.recovery.SDS_SMITS1999
-    names = ["white", "cyan", "magenta", "yellow", "red", "green", "blue"]
     wl = basis["white"].wavelengths
-    write("smits1999.csv", ["wavelength_nm"] + names,
-          np.column_stack([wl] + [basis[n].values for n in names]))
+    write(out, "smits1999.csv", ["wavelength_nm"] + SMITS_NAMES,
+          np.column_stack([wl] + [basis[n].values for n in SMITS_NAMES]))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,104 @@
+"""Reference colours for heron's renders, computed with colour-science.
+
+heron's film convention (src/spectrum/cie.rs):
+
+    XYZ = Σ_λ L(λ) x̄(λ) Δλ / Σ_λ ȳ(λ) Δλ      over 360–830 nm at 1 nm (CIE 1931 2°),
+
+so a constant spectrum L = 1 has Y = 1; linear sRGB is the IEC 61966-2-1 XYZ→sRGB matrix
+applied to that XYZ with no chromatic adaptation (XYZ is D65-relative).
+
+That convention is exactly colour-science's `sd_to_XYZ(..., method="Integration")` with
+an equal-energy illuminant, divided by 100 (k = 100 / Σ S ȳ Δλ with S = 1), so the
+references below use colour-science's own integration, colour matching functions,
+illuminant data, Smits (1999) uplift and sRGB colourspace.
+"""
+from __future__ import annotations
+
+import functools
+import warnings
+
+import numpy as np
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    import colour
+
+SHAPE = colour.SpectralShape(360, 830, 1)
+CMFS_NAME = "CIE 1931 2 Degree Standard Observer"
+
+
+@functools.cache
+def cmfs():
+    c = colour.MSDS_CMFS[CMFS_NAME]
+    assert c.shape == SHAPE, c.shape
+    return c
+
+
+def aligned(sd):
+    """sd on heron's grid, with sd's own interpolator and extrapolator (as heron does).
+
+    For Smits' basis that is linear interpolation between the ten samples, holding the
+    end values outside 380–720 nm: the same as src/spectrum/uplift.rs. (colour-science
+    warns that the Smits samples are "not uniform": 417.7778 − 380 is not exactly
+    (720 − 380)/9. The warning is harmless here and silenced.)
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", colour.utilities.ColourRuntimeWarning)
+        return sd.copy().align(SHAPE)
+
+
+def film_xyz(sd) -> np.ndarray:
+    """XYZ of a spectral radiance under heron's film convention, by colour-science."""
+    return colour.sd_to_XYZ(aligned(sd), cmfs(), illuminant=colour.sd_ones(SHAPE),
+                            method="Integration") / 100.0
+
+
+def xyz_to_linear_srgb(xyz) -> np.ndarray:
+    """IEC 61966-2-1 XYZ -> linear sRGB, no chromatic adaptation (XYZ is D65-relative)."""
+    return colour.XYZ_to_RGB(np.asarray(xyz, dtype=float), "sRGB", illuminant=None,
+                             chromatic_adaptation_transform=None)
+
+
+def spectrum_e():
+    return colour.sd_ones(SHAPE)
+
+
+@functools.cache
+def d65_unit():
+    """CIE D65 as heron uses it: aligned to 1 nm 360–830 nm, scaled to film Y = 1."""
+    d65 = aligned(colour.SDS_ILLUMINANTS["D65"])
+    return d65 / film_xyz(d65)[1]
+
+
+def smits_reflectance(rgb):
+    return aligned(colour.recovery.RGB_to_sd_Smits1999(np.asarray(rgb, dtype=float)))
+
+
+def rgb_emitter(rgb):
+    """heron's RGB emitter uplift: Smits (1999) reflectance of rgb × D65 at Y = 1."""
+    return smits_reflectance(rgb) * d65_unit()
+
+
+def expected_srgb(sd) -> np.ndarray:
+    """Linear sRGB heron's film should converge to for spectral radiance sd."""
+    return xyz_to_linear_srgb(film_xyz(sd))
+
+
+def uniform_sampling_sigma(sd) -> np.ndarray:
+    """Per-sample standard deviation of each linear sRGB channel when every camera sample
+    carries ONE wavelength drawn uniformly on 360–830 nm (the crudest spectral estimator).
+
+    Estimator per sample: f(λ) = L(λ) · (M · x̄ȳz̄(λ)) / (Σ ȳ Δλ) / p(λ), p = 1/N_λ per
+    1 nm bin. Hero-wavelength sampling, importance sampling or stratification only lower
+    it, so it bounds the noise a correct renderer may have; the render tests require
+    their measured standard error to be below a multiple of σ/√N, which is what gives
+    them power.
+    """
+    L = aligned(sd).values
+    xyz = cmfs().values
+    m = colour.RGB_COLOURSPACES["sRGB"].matrix_XYZ_to_RGB
+    w = (xyz @ m.T) / xyz[:, 1].sum()  # per-bin weight of each sRGB channel
+    n = len(L)
+    f = L[:, None] * w * n  # value of the estimator for each bin, p = 1/n
+    mean = f.mean(axis=0)
+    return np.sqrt(((f - mean) ** 2).mean(axis=0))

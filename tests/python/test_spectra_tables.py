@@ -1,0 +1,149 @@
+"""The committed tables in spectra/ are colour-science's data, exactly.
+
+Three layers: (1) every number equals colour-science 0.4.7's value (the CSVs are written
+with repr(float), so parsing them gives the float64 back; compared at 1e-12 relative);
+(2) the claims spectra/README.md makes about grids, interpolation and extrapolation hold;
+(3) scripts/gen_spectra.py reproduces the committed files byte for byte.
+"""
+from __future__ import annotations
+
+import csv
+import filecmp
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import heronref
+from heronref import colour
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+SPECTRA = REPO / "spectra"
+WL_1NM = np.arange(360, 831, dtype=float)
+RTOL = 1e-12
+SMITS_NAMES = ["white", "cyan", "magenta", "yellow", "red", "green", "blue"]
+
+
+def read_csv(name):
+    with (SPECTRA / name).open(newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    assert all(len(r) == len(header) for r in body), f"{name}: ragged rows"
+    return header, np.array([[float(v) for v in r] for r in body])
+
+
+def assert_same(actual, expected, what):
+    np.testing.assert_allclose(actual, expected, rtol=RTOL, atol=0, err_msg=what)
+
+
+def test_colour_science_version_is_the_pinned_one():
+    # The tables (and spectra/README.md) are tied to this version.
+    assert colour.__version__ == "0.4.7"
+
+
+def test_cie1931_header_and_grid():
+    header, data = read_csv("cie1931_2deg.csv")
+    assert header == ["wavelength_nm", "x_bar", "y_bar", "z_bar"]
+    assert data.shape == (471, 4)
+    np.testing.assert_array_equal(data[:, 0], WL_1NM)
+
+
+def test_cie1931_values_are_colour_science_cmfs():
+    _, data = read_csv("cie1931_2deg.csv")
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    np.testing.assert_array_equal(cmfs.wavelengths, WL_1NM)
+    assert_same(data[:, 1:], cmfs.values, "CIE 1931 2° x̄ ȳ z̄ vs colour-science")
+    # The raw table and colour-science's alignment to the same grid agree (the script
+    # writes the raw one; align() only adds round-off).
+    aligned = cmfs.copy().align(heronref.SHAPE).values
+    np.testing.assert_allclose(data[:, 1:], aligned, rtol=1e-12, atol=1e-14)
+    # Spot values from the CVRL CIE 1931 2° table.
+    row = {int(r[0]): r[1:] for r in data}
+    np.testing.assert_array_equal(row[360], [0.0001299, 0.000003917, 0.0006061])
+    np.testing.assert_array_equal(row[555], [0.5120501, 1.0, 0.005749999])
+    assert (data[:, 1:] >= 0).all()
+
+
+def test_cie1931_film_normalisation():
+    # Numbers quoted in spectra/README.md: Σȳ and the XYZ of equal energy.
+    _, data = read_csv("cie1931_2deg.csv")
+    sums = data[:, 1:].sum(axis=0)
+    assert sums[1] == pytest.approx(106.856917101, rel=1e-10)
+    np.testing.assert_allclose(sums / sums[1], [1.00008004, 1.0, 1.00033067], rtol=1e-8)
+
+
+def test_d65_header_and_grid():
+    header, data = read_csv("cie_d65.csv")
+    assert header == ["wavelength_nm", "value"]
+    assert data.shape == (471, 2)
+    np.testing.assert_array_equal(data[:, 0], WL_1NM)
+
+
+def test_d65_values_are_colour_science_d65_aligned():
+    _, data = read_csv("cie_d65.csv")
+    d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(heronref.SHAPE)
+    np.testing.assert_array_equal(d65.wavelengths, WL_1NM)
+    assert_same(data[:, 1], d65.values, "D65 vs colour-science D65 aligned to 1 nm 360-830")
+
+
+def test_d65_alignment_is_linear_inside_and_constant_beyond_780nm():
+    # What spectra/README.md says about the alignment, checked against the native data.
+    _, data = read_csv("cie_d65.csv")
+    native = colour.SDS_ILLUMINANTS["D65"]
+    assert native.shape == colour.SpectralShape(300, 780, 5)
+    wl, values = native.wavelengths, native.values
+    inside = data[:, 0] <= 780
+    # Tabulated values at multiples of 5 nm, straight lines in between.
+    expected = np.interp(data[inside, 0], wl, values)
+    np.testing.assert_allclose(data[inside, 1], expected, rtol=1e-12)
+    at5 = inside & (data[:, 0] % 5 == 0)
+    native_at = dict(zip(wl, values))
+    np.testing.assert_array_equal(data[at5, 1], [native_at[w] for w in data[at5, 0]])
+    # 781-830 nm hold the 780 nm value.
+    assert native_at[780.0] == 63.3828
+    np.testing.assert_array_equal(data[~inside, 1], np.full((~inside).sum(), 63.3828))
+    assert data[data[:, 0] == 560, 1] == [100.0]
+
+
+def test_d65_luminance_as_quoted():
+    _, d = read_csv("cie_d65.csv")
+    _, c = read_csv("cie1931_2deg.csv")
+    y = (d[:, 1] * c[:, 2]).sum() / c[:, 2].sum()
+    assert y == pytest.approx(98.8899736097, rel=1e-10)
+    xyz = (d[:, 1:2] * c[:, 1:]).sum(axis=0) / c[:, 2].sum() / y
+    np.testing.assert_allclose(xyz, [0.95047076, 1.0, 1.08882842], rtol=1e-8)
+
+
+def test_smits_header_and_layout():
+    header, data = read_csv("smits1999.csv")
+    assert header == ["wavelength_nm"] + SMITS_NAMES
+    assert data.shape == (10, 8)
+    # 380 + k·340/9 nm, to colour-science's four decimals.
+    np.testing.assert_allclose(data[:, 0], 380 + np.arange(10) * 340 / 9, atol=6e-5)
+    assert data[0, 0] == 380 and data[-1, 0] == 720
+
+
+def test_smits_values_are_colour_science_basis():
+    _, data = read_csv("smits1999.csv")
+    basis = colour.recovery.SDS_SMITS1999
+    for i, name in enumerate(SMITS_NAMES, start=1):
+        sd = basis[name]
+        np.testing.assert_array_equal(data[:, 0], sd.wavelengths, err_msg=f"Smits {name} wavelengths")
+        assert_same(data[:, i], sd.values, f"Smits {name}")
+    # Smits' white is not exactly 1 (the README and the render tests rely on this).
+    assert data[:, 1].min() == 0.9992
+
+
+def test_generator_reproduces_committed_tables(tmp_path):
+    script = REPO / "scripts" / "gen_spectra.py"
+    proc = subprocess.run([sys.executable, str(script), "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    for name in ("cie1931_2deg.csv", "cie_d65.csv", "smits1999.csv"):
+        assert filecmp.cmp(tmp_path / name, SPECTRA / name, shallow=False), (
+            f"spectra/{name} differs from what scripts/gen_spectra.py writes now; "
+            f"regenerate with: .venv/bin/python scripts/gen_spectra.py")
+    assert sorted(p.name for p in SPECTRA.glob("*.csv")) == sorted(
+        p.name for p in tmp_path.glob("*.csv")), "spectra/ has CSVs the generator does not write"
