@@ -35,6 +35,13 @@ fn shading(c: &mut Criterion) {
             g.bench_function(format!("{name}/lanes{lanes}"), |b| {
                 b.iter(|| renderer.render(&o).unwrap())
             });
+            if name == "default" && lanes == 4 {
+                // Camera rays one by one instead of Embree 8-wide packets.
+                o.packets = false;
+                g.bench_function(format!("{name}/lanes{lanes}/no-packets"), |b| {
+                    b.iter(|| renderer.render(&o).unwrap())
+                });
+            }
         }
     }
     g.finish();
