@@ -1,0 +1,201 @@
+//! Refractive-index models n(λ). Units: the API takes λ in nm; the dispersion formulas
+//! use λ in µm, as their catalogues do.
+//!
+//! - Sellmeier: n²(λ) = 1 + Σ_i B_i λ² / (λ² − C_i), with λ in µm and C_i in µm² (the form
+//!   of the Schott catalogue, Malitson 1965, Daimon & Masumura 2007).
+//! - Cauchy: n(λ) = A + B/λ² + C/λ⁴, with λ in µm.
+//! - Tabulated: linear interpolation of (λ nm, n) samples.
+//!
+//! The named catalogue lives in spectra/ior_catalogue.toml, compiled into the binary.
+use super::DenseSpectrum;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::sync::OnceLock;
+
+/// Up to four Sellmeier terms (the water fit has four); unused terms have B = 0.
+pub const SELLMEIER_TERMS: usize = 4;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ior {
+    /// The same index at every wavelength (no dispersion).
+    Constant(f32),
+    Sellmeier {
+        b: [f32; SELLMEIER_TERMS],
+        c: [f32; SELLMEIER_TERMS],
+    },
+    Cauchy {
+        a: f32,
+        b: f32,
+        c: f32,
+    },
+    Table(DenseSpectrum),
+}
+
+impl Ior {
+    /// n at `lambda_nm`.
+    #[inline]
+    pub fn eval(&self, lambda_nm: f32) -> f32 {
+        match self {
+            Ior::Constant(n) => *n,
+            Ior::Sellmeier { b, c } => {
+                let l2 = (lambda_nm * 1e-3) * (lambda_nm * 1e-3);
+                let mut n2 = 1.0;
+                for i in 0..SELLMEIER_TERMS {
+                    n2 += b[i] * l2 / (l2 - c[i]);
+                }
+                n2.sqrt()
+            }
+            Ior::Cauchy { a, b, c } => {
+                let l2 = (lambda_nm * 1e-3) * (lambda_nm * 1e-3);
+                a + b / l2 + c / (l2 * l2)
+            }
+            Ior::Table(t) => t.eval(lambda_nm),
+        }
+    }
+
+    /// True when n depends on wavelength, so that refraction separates the lanes.
+    pub fn is_dispersive(&self) -> bool {
+        match self {
+            Ior::Constant(_) => false,
+            Ior::Sellmeier { b, .. } => b.iter().any(|&x| x != 0.0),
+            Ior::Cauchy { b, c, .. } => *b != 0.0 || *c != 0.0,
+            Ior::Table(t) => !t.is_constant(),
+        }
+    }
+
+    /// Builds a Sellmeier model from 1 to 4 (B, C) pairs.
+    pub fn sellmeier(b: &[f32], c: &[f32]) -> Result<Ior, String> {
+        if b.len() != c.len() || b.is_empty() || b.len() > SELLMEIER_TERMS {
+            return Err(format!(
+                "expected 1 to {SELLMEIER_TERMS} B and as many C coefficients, got {} and {}",
+                b.len(),
+                c.len()
+            ));
+        }
+        let mut bb = [0.0; SELLMEIER_TERMS];
+        let mut cc = [0.0; SELLMEIER_TERMS];
+        bb[..b.len()].copy_from_slice(b);
+        cc[..c.len()].copy_from_slice(c);
+        Ok(Ior::Sellmeier { b: bb, c: cc })
+    }
+
+    /// Checks that n is finite and at least 1 over 360–830 nm (a pole of a Sellmeier
+    /// term inside the range, or a fit used far outside its range, would break this).
+    pub fn validate(&self) -> Result<(), String> {
+        for l in 360..=830 {
+            let n = self.eval(l as f32);
+            if !n.is_finite() || n < 1.0 {
+                return Err(format!(
+                    "expected a refractive index ≥ 1 over 360–830 nm, got n({l} nm) = {n}"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CatalogueEntry {
+    #[allow(dead_code)]
+    source: String,
+    sellmeier: SellmeierCoefficients,
+    n_d: f32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SellmeierCoefficients {
+    b: Vec<f32>,
+    c: Vec<f32>,
+}
+
+/// One catalogue material: its model and the catalogue's n_d (587.56 nm) to check it.
+#[derive(Clone, Debug)]
+pub struct CatalogueMaterial {
+    pub name: String,
+    pub ior: Ior,
+    pub n_d: f32,
+}
+
+const CATALOGUE: &str = include_str!("../../spectra/ior_catalogue.toml");
+
+/// The named refractive-index models of spectra/ior_catalogue.toml, by name.
+pub fn catalogue() -> &'static BTreeMap<String, CatalogueMaterial> {
+    static CAT: OnceLock<BTreeMap<String, CatalogueMaterial>> = OnceLock::new();
+    CAT.get_or_init(|| {
+        let raw: BTreeMap<String, CatalogueEntry> =
+            toml::from_str(CATALOGUE).expect("spectra/ior_catalogue.toml is valid");
+        raw.into_iter()
+            .map(|(name, e)| {
+                let ior =
+                    Ior::sellmeier(&e.sellmeier.b, &e.sellmeier.c).expect("catalogue coefficients");
+                (
+                    name.clone(),
+                    CatalogueMaterial {
+                        name,
+                        ior,
+                        n_d: e.n_d,
+                    },
+                )
+            })
+            .collect()
+    })
+}
+
+/// The model named `name` in the catalogue.
+pub fn named(name: &str) -> Option<Ior> {
+    catalogue().get(name).map(|m| m.ior.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn catalogue_reproduces_its_n_d() {
+        assert!(catalogue().len() >= 6);
+        for m in catalogue().values() {
+            let n = m.ior.eval(587.56);
+            let tol = if m.name == "water" { 5e-4 } else { 1e-4 };
+            assert!((n - m.n_d).abs() < tol, "{}: n_d {n} vs {}", m.name, m.n_d);
+            assert!(m.ior.is_dispersive());
+            m.ior.validate().unwrap();
+        }
+    }
+
+    #[test]
+    fn normal_dispersion_index_falls_with_wavelength() {
+        for m in catalogue().values() {
+            let (f, c) = (m.ior.eval(486.13), m.ior.eval(656.27));
+            assert!(f > c, "{}: n_F {f} <= n_C {c}", m.name);
+        }
+        // Abbe number of N-BK7 is 64.17 (Schott): (n_d − 1)/(n_F − n_C).
+        let bk7 = named("N-BK7").unwrap();
+        let v = (bk7.eval(587.56) - 1.0) / (bk7.eval(486.13) - bk7.eval(656.27));
+        assert!((v - 64.17).abs() < 0.1, "V_d = {v}");
+    }
+
+    #[test]
+    fn cauchy_and_constant() {
+        let c = Ior::Cauchy {
+            a: 1.5,
+            b: 0.004,
+            c: 0.0,
+        };
+        assert!((c.eval(500.0) - (1.5 + 0.004 / 0.25)).abs() < 1e-6);
+        assert!(c.is_dispersive());
+        assert!(!Ior::Constant(1.5).is_dispersive());
+        assert!(Ior::Cauchy {
+            a: 0.5,
+            b: 0.0,
+            c: 0.0
+        }
+        .validate()
+        .is_err());
+        assert!(
+            Ior::sellmeier(&[1.0], &[0.2]).unwrap().validate().is_err(),
+            "pole at 447 nm"
+        );
+    }
+}
