@@ -10,7 +10,7 @@ use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{whitted, Context, TraceCounters};
 use crate::math::Rng;
 use crate::scene::Scene;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledWavelengths, WavelengthSampler};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -29,6 +29,8 @@ pub struct RenderOptions {
     pub lanes: usize,
     /// Trace camera rays as 8-wide packets (otherwise one by one).
     pub packets: bool,
+    /// How hero wavelengths are drawn.
+    pub wavelengths: WavelengthSampler,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
 }
@@ -41,6 +43,7 @@ impl RenderOptions {
             threads: 0,
             lanes: 4,
             packets: true,
+            wavelengths: WavelengthSampler::Uniform,
             progress: None,
         }
     }
@@ -226,7 +229,7 @@ fn render_tile<const N: usize>(
                     let pixel = py as u64 * cam.width as u64 + px as u64;
                     let mut rng = Rng::for_sample(opts.seed, pixel, s as u64);
                     let (jx, jy) = (rng.uniform(), rng.uniform());
-                    wls[k] = SampledWavelengths::sample_uniform(rng.uniform());
+                    wls[k] = SampledWavelengths::sample(opts.wavelengths, rng.uniform());
                     rays[k].dir = cam.direction(px as f32 + jx, py as f32 + jy);
                     rngs[k] = rng;
                 }

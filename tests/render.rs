@@ -9,6 +9,7 @@ use heron::geometry::{Mesh, Shape, ShapeKind};
 use heron::light::{DirectionalLight, Light, PointLight};
 use heron::render::{render, RenderOptions};
 use heron::scene::{RenderSettings, Scene};
+use heron::spectrum::ior::Ior;
 use heron::spectrum::DenseSpectrum;
 use std::f32::consts::PI;
 
@@ -83,11 +84,11 @@ fn white_furnace_specular_objects_vanish() {
             rho_s: DenseSpectrum::constant(1.0),
         }),
         Material::Dielectric(Dielectric {
-            ior: 1.5,
+            ior: Ior::Constant(1.5),
             fresnel: true,
         }),
         Material::Dielectric(Dielectric {
-            ior: 2.42,
+            ior: Ior::Constant(2.42),
             fresnel: false,
         }),
         Material::Glossy(Glossy {
@@ -95,7 +96,7 @@ fn white_furnace_specular_objects_vanish() {
             rho_s: 0.1,
             shininess: 42.0,
             base: Some(Dielectric {
-                ior: 1.5,
+                ior: Ior::Constant(1.5),
                 fresnel: true,
             }),
         }),
@@ -289,7 +290,7 @@ fn image_is_identical_for_any_thread_count() {
         vec![
             lambertian(0.6),
             Material::Dielectric(Dielectric {
-                ior: 1.5,
+                ior: Ior::Constant(1.5),
                 fresnel: true,
             }),
         ],

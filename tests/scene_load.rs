@@ -185,7 +185,7 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
     let Material::Dielectric(g) = m else {
         panic!("{m:?}")
     };
-    assert_eq!(g.ior, 1.5);
+    assert_eq!(g.ior, heron::spectrum::ior::Ior::Constant(1.5));
     assert!(g.fresnel);
     assert!(Features::of(&s).specular);
 
@@ -197,7 +197,7 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
     assert_eq!(g.shininess, 42.0);
     assert_eq!(g.rho_d.max_value(), 0.0);
     let base = g.base.expect("glossy over glass");
-    assert_eq!(base.ior, 1.5);
+    assert_eq!(base.ior, heron::spectrum::ior::Ior::Constant(1.5));
     assert!(base.fresnel);
     assert_eq!(
         Features::of(&s),
@@ -253,7 +253,7 @@ fn cornell_box_has_one_shape_per_mesh_material() {
     let Material::Dielectric(glass) = by_name("glass") else {
         panic!()
     };
-    assert_eq!(glass.ior, 1.5);
+    assert_eq!(glass.ior, heron::spectrum::ior::Ior::Constant(1.5));
     assert!(matches!(by_name("mirror"), Material::Mirror(_)));
     assert_eq!(s.lights.len(), 1);
     let f = Features::of(&s);

@@ -1,11 +1,13 @@
 //! Smooth dielectric interface: refraction after the seed ("Refraction and total internal
 //! reflection"), with a Fresnel-weighted choice between reflection and refraction.
+use crate::spectrum::ior::Ior;
 use glam::Vec3;
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
-    /// Index of refraction of the inside relative to the outside (air/vacuum = 1).
-    pub ior: f32,
+    /// Index of refraction of the inside relative to the outside (air/vacuum = 1), a
+    /// function of wavelength.
+    pub ior: Ior,
     /// Weight reflection and refraction by the Fresnel equations (default). When false,
     /// the lecture's pure refraction: always refract, reflect only on total internal
     /// reflection.

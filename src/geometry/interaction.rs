@@ -31,9 +31,18 @@ pub struct Interaction {
 }
 
 impl Interaction {
-    /// Fills the record for `hit` of `ray` on `shape`, whose material is `material`.
+    /// Fills the record for `hit` of `ray` on `shape`, whose material is `material`;
+    /// `lambda` (nm) is the wavelength the path follows (the hero), at which the index
+    /// ratio is evaluated.
     #[inline]
-    pub fn new(ray: &Ray, hit: &Hit, shape: &Shape, material: &Material, depth: u32) -> Self {
+    pub fn new(
+        ray: &Ray,
+        hit: &Hit,
+        shape: &Shape,
+        material: &Material,
+        depth: u32,
+        lambda: f32,
+    ) -> Self {
         let (position, outward) = match &shape.kind {
             ShapeKind::Sphere { center, radius } => {
                 // Re-project onto the sphere: the float hit point drifts off the surface
@@ -46,8 +55,12 @@ impl Interaction {
         let front_face = outward.dot(ray.dir) < 0.0;
         let normal = if front_face { outward } else { -outward };
         let (ior, specular, shininess) = match material {
-            Material::Dielectric(d) => (d.ior, 0.0, 0.0),
-            Material::Glossy(g) => (g.base.as_ref().map_or(1.0, |b| b.ior), g.rho_s, g.shininess),
+            Material::Dielectric(d) => (d.ior.eval(lambda), 0.0, 0.0),
+            Material::Glossy(g) => (
+                g.base.as_ref().map_or(1.0, |b| b.ior.eval(lambda)),
+                g.rho_s,
+                g.shininess,
+            ),
             _ => (1.0, 0.0, 0.0),
         };
         let ior1_over_ior2 = if front_face { 1.0 / ior } else { ior };

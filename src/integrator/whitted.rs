@@ -14,7 +14,7 @@ use crate::bsdf::dielectric::refract;
 use crate::bsdf::fresnel::fresnel_dielectric;
 use crate::bsdf::mirror::reflect;
 use crate::bsdf::phong::phong_specular;
-use crate::bsdf::Material;
+use crate::bsdf::{Dielectric, Material};
 use crate::geometry::{Interaction, Ray};
 use crate::light::Light;
 use crate::math::Rng;
@@ -64,7 +64,7 @@ pub fn radiance<const N: usize>(
         };
         let shape = &scene.shapes[hit.geom_id as usize];
         let material = &scene.materials[shape.material as usize];
-        let mut it = Interaction::new(&ray, &hit, shape, material, depth);
+        let mut it = Interaction::new(&ray, &hit, shape, material, depth, wl.lambda[0]);
         let wo = -ray.dir;
         let next = match material {
             Material::Lambertian(m) => {
@@ -78,7 +78,7 @@ pub fn radiance<const N: usize>(
                 beta *= wl.eval(&m.rho_s);
                 Some(reflect(wo, it.normal))
             }
-            Material::Dielectric(d) => Some(scatter_dielectric(&it, wo, d.fresnel, rng)),
+            Material::Dielectric(d) => Some(scatter_dielectric(&it, wo, d, wl, &mut beta, rng)),
             Material::Glossy(g) => {
                 let fd = wl.eval(&g.rho_d) * FRAC_1_PI;
                 let (rho_s, s, n) = (it.specular, it.shininess, it.normal);
@@ -88,9 +88,12 @@ pub fn radiance<const N: usize>(
                     lr += (fd + SampledSpectrum::splat(fs)) * li_cos;
                 });
                 l += beta * lr;
+                // The course's glossy shader: Phong highlights from the lights plus the
+                // transparent shader's continuation, each at full weight (so with ρd > 0
+                // this combination can reflect more than it receives).
                 g.base
                     .as_ref()
-                    .map(|b| scatter_dielectric(&it, wo, b.fresnel, rng))
+                    .map(|b| scatter_dielectric(&it, wo, b, wl, &mut beta, rng))
             }
         };
         let Some(dir) = next else { break };
@@ -149,17 +152,47 @@ fn direct_lighting<const N: usize>(
 }
 
 /// Chooses the continuation at a dielectric: the seed's refraction with n_i/n_t from the
-/// interaction, reflection on total internal reflection, and (with `fresnel`) reflection
-/// with probability R otherwise.
+/// interaction (evaluated at the hero wavelength), reflection on total internal
+/// reflection, and (with `fresnel`) reflection with probability R otherwise.
+///
+/// With a wavelength-dependent index and several live lanes: reflection sends every
+/// lane the same way, so the lanes stay and each is weighted by R(λ_i)/R(λ_hero) (the
+/// probability of the choice was the hero's R). Refraction sends each wavelength its
+/// own way, so the path follows the hero and the other lanes end
+/// ([`SampledSpectrum::terminate_secondary`]); the hero's weight T/(1 − R) is 1.
 #[inline]
-fn scatter_dielectric(it: &Interaction, wo: Vec3, fresnel: bool, rng: &mut Rng) -> Vec3 {
+pub(crate) fn scatter_dielectric<const N: usize>(
+    it: &Interaction,
+    wo: Vec3,
+    d: &Dielectric,
+    wl: &SampledWavelengths<N>,
+    beta: &mut SampledSpectrum<N>,
+    rng: &mut Rng,
+) -> Vec3 {
     let n = it.normal;
     let eta = it.ior1_over_ior2;
-    if fresnel {
-        let r = fresnel_dielectric(wo.dot(n), eta);
-        if r >= 1.0 || rng.uniform() < r {
-            return reflect(wo, n);
+    let cos_i = wo.dot(n);
+    let lanes_alive = N > 1 && beta.0[1..].iter().any(|&b| b != 0.0);
+    let dispersive = lanes_alive && d.ior.is_dispersive();
+    if !d.fresnel {
+        if dispersive {
+            beta.terminate_secondary();
         }
+        return refract(wo, n, eta).unwrap_or_else(|| reflect(wo, n));
+    }
+    let r = fresnel_dielectric(cos_i, eta);
+    if r >= 1.0 || rng.uniform() < r {
+        if dispersive {
+            for i in 1..N {
+                let ni = d.ior.eval(wl.lambda[i]);
+                let eta_i = if it.front_face { 1.0 / ni } else { ni };
+                beta.0[i] *= fresnel_dielectric(cos_i, eta_i) / r;
+            }
+        }
+        return reflect(wo, n);
+    }
+    if dispersive {
+        beta.terminate_secondary();
     }
     refract(wo, n, eta).unwrap_or_else(|| reflect(wo, n))
 }

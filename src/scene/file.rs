@@ -137,7 +137,7 @@ pub struct MirrorFile {
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DielectricFile {
-    pub ior: PositiveNumber,
+    pub ior: IorSpec,
     /// Default true; false is the lecture's pure refraction.
     #[serde(default)]
     pub fresnel: Option<bool>,
@@ -151,7 +151,7 @@ pub struct GlossyFile {
     pub rho_s: UnitNumber,
     pub shininess: PositiveNumber,
     #[serde(default)]
-    pub ior: Option<PositiveNumber>,
+    pub ior: Option<IorSpec>,
     /// Only allowed together with `ior`; default true.
     #[serde(default)]
     pub fresnel: Option<bool>,
@@ -261,6 +261,19 @@ pub struct DirectionalLightFile {
 // ---------------------------------------------------------------------------------------
 // Leaf types: each is read as a raw TOML value and checked, so that its error message is
 // ours ("expected …, got …") and sits at the key path of the value.
+
+/// A refractive index: a positive number (no dispersion), the name of a catalogue entry
+/// (spectra/ior_catalogue.toml), or one of `{ sellmeier = { b = [..], c = [..] } }`
+/// (λ in µm, C in µm²), `{ cauchy = [A, B] }` or `{ cauchy = [A, B, C] }` (λ in µm),
+/// `{ table = "file.csv" }` (rows `wavelength_nm,n`, relative to the scene file).
+#[derive(Clone, Debug, PartialEq)]
+pub enum IorSpec {
+    Constant(f32),
+    Named(String),
+    Sellmeier { b: Vec<f32>, c: Vec<f32> },
+    Cauchy([f32; 3]),
+    Table(String),
+}
 
 /// `[x, y, z]`, three numbers finite in f32.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -518,6 +531,86 @@ impl<'de> Deserialize<'de> for PositiveNumber {
                 "expected a positive finite number, got {}",
                 show(&v)
             ))),
+        }
+    }
+}
+
+fn finite_list(v: &toml::Value) -> Option<Vec<f32>> {
+    match v {
+        toml::Value::Array(a) => a.iter().map(finite_f32).collect(),
+        _ => None,
+    }
+}
+
+impl<'de> Deserialize<'de> for IorSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let names = || {
+            crate::spectrum::ior::catalogue()
+                .keys()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let expected = || {
+            format!(
+                "expected a positive number, a catalogue name ({}), {{ sellmeier = {{ b = [..], c = [..] }} }}, {{ cauchy = [A, B, C] }} or {{ table = \"file.csv\" }}, got {}",
+                names(),
+                show(&v)
+            )
+        };
+        match &v {
+            toml::Value::String(name) => {
+                if crate::spectrum::ior::named(name).is_some() {
+                    Ok(IorSpec::Named(name.clone()))
+                } else {
+                    Err(D::Error::custom(format!(
+                        "unknown refractive-index model {name:?}, expected one of {}",
+                        names()
+                    )))
+                }
+            }
+            toml::Value::Table(t) if t.len() == 1 => {
+                let (k, x) = t.iter().next().expect("one entry");
+                match (k.as_str(), x) {
+                    ("sellmeier", toml::Value::Table(sc)) => {
+                        let b = sc.get("b").and_then(finite_list);
+                        let c = sc.get("c").and_then(finite_list);
+                        match (b, c) {
+                            (Some(b), Some(c))
+                                if sc.len() == 2 && b.len() == c.len() && (1..=4).contains(&b.len()) =>
+                            {
+                                Ok(IorSpec::Sellmeier { b, c })
+                            }
+                            _ => Err(D::Error::custom(format!(
+                                "expected sellmeier = {{ b = [B1, ..], c = [C1, ..] }} with 1 to 4 finite coefficients each (C in µm²), got {}",
+                                show(x)
+                            ))),
+                        }
+                    }
+                    ("cauchy", x) => match finite_list(x) {
+                        Some(c) if (2..=3).contains(&c.len()) => Ok(IorSpec::Cauchy([
+                            c[0],
+                            c[1],
+                            c.get(2).copied().unwrap_or(0.0),
+                        ])),
+                        _ => Err(D::Error::custom(format!(
+                            "expected cauchy = [A, B] or [A, B, C] (λ in µm), got {}",
+                            show(x)
+                        ))),
+                    },
+                    ("table", toml::Value::String(f)) => Ok(IorSpec::Table(f.clone())),
+                    _ => Err(D::Error::custom(expected())),
+                }
+            }
+            _ => match (number(&v), finite_f32(&v)) {
+                (_, Some(x)) if x > 0.0 => Ok(IorSpec::Constant(x)),
+                (Some(_), _) => Err(D::Error::custom(format!(
+                    "expected a positive finite number, got {}",
+                    show(&v)
+                ))),
+                _ => Err(D::Error::custom(expected())),
+            },
         }
     }
 }

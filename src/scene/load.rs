@@ -20,9 +20,9 @@
 mod obj;
 
 use super::file::{
-    show, Colour, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile, LightFile,
-    MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, SceneFile, ShapeFile,
-    SphereFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
+    show, Colour, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec, LambertianFile,
+    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, SceneFile,
+    ShapeFile, SphereFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
 };
 use super::{RenderSettings, Scene};
 use crate::bsdf::{Dielectric, Glossy, Lambertian, Material, Mirror};
@@ -30,6 +30,7 @@ use crate::camera::Camera;
 use crate::error::{HeronError, Result};
 use crate::geometry::{Mesh, Shape, ShapeKind};
 use crate::light::{DirectionalLight, Light, PointLight};
+use crate::spectrum::ior::Ior;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -411,7 +412,7 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     let mut materials = Vec::with_capacity(file.materials.len());
     let mut material_names = Vec::with_capacity(file.materials.len());
     for (name, m) in &file.materials {
-        materials.push(build_material(&key("materials", name), m).map_err(err)?);
+        materials.push(build_material(&key("materials", name), m, &base_dir).map_err(err)?);
         material_names.push(name.clone());
     }
     let index: HashMap<&str, u32> = material_names
@@ -565,7 +566,37 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     })
 }
 
-fn build_material(at: &str, m: &MaterialFile) -> std::result::Result<Material, String> {
+/// The refractive-index model of `spec`; a table file is read relative to `base_dir`.
+fn build_ior(at: &str, spec: &IorSpec, base_dir: &Path) -> std::result::Result<Ior, String> {
+    let at = format!("{at}.ior");
+    let ior = match spec {
+        IorSpec::Constant(n) => Ior::Constant(*n),
+        IorSpec::Named(name) => crate::spectrum::ior::named(name)
+            .ok_or_else(|| format!("{at}: unknown refractive-index model {name:?}"))?,
+        IorSpec::Sellmeier { b, c } => Ior::sellmeier(b, c).map_err(|e| format!("{at}: {e}"))?,
+        IorSpec::Cauchy([a, b, c]) => Ior::Cauchy {
+            a: *a,
+            b: *b,
+            c: *c,
+        },
+        IorSpec::Table(file) => {
+            let p = base_dir.join(file);
+            let text = std::fs::read_to_string(&p)
+                .map_err(|e| format!("{at}: cannot read {}: {e}", p.display()))?;
+            let samples = crate::spectrum::dense::parse_samples_csv(&text)
+                .map_err(|e| format!("{at}: {}: {e}", p.display()))?;
+            Ior::Table(DenseSpectrum::from_samples(&samples))
+        }
+    };
+    ior.validate().map_err(|e| format!("{at}: {e}"))?;
+    Ok(ior)
+}
+
+fn build_material(
+    at: &str,
+    m: &MaterialFile,
+    base_dir: &Path,
+) -> std::result::Result<Material, String> {
     Ok(match m {
         MaterialFile::Lambertian(l) => Material::Lambertian(Lambertian {
             rho_d: l.rho_d.spectrum(),
@@ -578,7 +609,7 @@ fn build_material(at: &str, m: &MaterialFile) -> std::result::Result<Material, S
                 .map_or_else(|| DenseSpectrum::constant(1.0), |r| r.spectrum()),
         }),
         MaterialFile::Dielectric(d) => Material::Dielectric(Dielectric {
-            ior: d.ior.0,
+            ior: build_ior(at, &d.ior, base_dir)?,
             fresnel: d.fresnel.unwrap_or(true),
         }),
         MaterialFile::Glossy(g) => {
@@ -609,10 +640,13 @@ fn build_material(at: &str, m: &MaterialFile) -> std::result::Result<Material, S
                 rho_d: g.rho_d.spectrum(),
                 rho_s,
                 shininess: g.shininess.0,
-                base: g.ior.map(|ior| Dielectric {
-                    ior: ior.0,
-                    fresnel: g.fresnel.unwrap_or(true),
-                }),
+                base: match &g.ior {
+                    Some(spec) => Some(Dielectric {
+                        ior: build_ior(at, spec, base_dir)?,
+                        fresnel: g.fresnel.unwrap_or(true),
+                    }),
+                    None => None,
+                },
             })
         }
     })

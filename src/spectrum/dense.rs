@@ -80,3 +80,49 @@ impl DenseSpectrum {
         self.values.iter().all(|&v| v == v0)
     }
 }
+
+/// Parses `wavelength_nm,value` rows: an optional header line, `#` comments and blank
+/// lines allowed; at least two rows, strictly increasing finite wavelengths, finite
+/// values. Errors name the line (1-based) and what was expected.
+pub fn parse_samples_csv(text: &str) -> Result<Vec<(f32, f32)>, String> {
+    let mut out: Vec<(f32, f32)> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+        let parsed = match fields.as_slice() {
+            [w, v] => w.parse::<f32>().ok().zip(v.parse::<f32>().ok()),
+            _ => None,
+        };
+        let Some((w, v)) = parsed else {
+            if out.is_empty() && i == 0 {
+                continue; // header line
+            }
+            return Err(format!(
+                "line {}: expected `wavelength_nm,value` with two numbers, got {l:?}",
+                i + 1
+            ));
+        };
+        if !w.is_finite() || !v.is_finite() {
+            return Err(format!(
+                "line {}: expected finite numbers, got {l:?}",
+                i + 1
+            ));
+        }
+        if let Some(&(prev, _)) = out.last() {
+            if w <= prev {
+                return Err(format!(
+                    "line {}: expected wavelengths to increase, got {w} after {prev}",
+                    i + 1
+                ));
+            }
+        }
+        out.push((w, v));
+    }
+    if out.len() < 2 {
+        return Err(format!("expected at least two rows, got {}", out.len()));
+    }
+    Ok(out)
+}

@@ -10,7 +10,7 @@ pub mod sampled;
 pub mod uplift;
 
 pub use dense::DenseSpectrum;
-pub use sampled::{SampledSpectrum, SampledWavelengths};
+pub use sampled::{SampledSpectrum, SampledWavelengths, WavelengthSampler};
 
 /// Shortest wavelength heron transports, nm (pbrt-v4 and Mitsuba 3 use the same range).
 pub const LAMBDA_MIN: f32 = 360.0;
