@@ -16,5 +16,6 @@ pub mod math;
 pub mod render;
 pub mod scene;
 pub mod spectrum;
+pub mod trace;
 
 pub use error::{HeronError, Result};

@@ -23,6 +23,8 @@ struct Cli {
 enum Command {
     /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview.
     Render(RenderArgs),
+    /// Follow one ray at one wavelength through a scene and print its events as JSON.
+    Trace(TraceArgs),
     /// Measure throughput.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -75,6 +77,25 @@ struct TraversalArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
     threads: Option<u16>,
+}
+
+#[derive(clap::Args)]
+struct TraceArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Ray origin X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    origin: [f32; 3],
+    /// Ray direction X,Y,Z (normalised here).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    dir: [f32; 3],
+    /// Wavelength in nm (360–830).
+    #[arg(long)]
+    lambda: f32,
+    /// At the k-th dielectric event, R reflects and T transmits (default T; total
+    /// internal reflection forces R), e.g. TRT for the primary rainbow ray.
+    #[arg(long, default_value = "")]
+    path: String,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<[f32; 3], String> {
@@ -156,6 +177,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => cmd_render(args),
+        Command::Trace(args) => cmd_trace(args),
         Command::Bench(BenchCommand::Traversal(args)) => cmd_bench_traversal(args),
         Command::Bench(BenchCommand::Mesh { n, output }) => {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
@@ -233,6 +255,22 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         stats.mrays_per_s(),
         stats.nonfinite
     );
+    Ok(())
+}
+
+fn cmd_trace(a: TraceArgs) -> Result<()> {
+    let choices = heron::trace::parse_path(&a.path)?;
+    let scene = load_scene(&a.scene)?;
+    let renderer = heron::render::Renderer::new(&scene)?;
+    let report = heron::trace::trace(
+        &scene,
+        renderer.accel(),
+        a.origin.into(),
+        a.dir.into(),
+        a.lambda,
+        &choices,
+    )?;
+    println!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())
 }
 
