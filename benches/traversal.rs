@@ -1,6 +1,7 @@
 //! Embree traversal: closest hit and occlusion, single rays vs 8-wide packets, for
 //! coherent camera rays and incoherent hemisphere rays, on a deterministic procedural
-//! mesh of about one million triangles (heron::bench::procedural_mesh(708)).
+//! mesh of about one million triangles (heron::bench::procedural_mesh(708)). Runs on
+//! criterion's own thread, so without the FTZ/DAZ bits heron's workers set.
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::Vec3;
 use heron::accel::embree::{self, RayQuery};
@@ -55,7 +56,6 @@ fn incoherent_rays() -> Vec<RayQuery> {
 }
 
 fn traversal(c: &mut Criterion) {
-    embree::set_flush_denormals();
     let mesh = heron::bench::procedural_mesh(708);
     let device = embree::Device::new("threads=1").unwrap();
     let mut b = device.scene_builder();

@@ -51,37 +51,24 @@ impl TraversalReport {
     }
 }
 
-/// Loads every object of an OBJ file as one triangle mesh.
+/// Loads every object of an OBJ file as one triangle mesh, with the scene loader's OBJ
+/// reader (errors name the line).
 pub fn load_obj_mesh(path: &Path) -> Result<Mesh> {
     let err = |message: String| HeronError::Io {
         path: path.to_path_buf(),
         message,
     };
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ..Default::default()
-    };
-    let (models, _) =
-        tobj::load_obj(path, &opts).map_err(|e| err(format!("cannot read OBJ: {e}")))?;
+    let text = std::fs::read_to_string(path).map_err(|e| err(format!("cannot read: {e}")))?;
+    let groups = crate::scene::load::obj::parse_obj(&text).map_err(err)?;
     let mut mesh = Mesh::default();
-    for m in models {
+    for g in groups {
         let base = mesh.positions.len() as u32;
-        let p = &m.mesh.positions;
-        for v in p.chunks_exact(3) {
-            let v = Vec3::new(v[0], v[1], v[2]);
-            if !v.is_finite() {
-                return Err(err(format!("object {}: non-finite vertex", m.name)));
-            }
-            mesh.positions.push(v);
-        }
-        let n = (p.len() / 3) as u32;
-        for t in m.mesh.indices.chunks_exact(3) {
-            if t.iter().any(|&i| i >= n) {
-                return Err(err(format!("object {}: vertex index out of range", m.name)));
-            }
-            mesh.indices.push([base + t[0], base + t[1], base + t[2]]);
-        }
+        mesh.positions.extend(g.positions);
+        mesh.indices.extend(
+            g.indices
+                .iter()
+                .map(|t| [base + t[0], base + t[1], base + t[2]]),
+        );
     }
     if mesh.indices.is_empty() {
         return Err(err("no triangles".into()));
@@ -222,11 +209,7 @@ pub fn run_traversal(mesh: &Mesh, o: &TraversalOptions) -> Result<TraversalRepor
         )));
     }
     let cam = ViewCamera::new(o)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(o.threads)
-        .start_handler(|_| embree::set_flush_denormals())
-        .build()
-        .map_err(|e| HeronError::Invalid(format!("cannot start worker threads: {e}")))?;
+    let pool = embree::worker_pool(o.threads)?;
     let device = embree::Device::new("")?;
     let t0 = Instant::now();
     let mut b = device.scene_builder();
@@ -330,10 +313,10 @@ fn trace_primary_row(
                 }
             }
         } else {
-            for k in 0..8 {
+            for (k, r) in rays.iter().enumerate() {
                 if active & (1 << k) != 0 {
-                    let h = scene.intersect1(&rays[k]);
-                    emit(&rays[k], &h, &mut rng);
+                    let h = scene.intersect1(r);
+                    emit(r, &h, &mut rng);
                 }
             }
         }

@@ -1,7 +1,8 @@
+#![deny(unsafe_code)]
 //! The heron command line.
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
-use heron::film::{exr::write_exr, png::write_png};
+use heron::film::{exr::stage_exr, png::stage_png};
 use heron::render::{render, RenderOptions};
 use heron::scene::load_scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -174,7 +175,18 @@ fn parse_lanes(s: &str) -> std::result::Result<usize, String> {
 }
 
 fn main() {
-    let cli = Cli::parse();
+    // Usage errors get one line and status 1 like every other error; --help and
+    // --version print as usual.
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            eprintln!("{}", first.trim_end());
+            std::process::exit(1);
+        }
+    };
     let result = match cli.command {
         Command::Render(args) => cmd_render(args),
         Command::Trace(args) => cmd_trace(args),
@@ -236,10 +248,17 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    write_exr(&film, &exr_path)?;
-    let png_path = exr_path.with_extension("png");
-    if !args.no_png {
-        write_png(&film, &png_path)?;
+    // Both files are staged first and renamed into place together: an error in either
+    // leaves neither behind.
+    let exr = stage_exr(&film, &exr_path)?;
+    let png = if args.no_png {
+        None
+    } else {
+        Some(stage_png(&film, &exr_path.with_extension("png"))?)
+    };
+    exr.commit()?;
+    if let Some(p) = png {
+        p.commit()?;
     }
     eprintln!(
         "{}: {}x{} at {} spp, {} lanes in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",

@@ -70,6 +70,24 @@ impl RenderStats {
 
 /// Builds the Embree scene: shape i becomes geometry i.
 pub fn build_accel(scene: &Scene, device: &embree::Device) -> Result<embree::Scene> {
+    // Embree drops primitives with coordinates beyond about 1.8e18; say so in the
+    // scene's own terms rather than let the build fail deep inside Embree.
+    const LIMIT: f32 = 1e18;
+    for (i, shape) in scene.shapes.iter().enumerate() {
+        let too_far = match &shape.kind {
+            ShapeKind::Sphere { center, radius } => center.abs().max_element() + radius > LIMIT,
+            ShapeKind::Mesh(m) => m.positions.iter().any(|p| p.abs().max_element() > LIMIT),
+        };
+        if too_far {
+            return Err(HeronError::Scene {
+                file: scene.source.clone(),
+                message: format!(
+                    "shape {i} ({}): expected coordinates within ±1e18 (Embree's limit)",
+                    scene.material_names[shape.material as usize]
+                ),
+            });
+        }
+    }
     let mut b = device.scene_builder();
     for (i, shape) in scene.shapes.iter().enumerate() {
         let id = match &shape.kind {
@@ -100,17 +118,32 @@ struct TileResult {
 pub struct Renderer<'s> {
     scene: &'s Scene,
     accel: embree::Scene,
+    /// The worker pool of the last render and its thread count, reused while the count
+    /// stays the same.
+    pool: std::sync::Mutex<Option<(usize, std::sync::Arc<rayon::ThreadPool>)>>,
     // Kept alive for as long as the committed scene.
     _device: embree::Device,
 }
 
 impl<'s> Renderer<'s> {
+    /// Builds the Embree scene with Embree's own threads (one per core).
     pub fn new(scene: &'s Scene) -> Result<Self> {
-        let device = embree::Device::new("")?;
+        Self::with_threads(scene, 0)
+    }
+
+    /// Builds the Embree scene; `threads` > 0 limits Embree's build threads too.
+    pub fn with_threads(scene: &'s Scene, threads: usize) -> Result<Self> {
+        let config = if threads > 0 {
+            format!("threads={threads}")
+        } else {
+            String::new()
+        };
+        let device = embree::Device::new(&config)?;
         let accel = build_accel(scene, &device)?;
         Ok(Renderer {
             scene,
             accel,
+            pool: std::sync::Mutex::new(None),
             _device: device,
         })
     }
@@ -121,28 +154,41 @@ impl<'s> Renderer<'s> {
 
     /// Renders the image; returns the film and statistics.
     pub fn render(&self, opts: &RenderOptions) -> Result<(Film, RenderStats)> {
-        render_with(self.scene, &self.accel, opts)
+        let pool = {
+            let mut cached = self.pool.lock().unwrap_or_else(|e| e.into_inner());
+            match &*cached {
+                Some((t, p)) if *t == opts.threads => p.clone(),
+                _ => {
+                    let p = std::sync::Arc::new(embree::worker_pool(opts.threads)?);
+                    *cached = Some((opts.threads, p.clone()));
+                    p
+                }
+            }
+        };
+        render_with(self.scene, &self.accel, &pool, opts)
     }
 }
 
 /// Renders `scene`; returns the film and statistics.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<(Film, RenderStats)> {
-    Renderer::new(scene)?.render(opts)
+    Renderer::with_threads(scene, opts.threads)?.render(opts)
 }
 
 fn render_with(
     scene: &Scene,
     accel: &embree::Scene,
+    pool: &rayon::ThreadPool,
     opts: &RenderOptions,
 ) -> Result<(Film, RenderStats)> {
     if opts.spp == 0 {
         return Err(HeronError::Invalid("spp must be at least 1".into()));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .start_handler(|_| embree::set_flush_denormals())
-        .build()
-        .map_err(|e| HeronError::Invalid(format!("cannot start worker threads: {e}")))?;
+    if ![1, 4, 8].contains(&opts.lanes) {
+        return Err(HeronError::Invalid(format!(
+            "lanes: expected 1, 4 or 8, got {}",
+            opts.lanes
+        )));
+    }
     let ctx = Context { scene, accel };
     let cam = &scene.camera;
     let (tw, th) = (cam.width.div_ceil(TILE), cam.height.div_ceil(TILE));
@@ -158,8 +204,8 @@ fn render_with(
             .map(|&(x0, y0)| {
                 let r = match opts.lanes {
                     1 => render_tile::<1>(&ctx, opts, x0, y0),
-                    8 => render_tile::<8>(&ctx, opts, x0, y0),
-                    _ => render_tile::<4>(&ctx, opts, x0, y0),
+                    4 => render_tile::<4>(&ctx, opts, x0, y0),
+                    _ => render_tile::<8>(&ctx, opts, x0, y0),
                 };
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 if let Some(p) = &opts.progress {

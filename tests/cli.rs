@@ -23,7 +23,7 @@ background = [0.1, 0.3, 0.6]
 [camera]
 eye = [2.0, 1.5, 2.0]
 look_at = [0.0, 0.5, 0.0]
-resolution = [24, 16]
+resolution = [48, 40]
 [render]
 spp = 2
 [materials.white]
@@ -85,7 +85,7 @@ fn bad_scenes_give_clear_errors_and_no_files() {
         ("type = \"dielectric\"", &["type = \"glas\""]),
         ("spp = 2", &["colour = 2"]),
         ("ior = 1.5", &["ior = nan"]),
-        ("resolution = [24, 16]", &["resolution = [24, 0]"]),
+        ("resolution = [48, 40]", &["resolution = [24, 0]"]),
         ("material = \"glass\"", &["material = \"gold\""]),
     ];
     let expect: &[&[&str]] = &[
@@ -119,6 +119,13 @@ fn bad_scenes_give_clear_errors_and_no_files() {
         d.path(),
         &["render", scene.to_str().unwrap(), "-o", out],
         &["nowhere.obj"],
+    );
+    let far = SMALL.replacen("center = [0.0, 0.5, 0.0]", "center = [0.0, 3e18, 0.0]", 1);
+    let scene = write_scene(d.path(), "far.toml", &far);
+    assert_bad(
+        d.path(),
+        &["render", scene.to_str().unwrap(), "-o", out],
+        &["far.toml", "1e18"],
     );
     let scene = write_scene(d.path(), "syntax.toml", "[camera\neye = [1, 2, 3]\n");
     assert_bad(

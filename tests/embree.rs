@@ -8,40 +8,25 @@ use std::sync::Arc;
 
 use glam::{DVec3, Vec3};
 use heron::accel::embree::{
-    flush_denormals_enabled, set_flush_denormals, Device, EmbreeError, Hit, RayCoherence, RayQuery,
-    Scene,
+    flush_denormals_enabled, worker_pool, Device, EmbreeError, Hit, RayCoherence, RayQuery, Scene,
 };
 
 // ---------------------------------------------------------------------------------------
 // Helpers
 
-/// PCG32 (O'Neill 2014, pcg32_random_r), for deterministic test rays.
-struct Pcg32 {
-    state: u64,
-    inc: u64,
-}
+/// Deterministic test rays from heron's own PCG32 streams.
+struct Pcg32(heron::math::Rng);
 
 impl Pcg32 {
     fn new(seed: u64, stream: u64) -> Self {
-        let mut rng = Pcg32 {
-            state: 0,
-            inc: (stream << 1) | 1,
-        };
-        rng.next_u32();
-        rng.state = rng.state.wrapping_add(seed);
-        rng.next_u32();
-        rng
+        Pcg32(heron::math::Rng::new(seed, stream))
     }
     fn next_u32(&mut self) -> u32 {
-        let old = self.state;
-        self.state = old.wrapping_mul(6364136223846793005).wrapping_add(self.inc);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        let rot = (old >> 59) as u32;
-        xorshifted.rotate_right(rot)
+        self.0.next_u32()
     }
     /// Uniform in [0, 1).
     fn f32(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        self.0.uniform()
     }
     fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.f32()
@@ -695,7 +680,6 @@ fn queries_from_many_threads_match_one_thread() {
             let scene = Arc::clone(&scene);
             let rays = Arc::clone(&rays);
             std::thread::spawn(move || {
-                set_flush_denormals();
                 // Each thread walks the rays in a different order (a permutation: the
                 // stride is coprime with n = 8000).
                 let n = rays.len();
@@ -916,24 +900,34 @@ fn scene_outlives_device_and_moves_between_threads() {
 }
 
 #[test]
-fn flush_denormals_sets_ftz_and_daz() {
+fn worker_pool_threads_flush_denormals() {
+    // A fresh thread starts with the default MXCSR (no FTZ/DAZ) …
     std::thread::spawn(|| {
         let tiny = std::hint::black_box(f32::MIN_POSITIVE);
-        let half = std::hint::black_box(0.5f32);
-        if cfg!(target_arch = "x86_64") {
-            // A fresh thread starts with the default MXCSR (no FTZ/DAZ).
-            assert!(!flush_denormals_enabled());
-            assert!(tiny * half > 0.0, "denormal result expected before");
-            set_flush_denormals();
-            assert!(flush_denormals_enabled());
-            assert_eq!(std::hint::black_box(tiny) * std::hint::black_box(half), 0.0);
-            // DAZ: a denormal input reads as zero.
-            let denormal = std::hint::black_box(f32::from_bits(1));
-            assert_eq!(denormal * std::hint::black_box(1.0f32), 0.0);
-        } else {
-            set_flush_denormals(); // no-op
-        }
+        assert!(!flush_denormals_enabled());
+        assert!(
+            tiny * std::hint::black_box(0.5f32) > 0.0,
+            "denormal result expected"
+        );
     })
     .join()
     .unwrap();
+    // … and heron's workers have both bits set.
+    let pool = worker_pool(2).unwrap();
+    let results: Vec<(bool, f32, f32)> = pool.broadcast(|_| {
+        let tiny = std::hint::black_box(f32::MIN_POSITIVE);
+        let denormal = std::hint::black_box(f32::from_bits(1));
+        (
+            flush_denormals_enabled(),
+            tiny * std::hint::black_box(0.5f32),
+            denormal * std::hint::black_box(1.0f32),
+        )
+    });
+    for (enabled, ftz, daz) in results {
+        if cfg!(target_arch = "x86_64") {
+            assert!(enabled);
+            assert_eq!(ftz, 0.0, "FTZ: a denormal result flushes to zero");
+            assert_eq!(daz, 0.0, "DAZ: a denormal input reads as zero");
+        }
+    }
 }

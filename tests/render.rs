@@ -321,3 +321,46 @@ fn image_is_identical_for_any_thread_count() {
         a.xyz.len()
     );
 }
+
+/// The course's sphere variants must look different where the sphere is and the same
+/// elsewhere: the material, not the setup, changes.
+#[test]
+fn course_variants_differ_only_where_the_sphere_is() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let render_small = |name: &str| {
+        let mut s = heron::scene::load_scene(&dir.join(format!("{name}.toml"))).unwrap();
+        s.camera = Camera::new(
+            s.camera.eye,
+            s.camera.look_at,
+            s.camera.up,
+            s.camera.d,
+            64,
+            64,
+        )
+        .unwrap();
+        s.settings.spp = 8;
+        run(&s, 2)
+    };
+    // Mean Y over a window: the sphere (centre of the view) and a patch of floor far
+    // in front of it (bottom-left corner, in no sphere's reflection or shadow).
+    let mean = |f: &Film, x0: usize, y0: usize, w: usize| {
+        let mut m = 0.0;
+        for y in y0..y0 + w {
+            for x in x0..x0 + w {
+                m += f.xyz[y * 64 + x][1];
+            }
+        }
+        m / (w * w) as f32
+    };
+    let base = render_small("default");
+    for v in ["default-mirror", "default-glass", "default-glossy"] {
+        let f = render_small(v);
+        let (a, b) = (mean(&base, 28, 24, 8), mean(&f, 28, 24, 8));
+        assert!(
+            (a - b).abs() > 0.2 * a.max(b),
+            "{v}: sphere {b} vs default {a}"
+        );
+        let (c, d) = (mean(&base, 0, 56, 6), mean(&f, 0, 56, 6));
+        assert!((c - d).abs() < 0.05 * c, "{v}: floor {d} vs default {c}");
+    }
+}

@@ -1,11 +1,17 @@
 //! OpenEXR output: float32 R, G, B in linear sRGB with the standard `chromaticities`
 //! attribute (sRGB primaries, D65 white), so any reader knows the colour space.
-use super::{write_atomically, Film};
+use super::{Film, Staged};
 use crate::spectrum::color::SRGB_CHROMATICITIES;
 use exr::prelude::*;
 use std::path::Path;
 
+/// Writes the EXR file; see [`stage_exr`] to write several outputs together.
 pub fn write_exr(film: &Film, path: &Path) -> crate::Result<()> {
+    stage_exr(film, path)?.commit()
+}
+
+/// Writes the EXR file to a temporary file, to be committed later.
+pub fn stage_exr(film: &Film, path: &Path) -> crate::Result<Staged> {
     let rgb = film.linear_srgb();
     let (w, h) = (film.width as usize, film.height as usize);
     let channels = SpecificChannels::rgb(|pos: Vec2<usize>| {
@@ -26,7 +32,7 @@ pub fn write_exr(film: &Film, path: &Path) -> crate::Result<()> {
         blue: Vec2(b[0], b[1]),
         white: Vec2(wp[0], wp[1]),
     });
-    write_atomically(path, |tmp| {
+    Staged::write(path, |tmp| {
         // Single-threaded compression keeps the bytes independent of scheduling.
         image
             .write()

@@ -50,39 +50,74 @@ impl Film {
     }
 }
 
-/// Writes through a temporary file in the target's folder and renames it into place,
-/// so a failed or interrupted write never leaves a partial output.
+/// An output written to a temporary file in its target's folder, waiting to be renamed
+/// into place by [`Staged::commit`]. Dropped without commit, the temporary file is
+/// removed, so a failed run never leaves a partial or stray file.
+pub struct Staged {
+    tmp: PathBuf,
+    path: PathBuf,
+    committed: bool,
+}
+
+impl Staged {
+    /// Runs `write` on a temporary path next to `path`.
+    pub fn write(
+        path: &Path,
+        write: impl FnOnce(&Path) -> Result<(), String>,
+    ) -> crate::Result<Staged> {
+        let err = |message: String| crate::HeronError::Io {
+            path: path.to_path_buf(),
+            message,
+        };
+        let name = path
+            .file_name()
+            .ok_or_else(|| err("not a file path".into()))?;
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if !dir.is_dir() {
+            return Err(err(format!(
+                "output folder {} does not exist",
+                dir.display()
+            )));
+        }
+        let staged = Staged {
+            tmp: dir.join(format!(
+                ".{}.{}.tmp",
+                name.to_string_lossy(),
+                std::process::id()
+            )),
+            path: path.to_path_buf(),
+            committed: false,
+        };
+        write(&staged.tmp).map_err(err)?;
+        Ok(staged)
+    }
+
+    /// Renames the temporary file into place.
+    pub fn commit(mut self) -> crate::Result<()> {
+        std::fs::rename(&self.tmp, &self.path).map_err(|e: io::Error| crate::HeronError::Io {
+            path: self.path.clone(),
+            message: format!("cannot rename into place: {e}"),
+        })?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes one file through a temporary file and a rename.
 pub(crate) fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> crate::Result<()> {
-    let err = |message: String| crate::HeronError::Io {
-        path: path.to_path_buf(),
-        message,
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| err("not a file path".into()))?;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(err(format!(
-            "output folder {} does not exist",
-            dir.display()
-        )));
-    }
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e: io::Error| format!("cannot rename into place: {e}"))
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(err)
+    Staged::write(path, write)?.commit()
 }

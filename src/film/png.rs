@@ -1,10 +1,16 @@
 //! PNG preview: linear sRGB clamped to [0, 1] and encoded with the sRGB transfer
 //! function, 8 bits per channel. For looking at, not for measuring: use the EXR.
-use super::{write_atomically, Film};
+use super::{Film, Staged};
 use crate::spectrum::color::srgb_encode;
 use std::path::Path;
 
+/// Writes the PNG file; see [`stage_png`] to write several outputs together.
 pub fn write_png(film: &Film, path: &Path) -> crate::Result<()> {
+    stage_png(film, path)?.commit()
+}
+
+/// Writes the PNG file to a temporary file, to be committed later.
+pub fn stage_png(film: &Film, path: &Path) -> crate::Result<Staged> {
     let mut bytes = Vec::with_capacity(film.xyz.len() * 3);
     for c in film.linear_srgb() {
         for v in c {
@@ -13,7 +19,7 @@ pub fn write_png(film: &Film, path: &Path) -> crate::Result<()> {
     }
     let img = image::RgbImage::from_raw(film.width, film.height, bytes)
         .expect("buffer size matches the film");
-    write_atomically(path, |tmp| {
+    Staged::write(path, |tmp| {
         img.save_with_format(tmp, image::ImageFormat::Png)
             .map_err(|e| format!("cannot write PNG: {e}"))
     })

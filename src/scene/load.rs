@@ -17,7 +17,7 @@
 //! Orders: `Scene::materials` is sorted by material name (a TOML table keeps no order);
 //! `Scene::shapes` follows the file, and a mesh entry becomes one shape per material it
 //! uses, in the order in which the materials' OBJ groups first appear in the OBJ file.
-mod obj;
+pub(crate) mod obj;
 
 use super::file::{
     show, Colour, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec, LambertianFile,

@@ -84,13 +84,27 @@ const MXCSR_FTZ: u32 = 1 << 15;
 #[cfg(target_arch = "x86_64")]
 const MXCSR_DAZ: u32 = 1 << 6;
 
-/// Sets the flush-to-zero and denormals-are-zero bits of the calling thread's MXCSR, as
-/// Embree asks of every thread that traces rays. Call once per worker thread.
+/// A rayon pool of `threads` workers (0: one per core) whose threads set flush-to-zero
+/// and denormals-are-zero when they start, as Embree asks of every thread that traces
+/// rays ("Embree API", "Performance Recommendations: MXCSR control and status
+/// register"), so that denormal numbers do not slow traversal down.
 ///
-/// Embree's performance recommendations ("Embree API", section "Performance
-/// Recommendations: MXCSR control and status register") ask for FTZ and DAZ so that
-/// denormal numbers do not slow traversal down. No-op on targets other than x86_64.
-pub fn set_flush_denormals() {
+/// This is the only way heron changes MXCSR. Rust's documentation of `_mm_setcsr` calls
+/// changing the floating-point environment undefined behaviour, because compiled code
+/// may assume the default one. heron accepts that risk because Embree asks for it, and
+/// keeps it small: the bits are set once, first thing on threads heron creates for
+/// tracing, and the only effect is that subnormal inputs and results become zero.
+pub fn worker_pool(threads: usize) -> Result<rayon::ThreadPool, EmbreeError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .start_handler(|_| set_flush_denormals())
+        .build()
+        .map_err(|e| EmbreeError::Other(format!("cannot start worker threads: {e}")))
+}
+
+/// Sets FTZ and DAZ on the calling thread; see [`worker_pool`]. No-op on targets other
+/// than x86_64.
+fn set_flush_denormals() {
     #[cfg(target_arch = "x86_64")]
     {
         #[allow(deprecated)]
@@ -100,7 +114,8 @@ pub fn set_flush_denormals() {
         let csr = unsafe { _mm_getcsr() };
         // SAFETY: SSE is part of the x86_64 baseline. Only the FTZ and DAZ bits change;
         // rounding mode and exception masks are kept, so no floating-point exception is
-        // unmasked. Denormal handling is a numerical effect, not a memory-safety one.
+        // unmasked. This runs first thing on a fresh worker thread (see `worker_pool`
+        // for why heron accepts the floating-point-environment caveat).
         #[allow(deprecated)]
         unsafe {
             _mm_setcsr(csr | MXCSR_FTZ | MXCSR_DAZ)

@@ -13,14 +13,14 @@ use glam::Vec3;
 /// names when both precede a block of faces, as `tobj` does). One name may occur in
 /// several groups (e.g. when `usemtl` splits an object).
 #[derive(Debug)]
-pub(super) struct ObjGroup {
+pub(crate) struct ObjGroup {
     pub name: String,
     pub positions: Vec<Vec3>,
     pub indices: Vec<[u32; 3]>,
 }
 
 /// Parses OBJ text. The error is one line, without the file name.
-pub(super) fn parse_obj(text: &str) -> Result<Vec<ObjGroup>, String> {
+pub(crate) fn parse_obj(text: &str) -> Result<Vec<ObjGroup>, String> {
     let text = prescan(text)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
