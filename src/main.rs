@@ -160,6 +160,16 @@ struct RenderArgs {
     /// Do not write the PNG preview.
     #[arg(long)]
     no_png: bool,
+    /// Add the CIE XYZ channels X, Y, Z to the EXR.
+    #[arg(long)]
+    xyz: bool,
+    /// Add N spectral channels (equal bins over 360–830 nm, the layout of Fichet et al.
+    /// 2021, readable by colour.read_spectral_image_Fichet2021).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=470))]
+    spectral_bins: Option<u16>,
+    /// How hero wavelengths are drawn: uniform or visible (pdf ∝ 1/cosh²(0.0072(λ − 538))).
+    #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
+    wavelengths: String,
     /// Do not draw the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -236,6 +246,11 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     opts.threads = args.threads.unwrap_or(0);
     opts.lanes = args.lanes;
     opts.packets = !args.no_packets;
+    opts.spectral_bins = args.spectral_bins.map_or(0, usize::from);
+    opts.wavelengths = match args.wavelengths.as_str() {
+        "visible" => heron::spectrum::WavelengthSampler::Visible,
+        _ => heron::spectrum::WavelengthSampler::Uniform,
+    };
     let bar = progress_bar(args.quiet);
     if let Some(bar) = &bar {
         let b = bar.clone();
@@ -250,7 +265,11 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     }
     // Both files are staged first and renamed into place together: an error in either
     // leaves neither behind.
-    let exr = stage_exr(&film, &exr_path)?;
+    let channels = heron::film::exr::ExrChannels {
+        xyz: args.xyz,
+        spectral: args.spectral_bins.is_some(),
+    };
+    let exr = stage_exr(&film, &exr_path, channels)?;
     let png = if args.no_png {
         None
     } else {

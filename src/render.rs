@@ -5,7 +5,7 @@
 //! samples are summed in sample order by the one worker that owns its tile, and tiles are
 //! gathered in tile order, so the image is bit-identical whatever the thread count.
 use crate::accel::embree::{self, RayQuery};
-use crate::film::{xyz_of_sample, Film};
+use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins};
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{whitted, Context, TraceCounters};
 use crate::math::Rng;
@@ -31,6 +31,9 @@ pub struct RenderOptions {
     pub packets: bool,
     /// How hero wavelengths are drawn.
     pub wavelengths: WavelengthSampler,
+    /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
+    /// (0: none).
+    pub spectral_bins: usize,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
 }
@@ -44,6 +47,7 @@ impl RenderOptions {
             lanes: 4,
             packets: true,
             wavelengths: WavelengthSampler::Uniform,
+            spectral_bins: 0,
             progress: None,
         }
     }
@@ -109,6 +113,8 @@ struct TileResult {
     w: u32,
     h: u32,
     xyz: Vec<[f32; 3]>,
+    /// Per pixel, `bins` values (empty without spectral output).
+    spectral: Vec<f32>,
     counters: TraceCounters,
     nonfinite: u64,
 }
@@ -216,10 +222,15 @@ fn render_with(
             .collect()
     });
     let wall = start.elapsed();
+    let bins = (opts.spectral_bins > 0).then_some(SpectralBins {
+        count: opts.spectral_bins,
+    });
+    let npix = (cam.width * cam.height) as usize;
     let mut film = Film {
         width: cam.width,
         height: cam.height,
-        xyz: vec![[0.0; 3]; (cam.width * cam.height) as usize],
+        xyz: vec![[0.0; 3]; npix],
+        spectral: bins.map(|b| (b, vec![0.0; npix * b.count])),
     };
     let mut stats = RenderStats {
         wall,
@@ -229,8 +240,15 @@ fn render_with(
     for t in results {
         for y in 0..t.h {
             for x in 0..t.w {
-                film.xyz[((t.y0 + y) * cam.width + t.x0 + x) as usize] =
-                    t.xyz[(y * t.w + x) as usize];
+                let (dst, src) = (
+                    ((t.y0 + y) * cam.width + t.x0 + x) as usize,
+                    (y * t.w + x) as usize,
+                );
+                film.xyz[dst] = t.xyz[src];
+                if let Some((b, data)) = &mut film.spectral {
+                    data[dst * b.count..(dst + 1) * b.count]
+                        .copy_from_slice(&t.spectral[src * b.count..(src + 1) * b.count]);
+                }
             }
         }
         stats.counters.rays += t.counters.rays;
@@ -250,6 +268,10 @@ fn render_tile<const N: usize>(
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
     let mut xyz = vec![[0.0f64; 3]; (w * h) as usize];
+    let bins = SpectralBins {
+        count: opts.spectral_bins,
+    };
+    let mut spectral = vec![0.0f64; (w * h) as usize * opts.spectral_bins];
     let mut counters = TraceCounters::default();
     let mut nonfinite = 0u64;
     let mut good = vec![0u32; (w * h) as usize];
@@ -304,19 +326,29 @@ fn render_tile<const N: usize>(
                     for j in 0..3 {
                         xyz[i][j] += c[j] as f64;
                     }
+                    if bins.count > 0 {
+                        let b = bins.count;
+                        add_to_bins(&bins, &mut spectral[i * b..(i + 1) * b], &l, &wls[k]);
+                    }
                     good[i] += 1;
                 }
             }
         }
     }
     // Non-finite samples are left out and counted: the mean is over the finite ones.
+    let inv = |n: u32| if n > 0 { 1.0 / n as f64 } else { 0.0 };
     let xyz = xyz
         .iter()
         .zip(&good)
         .map(|(c, &n)| {
-            let k = if n > 0 { 1.0 / n as f64 } else { 0.0 };
+            let k = inv(n);
             [(c[0] * k) as f32, (c[1] * k) as f32, (c[2] * k) as f32]
         })
+        .collect();
+    let spectral = spectral
+        .iter()
+        .enumerate()
+        .map(|(j, &v)| (v * inv(good[j / opts.spectral_bins.max(1)])) as f32)
         .collect();
     TileResult {
         x0,
@@ -324,6 +356,7 @@ fn render_tile<const N: usize>(
         w,
         h,
         xyz,
+        spectral,
         counters,
         nonfinite,
     }

@@ -9,7 +9,7 @@ pub mod png;
 
 use crate::spectrum::cie::cie1931;
 use crate::spectrum::color::xyz_to_linear_srgb;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -36,12 +36,51 @@ pub fn xyz_of_sample<const N: usize>(
     xyz
 }
 
-/// A finished image: mean XYZ per pixel, row-major from the top-left.
+/// Equal-width wavelength bins over 360–830 nm for spectral output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SpectralBins {
+    pub count: usize,
+}
+
+impl SpectralBins {
+    pub fn width(&self) -> f32 {
+        (LAMBDA_MAX - LAMBDA_MIN) / self.count as f32
+    }
+    pub fn centre(&self, k: usize) -> f32 {
+        LAMBDA_MIN + (k as f32 + 0.5) * self.width()
+    }
+    /// The bin of `lambda` nm (the last bin includes 830 nm).
+    #[inline]
+    pub fn index(&self, lambda: f32) -> usize {
+        (((lambda - LAMBDA_MIN) / self.width()) as usize).min(self.count - 1)
+    }
+}
+
+/// Adds one sample's lanes to spectral bins: each lane adds L(λ)/(N p(λ) Δλ_bin), the
+/// estimate of the bin's mean spectral radiance.
+#[inline]
+pub fn add_to_bins<const N: usize>(
+    bins: &SpectralBins,
+    out: &mut [f64],
+    l: &SampledSpectrum<N>,
+    wl: &SampledWavelengths<N>,
+) {
+    let w = 1.0 / (N as f32 * bins.width());
+    for i in 0..N {
+        if wl.pdf[i] > 0.0 && l.0[i] != 0.0 {
+            out[bins.index(wl.lambda[i])] += (l.0[i] * w / wl.pdf[i]) as f64;
+        }
+    }
+}
+
+/// A finished image: mean XYZ per pixel, row-major from the top-left, and optionally
+/// the mean spectral radiance in each of `bins` per pixel (pixel-major).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
     pub xyz: Vec<[f32; 3]>,
+    pub spectral: Option<(SpectralBins, Vec<f32>)>,
 }
 
 impl Film {
