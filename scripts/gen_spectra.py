@@ -59,12 +59,30 @@ def main():
     write(out, "cie1931_2deg.csv", ["wavelength_nm", "x_bar", "y_bar", "z_bar"],
           np.column_stack([cmfs.wavelengths, cmfs.values]))
 
+    # CIE 1964 10° observer: like the 1931 one, colour-science holds it at 1 nm over
+    # 360-830 nm, so it is written as tabulated (no .align(), for the same reason).
+    cmfs10 = colour.MSDS_CMFS["CIE 1964 10 Degree Standard Observer"]
+    if cmfs10.shape != SHAPE:
+        raise SystemExit(f"expected the CIE 1964 observer on {SHAPE}, got {cmfs10.shape}")
+    write(out, "cie1964_10deg.csv", ["wavelength_nm", "x_bar", "y_bar", "z_bar"],
+          np.column_stack([cmfs10.wavelengths, cmfs10.values]))
+
     # CIE D65 relative spectral power: 5 nm over 300-780 nm in colour-science, aligned
     # to 1 nm over 360-830 nm with the distribution's own interpolator (linear) and
     # colour-science's default extrapolator (constant: 781-830 nm repeat the 780 nm value).
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(SHAPE)
     write(out, "cie_d65.csv", ["wavelength_nm", "value"],
           np.column_stack([d65.wavelengths, d65.values]))
+
+    # CIE standard illuminant A relative spectral power: 5 nm over 300-780 nm in
+    # colour-science (the CIE 15:2004 table), aligned exactly like D65: linear
+    # interpolation (the distribution's own interpolator) and constant extrapolation
+    # (781-830 nm repeat the 780 nm value, 241.675). This is colour-science's tabulated A,
+    # not the Planckian formula of colour.colorimetry.sd_CIE_standard_illuminant_A;
+    # spectra/README.md says how far apart they are.
+    a = colour.SDS_ILLUMINANTS["A"].copy().align(SHAPE)
+    write(out, "cie_a.csv", ["wavelength_nm", "value"],
+          np.column_stack([a.wavelengths, a.values]))
 
     # Smits (1999) RGB-to-spectrum basis: 10 samples over 380-720 nm, as tabulated.
     basis = colour.recovery.SDS_SMITS1999

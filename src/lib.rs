@@ -7,6 +7,7 @@ pub mod accel;
 pub mod bench;
 pub mod bsdf;
 pub mod camera;
+pub mod colorimetry;
 pub mod error;
 pub mod film;
 pub mod geometry;

@@ -29,6 +29,8 @@ enum Command {
     /// Measure throughput.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Print the CIE XYZ, xy and linear sRGB of a spectral distribution CSV as JSON.
+    Color(ColorArgs),
 }
 
 #[derive(Subcommand)]
@@ -184,6 +186,29 @@ fn parse_lanes(s: &str) -> std::result::Result<usize, String> {
     }
 }
 
+/// `heron color`; the formulas are in the heron::colorimetry documentation.
+#[derive(clap::Args)]
+struct ColorArgs {
+    /// CSV of rows `wavelength_nm,value` (optional header line, # comments).
+    file: PathBuf,
+    /// D65, A or E: the file is a reflectance, XYZ = Σ R·I·x̄ / Σ I·ȳ (white has Y = 1);
+    /// none: the file is emitted, XYZ = Σ S·x̄ / Σ ȳ (the constant 1 has Y = 1).
+    #[arg(long, default_value = "D65")]
+    illuminant: heron::colorimetry::Illuminant,
+    /// CIE standard observer: 1931 (2°) or 1964 (10°).
+    #[arg(long, default_value = "1931")]
+    observer: heron::colorimetry::StandardObserver,
+}
+
+fn cmd_color(a: ColorArgs) -> Result<()> {
+    let report = heron::colorimetry::color_file(&a.file, a.observer, a.illuminant)?;
+    println!("{}", serde_json::to_string_pretty(&report)?);
+    for note in &report.notes {
+        eprintln!("note: {note}");
+    }
+    Ok(())
+}
+
 fn main() {
     // Usage errors get one line and status 1 like every other error; --help and
     // --version print as usual.
@@ -204,6 +229,7 @@ fn main() {
         Command::Bench(BenchCommand::Mesh { n, output }) => {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
         }
+        Command::Color(args) => cmd_color(args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

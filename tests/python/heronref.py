@@ -102,3 +102,43 @@ def uniform_sampling_sigma(sd) -> np.ndarray:
     f = L[:, None] * w * n  # value of the estimator for each bin, p = 1/n
     mean = f.mean(axis=0)
     return np.sqrt(((f - mean) ** 2).mean(axis=0))
+
+
+# --- `heron color` (tests/python/test_color_cmd.py) ------------------------------------
+
+OBSERVER_CMFS = {
+    "1931": "CIE 1931 2 Degree Standard Observer",
+    "1964": "CIE 1964 10 Degree Standard Observer",
+}
+
+
+@functools.cache
+def cmfs_for(observer: str):
+    """colour-science's CMFS for heron's --observer value ("1931" or "1964")."""
+    c = colour.MSDS_CMFS[OBSERVER_CMFS[observer]]
+    assert c.shape == SHAPE, c.shape
+    return c
+
+
+@functools.cache
+def illuminant_sd(name: str):
+    """The illuminant heron color uses for --illuminant name, on heron's grid: D65 and A
+    from SDS_ILLUMINANTS aligned as spectra/README.md says (linear, constant beyond
+    780 nm), E the constant 1 (scale cancels)."""
+    if name == "E":
+        return colour.sd_ones(SHAPE)
+    return aligned(colour.SDS_ILLUMINANTS[name])
+
+
+def color_xyz(sd, observer: str, illuminant: str) -> np.ndarray:
+    """XYZ `heron color` should print, by colour-science's own integration:
+
+    with an illuminant I, colour.sd_to_XYZ(R, cmfs, I, method="Integration") / 100
+    = Σ R I x̄ / Σ I ȳ (a perfect reflector has Y = 1); with "none", the same with an
+    all-ones illuminant, = Σ S x̄ / Σ ȳ (heron's film convention).
+    sd must already be on heron's grid (1 nm, 360–830 nm).
+    """
+    assert sd.shape == SHAPE, sd.shape
+    ill = colour.sd_ones(SHAPE) if illuminant == "none" else illuminant_sd(illuminant)
+    return colour.sd_to_XYZ(sd, cmfs_for(observer), illuminant=ill,
+                            method="Integration") / 100.0

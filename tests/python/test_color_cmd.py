@@ -1,0 +1,210 @@
+"""`heron color` against colour-science 0.4.7.
+
+`heron color FILE.csv --illuminant D65|A|E|none --observer 1931|1964` prints XYZ, xy and
+linear sRGB as JSON (src/colorimetry.rs). colour-science's answer for the same
+distribution (heronref.color_xyz):
+
+    XYZ = colour.sd_to_XYZ(sd, cmfs, illuminant, method="Integration") / 100
+
+with an all-ones illuminant for `none`, xy = colour.XYZ_to_xy(XYZ), and linear sRGB =
+colour.XYZ_to_RGB(XYZ, "sRGB", chromatic_adaptation_transform=None) (heronref).
+
+So that the comparison is about colorimetry and not about interpolation, every test
+distribution is first put on heron's grid (1 nm, 360–830 nm) BY COLOUR-SCIENCE and
+written to a CSV at those 471 wavelengths, where heron's linear interpolation
+(DenseSpectrum::from_samples) returns the values unchanged:
+
+- D65 and A (as emitters, `--illuminant none`): SDS_ILLUMINANTS aligned with their own
+  interpolator, LinearInterpolator, constant beyond 780 nm (heronref.aligned);
+- the 24 ColorChecker N Ohta patches (reflectances under D65, A and E): aligned with
+  their own interpolator, colour-science's default SpragueInterpolator, held constant
+  (Extrapolator, method "Constant") outside their 380–780 nm;
+- monochromatic lines at 450, 532.5, 589.3 and 632.8 nm (emitters): triangles of
+  half-width 1 nm built directly on the 1 nm grid (weights 1 − |λ − λ0| / 1 nm), so
+  each is the CMFs linearly interpolated at λ0.
+
+Each case runs with both observers. Agreement: |heron − ref| ≤ 1e-4·|ref| + 1e-6·max|ref|
+per component of XYZ, xy and linear sRGB (the floor, 1e-6 of the vector's largest
+component, is for components near 0, e.g. z̄ at 632.8 nm or an sRGB channel that is
+almost 0). heron's tables are float32 and its sums float64, so the deviations are
+~1e-7 relative; the tests also check that the tolerance is tight enough to catch the
+wrong observer, the wrong illuminant and a line shifted by 0.1 nm.
+"""
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+import heronref
+from heronref import SHAPE, colour
+from heronrun import REPO, require_heron_bin
+
+OBSERVERS = ["1931", "1964"]
+RTOL = 1e-4
+FLOOR = 1e-6  # times the largest |component| of the reference vector
+LINES_NM = [450.0, 532.5, 589.3, 632.8]
+PATCHES = list(colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"])
+
+
+# --- test distributions, on heron's grid ------------------------------------------------
+
+def patch_sd(name):
+    return heronref.aligned(colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"][name])
+
+
+def line_sd(lambda0):
+    wl = SHAPE.wavelengths
+    return colour.SpectralDistribution(np.clip(1 - np.abs(wl - lambda0), 0, None), wl,
+                                       name=f"line {lambda0} nm")
+
+
+def write_csv(path: pathlib.Path, sd) -> pathlib.Path:
+    assert sd.shape == SHAPE, f"{sd.name}: {sd.shape} is not heron's grid"
+    np.testing.assert_array_equal(sd.wavelengths, np.arange(360, 831))
+    with path.open("w", newline="\n") as f:
+        f.write(f"# {sd.name}, aligned by colour-science {colour.__version__}\n")
+        f.write("wavelength_nm,value\n")
+        for w, v in zip(sd.wavelengths, sd.values):
+            f.write(f"{int(w)},{float(v)!r}\n")
+    return path
+
+
+# --- running heron -----------------------------------------------------------------------
+
+def heron_color(csv: pathlib.Path, illuminant: str, observer: str) -> dict:
+    cmd = [str(require_heron_bin()), "color", str(csv), "--illuminant", illuminant,
+           "--observer", observer]
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, timeout=60)
+    if proc.returncode != 0:
+        pytest.fail(f"`{' '.join(cmd)}` exited with {proc.returncode}:\n{proc.stderr}",
+                    pytrace=False)
+    out = json.loads(proc.stdout)
+    assert list(out) == ["file", "observer", "illuminant", "XYZ", "xy", "linear_srgb"], out
+    assert out["file"] == str(csv)
+    assert out["observer"] == observer
+    assert out["illuminant"] == illuminant
+    # The CSVs cover 360–830 nm, so heron has nothing to say on stderr.
+    assert proc.stderr == "", proc.stderr
+    return out
+
+
+def reference(sd, illuminant, observer) -> dict:
+    xyz = heronref.color_xyz(sd, observer, illuminant)
+    return {"XYZ": xyz, "xy": colour.XYZ_to_xy(xyz),
+            "linear_srgb": heronref.xyz_to_linear_srgb(xyz)}
+
+
+def deviation(got, want):
+    """max over components of |got − want| / (RTOL·|want| + FLOOR·max|want|): ≤ 1 passes."""
+    got, want = np.asarray(got, float), np.asarray(want, float)
+    tol = RTOL * np.abs(want) + FLOOR * np.abs(want).max()
+    return float((np.abs(got - want) / tol).max())
+
+
+def assert_agrees(out, ref, what):
+    for key in ("XYZ", "xy", "linear_srgb"):
+        d = deviation(out[key], ref[key])
+        assert d <= 1, (f"{what}: {key} heron {out[key]} vs colour-science "
+                        f"{list(ref[key])} ({d:.3g} × tolerance)")
+
+
+@pytest.fixture(scope="module")
+def csvs(tmp_path_factory):
+    """Name -> (CSV path, the SD written to it)."""
+    d = tmp_path_factory.mktemp("color_csv")
+    sds = {"D65": heronref.aligned(colour.SDS_ILLUMINANTS["D65"]),
+           "A": heronref.aligned(colour.SDS_ILLUMINANTS["A"])}
+    sds.update({f"patch {i:02d}": patch_sd(p) for i, p in enumerate(PATCHES, start=1)})
+    sds.update({f"line {l}": line_sd(l) for l in LINES_NM})
+    return {name: (write_csv(d / f"{name.replace(' ', '_')}.csv", sd), sd)
+            for name, sd in sds.items()}
+
+
+# --- the checks --------------------------------------------------------------------------
+
+def test_colour_science_is_the_pinned_one():
+    assert colour.__version__ == "0.4.7"
+    assert len(PATCHES) == 24
+
+
+def test_test_distributions_are_what_the_docstring_says(csvs):
+    sd = colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"][PATCHES[0]]
+    assert sd.shape == colour.SpectralShape(380, 780, 5)
+    assert sd.interpolator is colour.SpragueInterpolator
+    assert colour.SDS_ILLUMINANTS["A"].interpolator is colour.LinearInterpolator
+    # Each line has unit area and its centroid at λ0.
+    for l in LINES_NM:
+        v = csvs[f"line {l}"][1].values
+        assert v.sum() == pytest.approx(1, abs=1e-12)
+        assert (v * SHAPE.wavelengths).sum() == pytest.approx(l, abs=1e-9)
+    # heronref's illuminants on the grid are what colour.sd_to_XYZ uses for the native
+    # data: passing the aligned or the native SD gives identical XYZ.
+    p = csvs["patch 01"][1]
+    for name in ("D65", "A"):
+        cmfs = heronref.cmfs_for("1931")
+        with warnings.catch_warnings():  # "Aligning ... illuminant shape": expected here
+            warnings.simplefilter("ignore", colour.utilities.ColourRuntimeWarning)
+            native = colour.sd_to_XYZ(p, cmfs, colour.SDS_ILLUMINANTS[name],
+                                      method="Integration")
+        np.testing.assert_array_equal(native / 100, heronref.color_xyz(p, "1931", name))
+
+
+@pytest.mark.parametrize("observer", OBSERVERS)
+@pytest.mark.parametrize("name", ["D65", "A"])
+def test_illuminants_as_emitters(csvs, name, observer):
+    path, sd = csvs[name]
+    assert_agrees(heron_color(path, "none", observer), reference(sd, "none", observer),
+                  f"{name} as emitter, {observer}")
+
+
+@pytest.mark.parametrize("observer", OBSERVERS)
+@pytest.mark.parametrize("illuminant", ["D65", "A", "E"])
+def test_colorchecker_patches_as_reflectances(csvs, illuminant, observer):
+    for i, patch in enumerate(PATCHES, start=1):
+        path, sd = csvs[f"patch {i:02d}"]
+        assert_agrees(heron_color(path, illuminant, observer),
+                      reference(sd, illuminant, observer),
+                      f"ColorChecker N Ohta {i:02d} {patch!r} under {illuminant}, {observer}")
+
+
+@pytest.mark.parametrize("observer", OBSERVERS)
+@pytest.mark.parametrize("lambda0", LINES_NM)
+def test_monochromatic_lines(csvs, lambda0, observer):
+    path, sd = csvs[f"line {lambda0}"]
+    assert_agrees(heron_color(path, "none", observer), reference(sd, "none", observer),
+                  f"line at {lambda0} nm, {observer}")
+
+
+def test_white_reflector_is_the_illuminant_white(tmp_path):
+    # A perfect reflector has Y = 1 and the illuminant's own chromaticity.
+    path = write_csv(tmp_path / "white.csv", colour.sd_ones(SHAPE))
+    for observer in OBSERVERS:
+        for name in ("D65", "A"):
+            out = heron_color(path, name, observer)
+            ill = heronref.illuminant_sd(name)
+            ref = reference(ill, "none", observer)
+            ref = {k: v / ref["XYZ"][1] if k != "xy" else v for k, v in ref.items()}
+            assert out["XYZ"][1] == pytest.approx(1, abs=1e-6)
+            assert_agrees(out, ref, f"white under {name}, {observer}")
+
+
+def test_tolerance_catches_wrong_observer_illuminant_and_wavelength(csvs):
+    """The comparison has power: plausible mistakes fail it by a wide margin."""
+    path, sd = csvs["patch 13"]  # blue
+    out = heron_color(path, "D65", "1964")
+    assert deviation(out["XYZ"], reference(sd, "D65", "1931")["XYZ"]) > 10
+    assert deviation(out["XYZ"], reference(sd, "A", "1964")["XYZ"]) > 10
+    path, sd = csvs["D65"]
+    out = heron_color(path, "none", "1931")
+    assert deviation(out["XYZ"], reference(sd, "none", "1964")["XYZ"]) > 10
+    # A line 0.1 nm off is outside the tolerance.
+    for l in LINES_NM:
+        path, _ = csvs[f"line {l}"]
+        out = heron_color(path, "none", "1931")
+        shifted = reference(line_sd(l + 0.1), "none", "1931")
+        assert deviation(out["XYZ"], shifted["XYZ"]) > 2, l
