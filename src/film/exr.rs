@@ -47,7 +47,10 @@ pub fn stage_exr(film: &Film, path: &Path, which: ExrChannels) -> crate::Result<
     if let (true, Some((bins, data))) = (which.spectral, &film.spectral) {
         for k in 0..bins.count {
             let name = spectral_channel_name(bins.centre(k));
-            list.push(AnyChannel::new(name.as_str(), plane(&|i| data[i * bins.count + k])));
+            list.push(AnyChannel::new(
+                name.as_str(),
+                plane(&|i| data[i * bins.count + k]),
+            ));
         }
         layer_attrs.other.insert(
             Text::from("spectralLayoutVersion"),

@@ -581,11 +581,9 @@ fn build_ior(at: &str, spec: &IorSpec, base_dir: &Path) -> std::result::Result<I
         },
         IorSpec::Table(file) => {
             let p = base_dir.join(file);
-            let text = std::fs::read_to_string(&p)
-                .map_err(|e| format!("{at}: cannot read {}: {e}", p.display()))?;
-            let samples = crate::spectrum::dense::parse_samples_csv(&text)
-                .map_err(|e| format!("{at}: {}: {e}", p.display()))?;
-            Ior::Table(DenseSpectrum::from_samples(&samples))
+            let csv =
+                crate::colorimetry::SpectrumCsv::read(&p).map_err(|e| format!("{at}: {e}"))?;
+            Ior::Table(csv.to_dense())
         }
     };
     ior.validate().map_err(|e| format!("{at}: {e}"))?;
