@@ -140,12 +140,12 @@ fn bad_command_line_values_are_usage_errors() {
     let ok = write(d.path(), "ok.csv", "360,1\n830,1\n");
     assert_fails(
         &["color", &ok, "--illuminant", "F2"],
-        2,
+        1,
         &["--illuminant", "expected D65, A, E or none", "F2"],
     );
     assert_fails(
         &["color", &ok, "--observer", "2015"],
-        2,
+        1,
         &["--observer", "expected 1931", "1964", "2015"],
     );
 }
