@@ -5,6 +5,7 @@
 pub mod cie;
 pub mod color;
 pub mod dense;
+pub mod rgb2spec;
 pub mod sampled;
 pub mod uplift;
 
