@@ -1,90 +1,45 @@
-//! RGB to spectrum uplift after Smits (1999), "An RGB-to-Spectrum Conversion for
-//! Reflectances", Journal of Graphics Tools 4(4). The seven basis spectra (white, cyan,
-//! magenta, yellow, red, green, blue) are in spectra/smits1999.csv at Smits' ten sample
-//! wavelengths over 380–720 nm; heron interpolates them linearly and holds the end
-//! values beyond.
+//! RGB to spectrum uplift after Jakob & Hanika (2019), "A Low-Dimensional Function Space
+//! for Efficient Spectral Upsampling", Computer Graphics Forum 38(2).
 //!
-//! Smits' construction is a non-negative combination of basis spectra bounded by 1 whose
-//! weights sum to max(r, g, b), so a reflectance in [0, 1]³ stays within [0, 1] at every
-//! wavelength, and white is (to the table's four digits) the constant 1.
-use super::cie::{d65_unit, parse_table};
+//! A linear sRGB reflectance becomes s(λ) = S(c0 t² + c1 t + c2) with the paper's
+//! sigmoid S(x) = ½ + x / (2 √(1 + x²)) and t = (λ − 595 nm) / 235 nm; the coefficients
+//! come from heron's own fitted table (spectra/rgb2spec_srgb.bin, interpolated
+//! trilinearly as in the paper) and a Gauss–Newton polish against heron's film, so that
+//! the reflectance lit by D65 (Y = 1) comes back through the film (CIE 1931 2°, IEC
+//! 61966-2-1 matrix) as the same linear sRGB. See [`super::rgb2spec`].
+//!
+//! Because S maps into (0, 1), a reflectance in [0, 1]³ is within [0, 1] at every
+//! wavelength with no clamping. Greys are exactly constant (c = (0, 0, x); black is 0
+//! and white is 1 at every wavelength). The round trip is exact to the fit (ΔE*ab 1e-8)
+//! except for the grey part of a colour: heron's D65 and the four-digit sRGB matrix
+//! disagree on white by up to 1.7e-4 (spectra/README.md), and the constant spectrum is
+//! taken as the grey, so a colour comes back within min(r, g, b) · 1.7e-4.
+//!
+//! (heron used Smits (1999) before; spectra/smits1999.csv is no longer used.)
+use super::cie::d65_unit;
+use super::rgb2spec::srgb_table;
 use super::DenseSpectrum;
-use std::sync::OnceLock;
-
-const SMITS_CSV: &str = include_str!("../../spectra/smits1999.csv");
-
-struct SmitsBasis {
-    white: DenseSpectrum,
-    cyan: DenseSpectrum,
-    magenta: DenseSpectrum,
-    yellow: DenseSpectrum,
-    red: DenseSpectrum,
-    green: DenseSpectrum,
-    blue: DenseSpectrum,
-}
-
-fn basis() -> &'static SmitsBasis {
-    static B: OnceLock<SmitsBasis> = OnceLock::new();
-    B.get_or_init(|| {
-        let rows = parse_table(SMITS_CSV, 7);
-        let col = |c: usize| {
-            let s: Vec<(f32, f32)> = rows.iter().map(|(w, v)| (*w, v[c])).collect();
-            DenseSpectrum::from_samples(&s)
-        };
-        SmitsBasis {
-            white: col(0),
-            cyan: col(1),
-            magenta: col(2),
-            yellow: col(3),
-            red: col(4),
-            green: col(5),
-            blue: col(6),
-        }
-    })
-}
-
-/// Smits' weights: (spectrum, weight) pairs for the white and the two chromatic bases.
-fn smits_terms(rgb: [f32; 3]) -> [(&'static DenseSpectrum, f32); 3] {
-    let b = basis();
-    let [r, g, bl] = rgb;
-    if r <= g && r <= bl {
-        if g <= bl {
-            [(&b.white, r), (&b.cyan, g - r), (&b.blue, bl - g)]
-        } else {
-            [(&b.white, r), (&b.cyan, bl - r), (&b.green, g - bl)]
-        }
-    } else if g <= r && g <= bl {
-        if r <= bl {
-            [(&b.white, g), (&b.magenta, r - g), (&b.blue, bl - r)]
-        } else {
-            [(&b.white, g), (&b.magenta, bl - g), (&b.red, r - bl)]
-        }
-    } else if r <= g {
-        [(&b.white, bl), (&b.yellow, r - bl), (&b.green, g - r)]
-    } else {
-        [(&b.white, bl), (&b.yellow, g - bl), (&b.red, r - g)]
-    }
-}
-
-fn smits(rgb: [f32; 3]) -> DenseSpectrum {
-    let t = smits_terms(rgb);
-    DenseSpectrum::from_fn(|l| t.iter().map(|(s, w)| w * s.eval(l)).sum::<f32>().max(0.0))
-}
 
 /// Reflectance spectrum for a linear sRGB reflectance (components expected in [0, 1];
-/// the scene loader checks that). Smits' red and cyan bases exceed 1 slightly (up to
-/// 1.015), so the result is clamped to [0, 1]: a surface must not reflect more than it
-/// receives at any wavelength.
+/// the scene loader checks that, and out-of-range or NaN components are clamped to
+/// [0, 1] here). Within [0, 1] at every wavelength by construction.
 pub fn rgb_to_reflectance(rgb: [f32; 3]) -> DenseSpectrum {
-    let s = smits(rgb);
-    DenseSpectrum::from_fn(|l| s.eval(l).min(1.0))
+    srgb_table().coefficients(rgb).to_dense()
 }
 
-/// Emission spectrum for a linear sRGB emitter colour (components ≥ 0): the Smits
-/// uplift times D65 scaled to luminance Y = 1, so (1, 1, 1) is the sRGB white point
-/// with Y = 1, and the colour scales linearly with the components.
+/// Emission spectrum for a linear sRGB emitter colour (components ≥ 0; negative or NaN
+/// ones count as 0), as pbrt-v4's RGBIlluminantSpectrum: with m = max(r, g, b), the
+/// reflectance-style spectrum of rgb / m, times m, times D65 scaled to luminance Y = 1.
+/// So (1, 1, 1) is exactly D65 at Y = 1 (sRGB white to 2e-4), emitters brighter than 1
+/// work, and the colour scales linearly with the components.
 pub fn rgb_to_illuminant(rgb: [f32; 3]) -> DenseSpectrum {
-    smits(rgb).mul(d65_unit())
+    let rgb = rgb.map(|v| if v.is_nan() { 0.0 } else { v.max(0.0) });
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m <= 0.0 {
+        return DenseSpectrum::constant(0.0);
+    }
+    let s = srgb_table().coefficients(rgb.map(|v| v / m)).to_dense();
+    s.mul(d65_unit()).scaled(m)
 }
 
 /// Named spectra a scene may use: "E" (equal energy, 1 at every wavelength) and "D65"
@@ -105,6 +60,10 @@ mod tests {
     use crate::spectrum::cie::spectrum_to_xyz;
     use crate::spectrum::color::xyz_to_linear_srgb;
 
+    fn film_rgb(s: &DenseSpectrum) -> [f32; 3] {
+        xyz_to_linear_srgb(spectrum_to_xyz(s))
+    }
+
     #[test]
     fn reflectances_stay_within_zero_and_one() {
         for r in 0..=10 {
@@ -116,36 +75,61 @@ mod tests {
                 }
             }
         }
+        // Out-of-range input is clamped, not extrapolated.
+        let s = rgb_to_reflectance([1.5, -0.2, f32::NAN]);
+        assert!(s.min_value() >= 0.0 && s.max_value() <= 1.0);
+        assert_eq!(s, rgb_to_reflectance([1.0, 0.0, 0.0]));
     }
 
     #[test]
-    fn white_light_is_srgb_white_with_unit_luminance() {
-        let c = xyz_to_linear_srgb(spectrum_to_xyz(&rgb_to_illuminant([1.0, 1.0, 1.0])));
-        for v in c {
-            assert!((v - 1.0).abs() < 2e-3, "{c:?}");
+    fn greys_are_constant_black_is_zero_white_is_one() {
+        assert_eq!(rgb_to_reflectance([0.0; 3]), DenseSpectrum::constant(0.0));
+        assert_eq!(rgb_to_reflectance([1.0; 3]), DenseSpectrum::constant(1.0));
+        for g in [0.001f32, 0.18, 0.5, 0.8, 0.999] {
+            let s = rgb_to_reflectance([g; 3]);
+            assert!(s.is_constant() && (s.values()[0] - g).abs() < 1e-6, "{g}");
+        }
+        assert_eq!(rgb_to_illuminant([0.0; 3]), DenseSpectrum::constant(0.0));
+    }
+
+    #[test]
+    fn white_light_is_d65_at_unit_luminance_and_srgb_white() {
+        let w = rgb_to_illuminant([1.0, 1.0, 1.0]);
+        assert_eq!(&w, d65_unit());
+        for v in film_rgb(&w) {
+            assert!((v - 1.0).abs() < 2e-4, "{v}");
         }
         let d = spectrum_to_xyz(&named("D65").unwrap());
         assert!((d[1] - 1.0).abs() < 1e-6);
     }
 
     #[test]
-    fn illuminant_colours_come_back_close_to_their_rgb() {
-        // Smits' basis was fitted for a different RGB space, so it is no exact inverse
-        // of sRGB: the green primary comes back with 0.09 blue. Greys and the course's
-        // background within 0.03, primaries within 0.1.
+    fn illuminant_colours_come_back_as_their_rgb() {
+        // Jakob–Hanika plus the polish is an inverse of the film to the grey part's
+        // 1.7e-4 (Smits' basis missed the green primary by 0.09).
         for rgb in [
             [1.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],
             [0.0, 0.0, 1.0],
             [0.5, 0.5, 0.5],
             [0.1, 0.3, 0.6],
+            [4.0, 2.0, 0.5],
+            [0.0, 30.0, 10.0],
         ] {
-            let c = xyz_to_linear_srgb(spectrum_to_xyz(&rgb_to_illuminant(rgb)));
-            let grey_or_soft = rgb.iter().all(|&v| v > 0.05);
-            let tol = if grey_or_soft { 0.03 } else { 0.1 };
+            let m = rgb.iter().fold(0.0f32, |a, &b| a.max(b));
+            let c = film_rgb(&rgb_to_illuminant(rgb));
             for i in 0..3 {
-                assert!((c[i] - rgb[i]).abs() < tol, "{rgb:?} -> {c:?}");
+                assert!((c[i] - rgb[i]).abs() <= 2e-4 * m, "{rgb:?} -> {c:?}");
             }
+        }
+    }
+
+    #[test]
+    fn illuminants_scale_linearly() {
+        let a = rgb_to_illuminant([0.2, 0.4, 0.1]);
+        let b = rgb_to_illuminant([2.0, 4.0, 1.0]);
+        for (x, y) in a.values().iter().zip(b.values()) {
+            assert!((10.0 * x - y).abs() <= 1e-5 * y.max(1e-3), "{x} {y}");
         }
     }
 }
