@@ -364,3 +364,82 @@ fn course_variants_differ_only_where_the_sphere_is() {
         assert!((c - d).abs() < 0.05 * c, "{v}: floor {d} vs default {c}");
     }
 }
+
+/// The sun: a Lambertian floor under it has ρ/π E cos θ (the disk sampled over its
+/// extent), and a camera looking at it sees a disk of radiance E/Ω and the solar
+/// angular radius.
+#[test]
+fn sun_lights_like_its_irradiance_and_shows_its_disk() {
+    use heron::light::SunLight;
+    let theta = 50f32.to_radians();
+    let alpha = 0.2666f32.to_radians();
+    let sun = SunLight::new(
+        Vec3::new(theta.sin(), -theta.cos(), 0.0),
+        DenseSpectrum::constant(2.0),
+        alpha,
+    );
+    let cam = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 16, 16).unwrap();
+    let mut s = scene(
+        cam.clone(),
+        vec![quad(
+            Vec3::new(-50.0, 0.0, -50.0),
+            Vec3::new(0.0, 0.0, 100.0),
+            Vec3::new(100.0, 0.0, 0.0),
+            0,
+        )],
+        vec![lambertian(0.5)],
+        vec![Light::Sun(sun.clone())],
+        0.0,
+    );
+    // Same spp as the unit reference, so the two share their wavelengths sample for
+    // sample.
+    let film = run(&s, 2);
+    let unit = unit_reference(&cam);
+    let expected = 0.5 / PI * 2.0 * theta.cos();
+    // Each shadow ray sees cos θ of one point of the disk: a spread of about
+    // α sin θ = 0.4% per sample, so 1% per pixel and 5e-4 over the image.
+    let mut mean = 0.0;
+    for (a, u) in film.xyz.iter().zip(&unit.xyz) {
+        let r = a[1] / u[1];
+        mean += r / film.xyz.len() as f32;
+        assert!(
+            (r - expected).abs() < 1e-2 * expected,
+            "ratio {r}, expected {expected}"
+        );
+    }
+    assert!(
+        (mean - expected).abs() < 5e-4 * expected,
+        "mean {mean}, expected {expected}"
+    );
+    // Look straight at the sun through a narrow field: 0.01 rad across 64 pixels.
+    let to_sun = -sun.direction;
+    let d = 64.0 / 0.01 / 64.0; // image height 1 at distance d spans 1/d rad
+    let cam = Camera::new(Vec3::ZERO, to_sun, Vec3::Z, d, 64, 64).unwrap();
+    let mut sky = scene(
+        cam.clone(),
+        vec![],
+        vec![],
+        vec![Light::Sun(sun.clone())],
+        0.0,
+    );
+    sky.settings.spp = 4;
+    let film = run(&sky, 2);
+    let unit = unit_reference(&cam);
+    let l = sun.radiance.eval(550.0);
+    let mut inside = 0;
+    for (a, u) in film.xyz.iter().zip(&unit.xyz) {
+        let r = a[1] / u[1];
+        if r > 0.0 {
+            inside += 1;
+            // Pixels on the rim are partly covered.
+            assert!(r <= l * 1.0001, "{r} > disk radiance {l}");
+        }
+    }
+    // Disk area in pixels: π (α / (0.01 rad / 64 px))².
+    let px = std::f32::consts::PI * (alpha / (0.01 / 64.0)).powi(2);
+    assert!(
+        (inside as f32 - px).abs() < 0.1 * px,
+        "{inside} pixels see the disk, expected about {px}"
+    );
+    assert!((l * sun.solid_angle() - 2.0).abs() < 1e-4);
+}

@@ -59,7 +59,7 @@ pub fn radiance<const N: usize>(
             }
         };
         let Some(hit) = hit else {
-            l += beta * wl.eval(&scene.background);
+            l += beta * escaped_radiance(ctx, ray.dir, wl);
             break;
         };
         let shape = &scene.shapes[hit.geom_id as usize];
@@ -70,7 +70,7 @@ pub fn radiance<const N: usize>(
             Material::Lambertian(m) => {
                 let f = wl.eval(&m.rho_d) * FRAC_1_PI;
                 let mut e = SampledSpectrum::<N>::zero();
-                direct_lighting(ctx, &it, wl, counters, |_, li_cos| e += li_cos);
+                direct_lighting(ctx, &it, wl, rng, counters, |_, li_cos| e += li_cos);
                 l += beta * f * e;
                 None
             }
@@ -83,7 +83,7 @@ pub fn radiance<const N: usize>(
                 let fd = wl.eval(&g.rho_d) * FRAC_1_PI;
                 let (rho_s, s, n) = (it.specular, it.shininess, it.normal);
                 let mut lr = SampledSpectrum::<N>::zero();
-                direct_lighting(ctx, &it, wl, counters, |wi, li_cos| {
+                direct_lighting(ctx, &it, wl, rng, counters, |wi, li_cos| {
                     let fs = phong_specular(rho_s, s, wi, wo, n);
                     lr += (fd + SampledSpectrum::splat(fs)) * li_cos;
                 });
@@ -108,16 +108,37 @@ pub fn radiance<const N: usize>(
     l
 }
 
+/// Radiance along a ray that leaves the scene: the background, plus the sun's disk
+/// where the ray points into it.
+#[inline]
+pub(crate) fn escaped_radiance<const N: usize>(
+    ctx: &Context,
+    dir: Vec3,
+    wl: &SampledWavelengths<N>,
+) -> SampledSpectrum<N> {
+    let mut l = wl.eval(&ctx.scene.background);
+    for light in &ctx.scene.lights {
+        if let Light::Sun(s) = light {
+            if s.sees_disk(dir) {
+                l += wl.eval(&s.radiance);
+            }
+        }
+    }
+    l
+}
+
 /// Calls `visit(ωi, L_i cos θi)` for every light that reaches the shading point
 /// unoccluded, ωi being the unit direction toward the light.
 ///
 /// Shadow rays follow the seed: t_min = ε, t_max = ‖p − x‖ − ε for a point light at p,
-/// and no cutoff for a directional light.
+/// and no cutoff for a directional light or the sun. The sun is sampled at one point of
+/// its disk, uniformly in solid angle, so L_i/pdf = L Ω = E.
 #[inline]
 fn direct_lighting<const N: usize>(
     ctx: &Context,
     it: &Interaction,
     wl: &SampledWavelengths<N>,
+    rng: &mut Rng,
     counters: &mut TraceCounters,
     mut visit: impl FnMut(Vec3, SampledSpectrum<N>),
 ) {
@@ -133,6 +154,11 @@ fn direct_lighting<const N: usize>(
                 (to / d, d - eps, wl.eval(&p.intensity) * (1.0 / d2))
             }
             Light::Directional(dl) => (-dl.direction, f32::INFINITY, wl.eval(&dl.radiance)),
+            Light::Sun(sun) => (
+                sun.sample_direction(rng),
+                f32::INFINITY,
+                wl.eval(&sun.irradiance),
+            ),
         };
         let cos = wi.dot(n);
         if cos <= 0.0 || t_max <= eps {

@@ -41,6 +41,7 @@ impl Features {
         let lit = scene.lights.iter().any(|l| match l {
             Light::Point(p) => p.intensity.max_value() > 0.0,
             Light::Directional(d) => d.radiance.max_value() > 0.0,
+            Light::Sun(s) => s.irradiance.max_value() > 0.0,
         });
         let non_specular =
             used().any(|m| matches!(m, Material::Lambertian(_) | Material::Glossy(_)));

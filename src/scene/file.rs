@@ -237,10 +237,11 @@ pub struct MeshFile {
 pub enum LightFile {
     Point(PointLightFile),
     Directional(DirectionalLightFile),
+    Sun(SunLightFile),
 }
 
 /// The `type` values of [`LightFile`], in declaration order.
-pub const LIGHT_TYPES: &[&str] = &["point", "directional"];
+pub const LIGHT_TYPES: &[&str] = &["point", "directional", "sun"];
 
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -248,6 +249,19 @@ pub struct PointLightFile {
     pub position: Point3,
     /// Radiant intensity, a colour.
     pub intensity: Emission,
+}
+
+/// The sun: a directional light with the solar disk's extent.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunLightFile {
+    /// The direction the light travels; normalised on load.
+    pub direction: Direction3,
+    /// Irradiance at normal incidence, a colour; the disk's radiance is E/Ω.
+    pub irradiance: Emission,
+    /// Angular radius in degrees, in (0, 90); default 0.2666.
+    #[serde(default)]
+    pub angular_radius: Option<PositiveNumber>,
 }
 
 #[derive(Debug, serde::Deserialize)]

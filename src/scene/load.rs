@@ -22,14 +22,14 @@ pub(crate) mod obj;
 use super::file::{
     show, Colour, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec, LambertianFile,
     LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, SceneFile,
-    ShapeFile, SphereFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
+    ShapeFile, SphereFile, SunLightFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
 };
 use super::{RenderSettings, Scene};
 use crate::bsdf::{Dielectric, Glossy, Lambertian, Material, Mirror};
 use crate::camera::Camera;
 use crate::error::{HeronError, Result};
 use crate::geometry::{Mesh, Shape, ShapeKind};
-use crate::light::{DirectionalLight, Light, PointLight};
+use crate::light::{DirectionalLight, Light, PointLight, SunLight};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
@@ -230,6 +230,7 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("shapes", "mesh") => check::<MeshFile>(t),
         ("lights", "point") => check::<PointLightFile>(t),
         ("lights", "directional") => check::<DirectionalLightFile>(t),
+        ("lights", "sun") => check::<SunLightFile>(t),
         _ => None,
     }?;
     let mut full = item_path.to_vec();
@@ -503,17 +504,33 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     let lights = file
         .lights
         .iter()
-        .map(|l| match l {
-            LightFile::Point(p) => Light::Point(PointLight {
+        .enumerate()
+        .map(|(i, l)| match l {
+            LightFile::Point(p) => Ok(Light::Point(PointLight {
                 position: p.position.0,
                 intensity: p.intensity.spectrum(),
-            }),
-            LightFile::Directional(d) => Light::Directional(DirectionalLight {
+            })),
+            LightFile::Directional(d) => Ok(Light::Directional(DirectionalLight {
                 direction: d.direction.unit(),
                 radiance: d.radiance.spectrum(),
-            }),
+            })),
+            LightFile::Sun(s) => {
+                let deg = s
+                    .angular_radius
+                    .map_or(crate::light::sun::SUN_ANGULAR_RADIUS_DEG, |a| a.0);
+                if deg >= 90.0 {
+                    return Err(err(format!(
+                        "lights[{i}].angular_radius: expected degrees in (0, 90), got {deg}"
+                    )));
+                }
+                Ok(Light::Sun(SunLight::new(
+                    s.direction.unit(),
+                    s.irradiance.spectrum(),
+                    deg.to_radians(),
+                )))
+            }
         })
-        .collect();
+        .collect::<Result<Vec<_>>>()?;
 
     let background = file
         .background

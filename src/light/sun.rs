@@ -1,0 +1,113 @@
+//! The sun: a distant disk of angular radius α (default 0.2666°, the mean solar radius
+//! seen from Earth; 0.262–0.271° over the year), given by its irradiance E at normal
+//! incidence. Its disk has radiance L = E/Ω with Ω = 2π(1 − cos α), seen by rays that
+//! leave the scene towards it. Shadow rays sample the disk uniformly in solid angle, so
+//! shadows have the sun's penumbra. The seed's Aristotelian rainbow needs the disk's
+//! extent; so does a prism's spectrum, which is the disk's image spread by dispersion.
+use crate::math::Rng;
+use crate::spectrum::DenseSpectrum;
+use glam::Vec3;
+
+/// The mean angular radius of the sun, degrees.
+pub const SUN_ANGULAR_RADIUS_DEG: f32 = 0.2666;
+
+#[derive(Clone, Debug)]
+pub struct SunLight {
+    /// Unit vector in the direction the light travels.
+    pub direction: Vec3,
+    /// Irradiance at normal incidence, E(λ).
+    pub irradiance: DenseSpectrum,
+    /// Angular radius α in radians.
+    pub angular_radius: f32,
+    /// 1 − cos α, computed as 2 sin²(α/2) to keep its digits for small α.
+    one_minus_cos: f32,
+    sin2: f32,
+    /// Disk radiance L = E/Ω.
+    pub radiance: DenseSpectrum,
+}
+
+impl SunLight {
+    /// `angular_radius` in radians, in (0, π/2).
+    pub fn new(direction: Vec3, irradiance: DenseSpectrum, angular_radius: f32) -> Self {
+        let a = angular_radius as f64;
+        let omc = 2.0 * (0.5 * a).sin().powi(2);
+        let solid_angle = 2.0 * std::f64::consts::PI * omc;
+        SunLight {
+            direction: direction.normalize(),
+            radiance: irradiance.scaled((1.0 / solid_angle) as f32),
+            irradiance,
+            angular_radius,
+            one_minus_cos: omc as f32,
+            sin2: a.sin().powi(2) as f32,
+        }
+    }
+
+    /// Solid angle of the disk, Ω = 2π(1 − cos α).
+    pub fn solid_angle(&self) -> f32 {
+        2.0 * std::f32::consts::PI * self.one_minus_cos
+    }
+
+    /// True when the unit direction `d` points into the disk. Uses |d × s|² ≤ sin²α,
+    /// which keeps its precision for the sun's small radius, where 1 − d·s would not.
+    #[inline]
+    pub fn sees_disk(&self, d: Vec3) -> bool {
+        let s = -self.direction;
+        d.dot(s) > 0.0 && d.cross(s).length_squared() <= self.sin2
+    }
+
+    /// A direction towards the disk, uniform in solid angle (pdf 1/Ω).
+    #[inline]
+    pub fn sample_direction(&self, rng: &mut Rng) -> Vec3 {
+        let s = -self.direction;
+        let u = rng.uniform() * self.one_minus_cos;
+        let cos = 1.0 - u;
+        let sin = (u * (2.0 - u)).max(0.0).sqrt();
+        let phi = 2.0 * std::f32::consts::PI * rng.uniform();
+        let (t, b) = s.any_orthonormal_pair();
+        (sin * phi.cos()) * t + (sin * phi.sin()) * b + cos * s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_cover_the_disk_uniformly_and_nothing_else() {
+        let sun = SunLight::new(
+            Vec3::new(0.3, -1.0, 0.2),
+            DenseSpectrum::constant(1.0),
+            SUN_ANGULAR_RADIUS_DEG.to_radians(),
+        );
+        let s = -sun.direction;
+        let mut rng = Rng::new(2, 4);
+        // Uniform in solid angle: the fraction inside half the angular radius is
+        // (1 − cos(α/2)) / (1 − cos α) ≈ 1/4.
+        let half = 0.5 * sun.angular_radius;
+        let n = 100_000;
+        let mut inner = 0;
+        for _ in 0..n {
+            let d = sun.sample_direction(&mut rng);
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            assert!(sun.sees_disk(d), "a sample outside the disk");
+            if d.cross(s).length() < half.sin() {
+                inner += 1;
+            }
+        }
+        let expected = (1.0 - (half as f64).cos()) / (1.0 - (sun.angular_radius as f64).cos());
+        let f = inner as f64 / n as f64;
+        assert!((f - expected).abs() < 0.005, "{f} vs {expected}");
+        // Just outside the rim is not the disk.
+        let (t, _) = s.any_orthonormal_pair();
+        let out = (s + 1.01 * sun.angular_radius.tan() * t).normalize();
+        let inside = (s + 0.99 * sun.angular_radius.tan() * t).normalize();
+        assert!(!sun.sees_disk(out) && sun.sees_disk(inside));
+    }
+
+    #[test]
+    fn disk_radiance_times_solid_angle_is_the_irradiance() {
+        let sun = SunLight::new(Vec3::NEG_Y, DenseSpectrum::constant(2.0), 0.01);
+        let e = sun.radiance.eval(550.0) * sun.solid_angle();
+        assert!((e - 2.0).abs() < 1e-5, "{e}");
+    }
+}
