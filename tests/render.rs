@@ -379,7 +379,7 @@ fn sun_lights_like_its_irradiance_and_shows_its_disk() {
         alpha,
     );
     let cam = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 16, 16).unwrap();
-    let mut s = scene(
+    let s = scene(
         cam.clone(),
         vec![quad(
             Vec3::new(-50.0, 0.0, -50.0),
