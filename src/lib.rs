@@ -8,6 +8,7 @@ pub mod bench;
 pub mod bsdf;
 pub mod camera;
 pub mod colorimetry;
+pub mod converge;
 pub mod error;
 pub mod film;
 pub mod geometry;

@@ -26,6 +26,9 @@ enum Command {
     Render(RenderArgs),
     /// Follow one ray at one wavelength through a scene and print its events as JSON.
     Trace(TraceArgs),
+    /// Run time against error: render a reference, then each (lanes, spp) setting, and
+    /// print CSV of wall time, time per sample and relative RMSE.
+    Converge(ConvergeArgs),
     /// Measure throughput.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -80,6 +83,40 @@ struct TraversalArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
     threads: Option<u16>,
+}
+
+#[derive(clap::Args)]
+struct ConvergeArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Samples per pixel of the reference (rendered with 8 lanes and seed + 1).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..))]
+    reference_spp: u32,
+    /// Comma-separated spp values to measure.
+    #[arg(long, default_value = "1,4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..))]
+    spp: Vec<u32>,
+    /// Comma-separated lane counts (each 1, 4 or 8).
+    #[arg(long, default_value = "1,4,8", value_delimiter = ',', value_parser = parse_lanes)]
+    lanes: Vec<usize>,
+    /// Override the scene's resolution, W,H (smaller is faster to converge).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
+    /// Random seed of the measured runs.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// How hero wavelengths are drawn in the measured runs: uniform or visible.
+    #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
+    wavelengths: String,
+}
+
+fn wavelength_sampler(name: &str) -> heron::spectrum::WavelengthSampler {
+    match name {
+        "visible" => heron::spectrum::WavelengthSampler::Visible,
+        _ => heron::spectrum::WavelengthSampler::Uniform,
+    }
 }
 
 #[derive(clap::Args)]
@@ -225,6 +262,7 @@ fn main() {
     let result = match cli.command {
         Command::Render(args) => cmd_render(args),
         Command::Trace(args) => cmd_trace(args),
+        Command::Converge(args) => cmd_converge(args),
         Command::Bench(BenchCommand::Traversal(args)) => cmd_bench_traversal(args),
         Command::Bench(BenchCommand::Mesh { n, output }) => {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
@@ -273,10 +311,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     opts.lanes = args.lanes;
     opts.packets = !args.no_packets;
     opts.spectral_bins = args.spectral_bins.map_or(0, usize::from);
-    opts.wavelengths = match args.wavelengths.as_str() {
-        "visible" => heron::spectrum::WavelengthSampler::Visible,
-        _ => heron::spectrum::WavelengthSampler::Uniform,
-    };
+    opts.wavelengths = wavelength_sampler(&args.wavelengths);
     let bar = progress_bar(args.quiet);
     if let Some(bar) = &bar {
         let b = bar.clone();
@@ -319,6 +354,38 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         stats.mrays_per_s(),
         stats.nonfinite
     );
+    Ok(())
+}
+
+fn cmd_converge(a: ConvergeArgs) -> Result<()> {
+    let mut scene = load_scene(&a.scene)?;
+    if let Some((w, h)) = a.size {
+        let c = &scene.camera;
+        scene.camera = heron::camera::Camera::new(c.eye, c.look_at, c.up, c.d, w, h)
+            .map_err(|e| anyhow::anyhow!("--size: {e}"))?;
+    }
+    let mut base = RenderOptions::from_scene(&scene);
+    base.seed = a.seed;
+    base.threads = a.threads.map_or(0, usize::from);
+    base.wavelengths = wavelength_sampler(&a.wavelengths);
+    let (ref_wall, rows) =
+        heron::converge::converge(&scene, &base, a.reference_spp, &a.lanes, &a.spp)?;
+    println!(
+        "# {}: {}x{}, {} wavelengths, reference {} spp x 8 lanes ({:.1} s)",
+        a.scene.display(),
+        scene.camera.width,
+        scene.camera.height,
+        a.wavelengths,
+        a.reference_spp,
+        ref_wall
+    );
+    println!("lanes,spp,wall_s,ns_per_sample,rel_rmse,rmse_sqrt_time");
+    for r in rows {
+        println!(
+            "{},{},{:.4},{:.1},{:.5},{:.5}",
+            r.lanes, r.spp, r.wall_s, r.ns_per_sample, r.rel_rmse, r.rmse_sqrt_time
+        );
+    }
     Ok(())
 }
 

@@ -230,3 +230,35 @@ fn the_course_scenes_render() {
         assert!(out.is_file());
     }
 }
+
+#[test]
+fn converge_reports_error_falling_with_samples() {
+    let out = heron(&[
+        "converge",
+        &repo("scenes/default.toml"),
+        "--size",
+        "32,32",
+        "--reference-spp",
+        "256",
+        "--spp",
+        "1,64",
+        "--lanes",
+        "4",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{text}");
+    let (e1, e64) = (rows[0][4], rows[1][4]);
+    // Unbiased Monte Carlo: error ∝ 1/sqrt(spp), so 64× the samples should cut it by
+    // about 8 (less, as the reference's own noise adds in); require at least 3.
+    assert!(e1 > 3.0 * e64, "1 spp error {e1}, 64 spp error {e64}");
+}
