@@ -46,7 +46,7 @@
 //! ```
 //!
 //! A colour is a number (grey), `[r, g, b]` in linear sRGB, or
-//! `{ spectrum = "E" | "D65", scale = 1.0 }` (scale optional, default 1).
+//! `{ spectrum = "E" | "D65" | "A", scale = 1.0 }` (scale optional, default 1).
 use crate::spectrum::uplift::{named, rgb_to_illuminant, rgb_to_reflectance, NAMED_SPECTRA};
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;

@@ -42,14 +42,15 @@ pub fn rgb_to_illuminant(rgb: [f32; 3]) -> DenseSpectrum {
     s.mul(d65_unit()).scaled(m)
 }
 
-/// Named spectra a scene may use: "E" (equal energy, 1 at every wavelength) and "D65"
-/// (scaled to Y = 1).
-pub const NAMED_SPECTRA: &[&str] = &["E", "D65"];
+/// Named spectra a scene may use: "E" (equal energy, 1 at every wavelength), and the
+/// CIE illuminants "D65" and "A", each scaled to Y = 1.
+pub const NAMED_SPECTRA: &[&str] = &["E", "D65", "A"];
 
 pub fn named(name: &str) -> Option<DenseSpectrum> {
     match name {
         "E" => Some(DenseSpectrum::constant(1.0)),
         "D65" => Some(d65_unit().clone()),
+        "A" => Some(super::cie::illuminant_a_unit().clone()),
         _ => None,
     }
 }
@@ -131,5 +132,24 @@ mod tests {
         for (x, y) in a.values().iter().zip(b.values()) {
             assert!((10.0 * x - y).abs() <= 1e-5 * y.max(1e-3), "{x} {y}");
         }
+    }
+
+    #[test]
+    fn named_illuminants_have_unit_luminance_and_their_white_points() {
+        use crate::spectrum::cie::spectrum_to_xyz;
+        for (name, xy) in [
+            ("D65", (0.3127, 0.3290)),
+            ("A", (0.4476, 0.4074)),
+            ("E", (0.3333, 0.3333)),
+        ] {
+            let xyz = spectrum_to_xyz(&named(name).unwrap());
+            let sum = xyz[0] + xyz[1] + xyz[2];
+            assert!((xyz[1] - 1.0).abs() < 1e-5, "{name}: Y = {}", xyz[1]);
+            assert!(
+                (xyz[0] / sum - xy.0).abs() < 2e-4 && (xyz[1] / sum - xy.1).abs() < 2e-4,
+                "{name}"
+            );
+        }
+        assert!(named("F2").is_none());
     }
 }
