@@ -846,3 +846,329 @@ fn features_follow_the_materials_in_use() {
     // Defined but unused materials do not count.
     assert_eq!(scene(mats, "", light), none);
 }
+
+// ------------------------------------------------------------------------------------
+// Refractive-index models: `ior` as a number, a catalogue name, Sellmeier or Cauchy
+// coefficients, or a table file
+
+use heron::spectrum::ior::{catalogue, Ior};
+
+/// The d line (helium, 587.56 nm), where catalogues quote n_d.
+const LAMBDA_D: f32 = 587.56;
+
+/// A scene with one dielectric `glass` (index `ior`, written as TOML) on a sphere and one
+/// glossy `coat` over the same index.
+fn ior_scene(ior: &str) -> String {
+    format!(
+        "{CAMERA}\n[materials.glass]\ntype = \"dielectric\"\nior = {ior}\n\n\
+         [materials.coat]\ntype = \"glossy\"\nrho_d = 0.2\nrho_s = 0.1\nshininess = 20\nior = {ior}\n\n\
+         [[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\n"
+    )
+}
+
+/// The index of `glass` (and checks that `coat`'s base has the same one).
+fn load_ior(dir: &Dir, ior: &str) -> Ior {
+    let p = dir.write("scene.toml", &ior_scene(ior));
+    let s = load_scene(&p).unwrap_or_else(|e| panic!("ior = {ior}: {e}"));
+    let by_name = |n: &str| {
+        let i = s.material_names.iter().position(|m| m == n).unwrap();
+        s.materials[i].clone()
+    };
+    let Material::Dielectric(d) = by_name("glass") else {
+        panic!("glass is not a dielectric")
+    };
+    let Material::Glossy(g) = by_name("coat") else {
+        panic!("coat is not glossy")
+    };
+    assert_eq!(g.base.expect("coat has a base").ior, d.ior, "ior = {ior}");
+    d.ior
+}
+
+/// n² = 1 + Σ B λ²/(λ² − C), λ in µm, in f64.
+fn sellmeier_n(b: &[f64], c: &[f64], lambda_nm: f64) -> f64 {
+    let l2 = (lambda_nm * 1e-3).powi(2);
+    (1.0 + b.iter().zip(c).map(|(b, c)| b * l2 / (l2 - c)).sum::<f64>()).sqrt()
+}
+
+#[test]
+fn ior_catalogue_names_load_as_the_catalogue() {
+    let dir = Dir::new();
+    let names: Vec<&String> = catalogue().keys().collect();
+    for want in ["N-BK7", "fused-silica", "N-SF11", "F2", "diamond", "water"] {
+        assert!(
+            catalogue().contains_key(want),
+            "{want} missing from {names:?}"
+        );
+    }
+    for (name, m) in catalogue() {
+        let ior = load_ior(&dir, &format!("\"{name}\""));
+        assert_eq!(
+            Some(&ior),
+            heron::spectrum::ior::named(name).as_ref(),
+            "{name}"
+        );
+        assert!(ior.is_dispersive(), "{name}");
+        let tol = if name == "water" { 5e-4 } else { 1e-4 };
+        assert!(
+            (ior.eval(LAMBDA_D) - m.n_d).abs() < tol,
+            "{name}: n_d {}",
+            ior.eval(LAMBDA_D)
+        );
+    }
+    // A plain number is still a constant index.
+    assert_eq!(load_ior(&dir, "1.5"), Ior::Constant(1.5));
+    assert_eq!(load_ior(&dir, "2"), Ior::Constant(2.0));
+}
+
+#[test]
+fn ior_sellmeier_coefficients_load() {
+    let dir = Dir::new();
+    // N-BK7's coefficients written out: the same model as the catalogue entry, n_d 1.5168.
+    let ior = load_ior(
+        &dir,
+        "{ sellmeier = { b = [1.03961212, 0.231792344, 1.01046945], c = [0.00600069867, 0.0200179144, 103.560653] } }",
+    );
+    assert_eq!(Some(&ior), heron::spectrum::ior::named("N-BK7").as_ref());
+    assert!(
+        (ior.eval(LAMBDA_D) - 1.5168).abs() < 1e-4,
+        "{}",
+        ior.eval(LAMBDA_D)
+    );
+    // 1, 2 and 4 terms, against the formula in f64.
+    let cases: &[(&[f64], &[f64])] = &[
+        (&[1.2], &[0.01]),
+        (&[0.6961663, 0.4079426], &[0.004679148, 0.01351206]),
+        (
+            &[0.5684, 0.1726, 0.02086, 0.1131],
+            &[0.005102, 0.01821, 0.02621, 10.698],
+        ),
+    ];
+    for (b, c) in cases {
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let ior = load_ior(
+            &dir,
+            &format!(
+                "{{ sellmeier = {{ b = [{}], c = [{}] }} }}",
+                list(b),
+                list(c)
+            ),
+        );
+        for lambda in [360.0, LAMBDA_D as f64, 830.0] {
+            let want = sellmeier_n(b, c, lambda);
+            let got = ior.eval(lambda as f32) as f64;
+            assert!(
+                (got - want).abs() < 2e-6,
+                "b {b:?} c {c:?} at {lambda} nm: {got} vs {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn ior_cauchy_coefficients_load() {
+    let dir = Dir::new();
+    // A + B/λ² (λ in µm): a BK7-like fit, n_d = 1.5046 + 0.0042/0.58756² = 1.516766.
+    let ior = load_ior(&dir, "{ cauchy = [1.5046, 0.0042] }");
+    assert_eq!(
+        ior,
+        Ior::Cauchy {
+            a: 1.5046,
+            b: 0.0042,
+            c: 0.0
+        }
+    );
+    assert!(
+        (ior.eval(LAMBDA_D) - 1.516766).abs() < 2e-6,
+        "{}",
+        ior.eval(LAMBDA_D)
+    );
+    // A + B/λ² + C/λ⁴.
+    let ior = load_ior(&dir, "{ cauchy = [1.7, 0.01, 0.0005] }");
+    let l2 = (LAMBDA_D as f64 * 1e-3).powi(2);
+    let want = 1.7 + 0.01 / l2 + 0.0005 / (l2 * l2);
+    assert!((ior.eval(LAMBDA_D) as f64 - want).abs() < 2e-6);
+    assert!(ior.eval(400.0) > ior.eval(700.0), "normal dispersion");
+    // B = C = 0: not dispersive.
+    assert!(!load_ior(&dir, "{ cauchy = [1.5, 0] }").is_dispersive());
+}
+
+#[test]
+fn ior_table_loads_relative_to_the_scene_and_interpolates() {
+    let dir = Dir::new();
+    dir.write(
+        "data/ior.csv",
+        "# a made-up glass\nwavelength_nm,n\n\n360, 1.53\n600,1.515\n830,1.51\n",
+    );
+    let ior = load_ior(&dir, "{ table = \"data/ior.csv\" }");
+    assert!(matches!(ior, Ior::Table(_)), "{ior:?}");
+    assert!(ior.is_dispersive());
+    for (lambda, want) in [
+        (360.0, 1.53),
+        (480.0, 1.5225),       // halfway between 360 and 600
+        (LAMBDA_D, 1.5157775), // 1.53 − 0.015 · 227.56/240
+        (600.0, 1.515),
+        (715.0, 1.5125),
+        (830.0, 1.51),
+    ] {
+        assert!(
+            (ior.eval(lambda) - want).abs() < 2e-6,
+            "n({lambda}) = {}, expected {want}",
+            ior.eval(lambda)
+        );
+    }
+    // A table covering only part of the range holds its end values.
+    dir.write("short.csv", "500,1.6\n600,1.58\n");
+    let ior = load_ior(&dir, "{ table = \"short.csv\" }");
+    assert!((ior.eval(400.0) - 1.6).abs() < 1e-6 && (ior.eval(800.0) - 1.58).abs() < 1e-6);
+    // A constant table is not dispersive.
+    dir.write("flat.csv", "360,1.4\n830,1.4\n");
+    assert!(!load_ior(&dir, "{ table = \"flat.csv\" }").is_dispersive());
+}
+
+/// The error for `ior` (as TOML) in the dielectric and in the glossy material; both must
+/// name their key path, and contain every string of `wants`.
+fn ior_errors(dir: &Dir, ior: &str, wants: &[&str]) -> String {
+    let (_, msg) = dir.err(&ior_scene(ior));
+    // Materials are checked in name order: coat before glass.
+    assert!(
+        msg.contains("materials.coat.ior"),
+        "ior = {ior}: no key path in {msg:?}"
+    );
+    for w in wants {
+        assert!(msg.contains(w), "ior = {ior}\nwant {w:?}\n got {msg:?}");
+    }
+    let p = dir.write(
+        "scene.toml",
+        &format!("{CAMERA}\n[materials.\"my glass\"]\ntype = \"dielectric\"\nior = {ior}\n"),
+    );
+    let Err(HeronError::Scene { message, .. }) = load_scene(&p) else {
+        panic!("ior = {ior}: expected a scene error")
+    };
+    assert!(message.contains("materials.\"my glass\".ior"), "{message}");
+    for w in wants {
+        assert!(
+            message.contains(w),
+            "ior = {ior}\nwant {w:?}\n got {message:?}"
+        );
+    }
+    msg
+}
+
+#[test]
+fn ior_errors_name_the_key_path() {
+    let dir = Dir::new();
+    // Unknown catalogue name: the message lists the names.
+    let msg = ior_errors(&dir, "\"BK7\"", &["unknown refractive-index model \"BK7\""]);
+    for name in catalogue().keys() {
+        assert!(msg.contains(name.as_str()), "{name} not listed in {msg:?}");
+    }
+    // Sellmeier shapes.
+    let shape = "expected sellmeier = { b = [B1, ..], c = [C1, ..] } with 1 to 4";
+    ior_errors(
+        &dir,
+        "{ sellmeier = { b = [1.0, 0.2], c = [0.01] } }",
+        &[shape],
+    );
+    ior_errors(
+        &dir,
+        "{ sellmeier = { b = [1, 1, 1, 1, 1], c = [0.01, 0.01, 0.01, 0.01, 0.01] } }",
+        &[shape],
+    );
+    ior_errors(&dir, "{ sellmeier = { b = [], c = [] } }", &[shape]);
+    ior_errors(&dir, "{ sellmeier = { b = [1.0] } }", &[shape]);
+    ior_errors(
+        &dir,
+        "{ sellmeier = { b = [1.0], c = [0.01], d = [1] } }",
+        &[shape],
+    );
+    ior_errors(
+        &dir,
+        "{ sellmeier = { b = [\"1\"], c = [0.01] } }",
+        &[shape],
+    );
+    ior_errors(&dir, "{ sellmeier = { b = [nan], c = [0.01] } }", &[shape]);
+    // A pole inside 360–830 nm: C = 0.2 µm² puts it at √0.2 µm = 447 nm.
+    let range = "expected a refractive index ≥ 1 over 360–830 nm";
+    ior_errors(&dir, "{ sellmeier = { b = [1], c = [0.2] } }", &[range]);
+    // Negative B: n² < 1 (n < 1 or NaN).
+    ior_errors(&dir, "{ sellmeier = { b = [-0.5], c = [0.01] } }", &[range]);
+    // Cauchy below 1 at the red end: 0.99 + 0.005/λ² < 1 beyond √0.5 µm = 707.1 nm.
+    ior_errors(
+        &dir,
+        "{ cauchy = [0.99, 0.005] }",
+        &[range, "n(708 nm) = 0.99"],
+    );
+    ior_errors(
+        &dir,
+        "{ cauchy = [1.5] }",
+        &["expected cauchy = [A, B] or [A, B, C] (λ in µm), got [1.5]"],
+    );
+    ior_errors(
+        &dir,
+        "{ cauchy = [1.5, 0.01, 0, 0] }",
+        &["expected cauchy = [A, B] or [A, B, C]"],
+    );
+    // Not one of the forms.
+    ior_errors(
+        &dir,
+        "{ sellmeier = { b = [1], c = [0.01] }, cauchy = [1.5, 0] }",
+        &["expected a positive number, a catalogue name"],
+    );
+    ior_errors(
+        &dir,
+        "{ table = 3 }",
+        &["expected a positive number, a catalogue name"],
+    );
+    ior_errors(
+        &dir,
+        "[1.5]",
+        &["expected a positive number, a catalogue name"],
+    );
+    ior_errors(&dir, "0.5", &[range]);
+}
+
+#[test]
+fn ior_table_errors_name_the_file_and_the_line() {
+    let dir = Dir::new();
+    // A missing file: its path is named.
+    let _ = std::fs::remove_file(dir.path("missing.csv"));
+    let msg = ior_errors(&dir, "{ table = \"missing.csv\" }", &["missing.csv"]);
+    assert!(
+        msg.contains(&dir.path("missing.csv").display().to_string()),
+        "{msg}"
+    );
+    // Malformed rows: the file and the line number.
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "wavelength_nm,n\n400,1.5\n500,x\n",
+            &["bad.csv", "line 3", "expected a number, got \"x\""],
+        ),
+        (
+            "400,1.5\n500;1.49\n",
+            &["bad.csv", "line 2", "expected two comma-separated numbers"],
+        ),
+        (
+            "400,1.5\n500,1.49,7\n",
+            &["bad.csv", "line 2", "found 3 fields"],
+        ),
+        (
+            "# comment\n\n400,1.5\n400,1.49\n",
+            &["bad.csv", "line 4", "strictly increasing"],
+        ),
+        ("400,1.5\n", &["bad.csv", "expected at least 2 rows"]),
+        // Well-formed, but n < 1 somewhere: the range check.
+        (
+            "360,1.5\n600,0.99\n830,1.5\n",
+            &["expected a refractive index ≥ 1 over 360–830 nm"],
+        ),
+    ];
+    for (csv, wants) in cases {
+        dir.write("bad.csv", csv);
+        ior_errors(&dir, "{ table = \"bad.csv\" }", wants);
+    }
+}

@@ -30,5 +30,6 @@ def heron_bin() -> pathlib.Path:
 
 @pytest.fixture(scope="session")
 def render(tmp_path_factory) -> Renderer:
-    """render(scene_file_name, spp=, seed=, threads=) -> Render (cached per session)."""
+    """render(scene_file_name, spp=, seed=, threads=, extra=(flags...)) -> Render (cached
+    per session)."""
     return Renderer(tmp_path_factory)

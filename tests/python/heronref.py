@@ -10,7 +10,12 @@ applied to that XYZ with no chromatic adaptation (XYZ is D65-relative).
 That convention is exactly colour-science's `sd_to_XYZ(..., method="Integration")` with
 an equal-energy illuminant, divided by 100 (k = 100 / Σ S ȳ Δλ with S = 1), so the
 references below use colour-science's own integration, colour matching functions,
-illuminant data, Smits (1999) uplift and sRGB colourspace.
+illuminant data and sRGB colourspace.
+
+RGB uplift (src/spectrum/uplift.rs) is Jakob & Hanika (2019). The references need it only
+for greys, where it is exact: a grey reflectance g is the constant g, and a grey emitter
+g·(1, 1, 1) is g × D65 scaled to film Y = 1 (`d65_unit`), so RGB white renders as
+XYZ_to_sRGB(D65 at Y = 1) = (1.0000057, 1.0000753, 0.9998329), not (1, 1, 1).
 """
 from __future__ import annotations
 
@@ -37,10 +42,7 @@ def cmfs():
 def aligned(sd):
     """sd on heron's grid, with sd's own interpolator and extrapolator (as heron does).
 
-    For Smits' basis that is linear interpolation between the ten samples, holding the
-    end values outside 380–720 nm: the same as src/spectrum/uplift.rs. (colour-science
-    warns that the Smits samples are "not uniform": 417.7778 − 380 is not exactly
-    (720 − 380)/9. The warning is harmless here and silenced.)
+    Colour-science's runtime warnings about the source grid are silenced.
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", colour.utilities.ColourRuntimeWarning)
@@ -70,13 +72,14 @@ def d65_unit():
     return d65 / film_xyz(d65)[1]
 
 
-def smits_reflectance(rgb):
-    return aligned(colour.recovery.RGB_to_sd_Smits1999(np.asarray(rgb, dtype=float)))
+def grey_emitter(g: float):
+    """heron's uplift of the RGB emitter (g, g, g): exactly g × D65 at film Y = 1.
 
-
-def rgb_emitter(rgb):
-    """heron's RGB emitter uplift: Smits (1999) reflectance of rgb × D65 at Y = 1."""
-    return smits_reflectance(rgb) * d65_unit()
+    Jakob & Hanika's model gives the constant spectrum for a grey, and
+    rgb_to_illuminant multiplies by D65(Y = 1) (src/spectrum/uplift.rs). Only greys have
+    a closed form; a coloured RGB would need heron's coefficient table.
+    """
+    return d65_unit() * float(g)
 
 
 def expected_srgb(sd) -> np.ndarray:

@@ -2,10 +2,11 @@
 
 The render tests run:
 
-    heron render SCENE.toml -o OUT.exr [--spp N] [--seed S] [--threads N]
+    heron render SCENE.toml -o OUT.exr [--spp N] [--seed S] [--threads N] [EXTRA...]
 
-from HERON_BIN (default <repo>/target/release/heron). A missing binary makes each render
-test FAIL with a message saying how to build or point to it; it is never skipped.
+(EXTRA: further flags such as `--xyz --spectral-bins 94`) from HERON_BIN (default
+<repo>/target/release/heron). A missing binary makes each render test FAIL with a
+message saying how to build or point to it; it is never skipped.
 """
 from __future__ import annotations
 
@@ -61,7 +62,7 @@ class Renderer:
         self._cache: dict = {}
 
     def __call__(self, scene: str, *, spp: int | None = None, seed: int | None = None,
-                 threads: int | None = None) -> Render:
+                 threads: int | None = None, extra: tuple[str, ...] = ()) -> Render:
         scene_path = SCENES / scene
         assert scene_path.is_file(), f"test scene {scene_path} is missing"
         args = []
@@ -71,6 +72,7 @@ class Renderer:
             args += ["--seed", str(seed)]
         if threads is not None:
             args += ["--threads", str(threads)]
+        args += [str(x) for x in extra]
         key = (scene, tuple(args))
         if key not in self._cache:
             self._cache[key] = self._run(scene_path, tuple(args))

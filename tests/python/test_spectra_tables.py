@@ -240,7 +240,8 @@ def test_smits_values_are_colour_science_basis():
         sd = basis[name]
         np.testing.assert_array_equal(data[:, 0], sd.wavelengths, err_msg=f"Smits {name} wavelengths")
         assert_same(data[:, i], sd.values, f"Smits {name}")
-    # Smits' white is not exactly 1 (the README and the render tests rely on this).
+    # Smits' white is not exactly 1 (the table is kept, unused: heron uplifts RGB with
+    # Jakob & Hanika 2019 now, whose white is exactly 1).
     assert data[:, 1].min() == 0.9992
 
 
