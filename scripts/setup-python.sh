@@ -81,7 +81,7 @@ if ! "$VENV/bin/python" -m pip check; then
     die "pip check failed: tests/python/requirements.txt is missing a dependency or pins incompatible versions"
 fi
 
-if ! "$VENV/bin/python" -c 'import colour, numpy, scipy, OpenEXR, PIL, pytest, miepython' ; then
+if ! "$VENV/bin/python" -c 'import colour, numpy, scipy, OpenEXR, OpenImageIO, PIL, pytest, miepython' ; then
     die "the installed packages do not import (see the traceback above)"
 fi
 
