@@ -3,7 +3,10 @@
 //!
 //! f(ωi, ωo) = ρd/π + ρs (s+2)/(2π) (ωo·ωr)^s,  ωr = 2(ωi·n)n − ωi,
 //!
-//! which loses energy but never creates it when ρd + ρs ≤ 1.
+//! which, as a BRDF on its own, loses energy but never creates it when ρd + ρs ≤ 1.
+//! The course's glossy-over-refractive combination (`base`) adds the dielectric's
+//! continuation at full weight on top (integrator::whitted), so with ρd > 0 that
+//! combination can reflect more than it receives; the course's scenes use ρd = 0.
 use super::Dielectric;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
