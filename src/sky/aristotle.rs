@@ -189,6 +189,12 @@ impl AristotleSky {
 pub fn band_wavelength(t: f64) -> f64 {
     let water = crate::spectrum::ior::named("water").expect("water");
     let angle = |l: f64| super::descartes::rainbow_angle(water.eval(l as f32) as f64, 1);
+    if t <= 0.0 {
+        return BAND_VIOLET_NM;
+    }
+    if t >= 1.0 {
+        return BAND_RED_NM;
+    }
     let (a0, a1) = (angle(BAND_VIOLET_NM), angle(BAND_RED_NM));
     let target = a0 + t * (a1 - a0);
     let (mut lo, mut hi) = (BAND_VIOLET_NM, BAND_RED_NM);

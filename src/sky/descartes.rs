@@ -38,10 +38,15 @@ use glam::Vec3;
 use std::f64::consts::PI;
 
 /// Total deviation D_k(b) in radians of a ray with impact parameter `b` ∈ [0, 1] after
-/// `k` internal reflections in a sphere of relative index `n`.
+/// `k` ≥ 1 internal reflections in a sphere of relative index `n`; for k = 0 the
+/// externally reflected ray, D = π − 2i (not the directly transmitted one).
 #[inline]
 pub fn deviation(b: f64, n: f64, k: u32) -> f64 {
     let i = b.clamp(0.0, 1.0).asin();
+    if k == 0 {
+        // External reflection.
+        return PI - 2.0 * i;
+    }
     let r = (b.clamp(0.0, 1.0) / n).asin();
     2.0 * (i - r) + k as f64 * (PI - 2.0 * r)
 }
