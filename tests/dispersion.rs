@@ -23,6 +23,7 @@ fn glass_scene(shapes: Vec<Shape>, ior: Ior) -> Scene {
         material_names: vec!["glass".into()],
         lights: vec![],
         background: DenseSpectrum::constant(0.0),
+        sky: None,
         settings: RenderSettings {
             spp: 1,
             max_depth: 32,

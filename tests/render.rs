@@ -32,6 +32,7 @@ fn scene(
         materials,
         lights,
         background: DenseSpectrum::constant(bg),
+        sky: None,
         settings: RenderSettings {
             spp: 4,
             max_depth: 64,

@@ -669,6 +669,7 @@ fn water_drop_scene() -> Scene {
         material_names: vec!["water".into()],
         lights: vec![],
         background: DenseSpectrum::constant(0.0),
+        sky: None,
         settings: RenderSettings {
             spp: 1,
             max_depth: 32,

@@ -108,15 +108,32 @@ pub fn radiance<const N: usize>(
     l
 }
 
-/// Radiance along a ray that leaves the scene: the background, plus the sun's disk
-/// where the ray points into it.
+/// Radiance along a ray that leaves the scene: the background (or a sky model that
+/// contains it), the physical rainbow sky on top of it, and the sun's disk where the ray
+/// points into it.
 #[inline]
 pub(crate) fn escaped_radiance<const N: usize>(
     ctx: &Context,
     dir: Vec3,
     wl: &SampledWavelengths<N>,
 ) -> SampledSpectrum<N> {
-    let mut l = wl.eval(&ctx.scene.background);
+    let mut l = match &ctx.scene.sky {
+        None => wl.eval(&ctx.scene.background),
+        Some(sky) => {
+            // θ once per ray; the table per lane.
+            let theta = crate::sky::antisolar_angle(dir, sky.sun_dir).to_degrees();
+            let mut s = SampledSpectrum::<N>::zero();
+            for i in 0..N {
+                let lambda = wl.lambda[i];
+                s.0[i] = sky.table.eval(theta, lambda) * sky.factor.eval(lambda);
+            }
+            if sky.replaces_background {
+                s
+            } else {
+                s + wl.eval(&ctx.scene.background)
+            }
+        }
+    };
     for light in &ctx.scene.lights {
         if let Light::Sun(s) = light {
             if s.sees_disk(dir) {

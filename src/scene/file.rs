@@ -75,6 +75,30 @@ pub struct SceneFile {
     pub shapes: Vec<ShapeFile>,
     #[serde(default)]
     pub lights: Vec<LightFile>,
+    /// A rainbow sky over the background; needs a `sun` light.
+    #[serde(default)]
+    pub sky: Option<SkyFile>,
+}
+
+/// `[sky]`: a sky model seen by rays that leave the scene (src/sky).
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkyFile {
+    /// constant, aristotle, descartes, airy or mie.
+    pub model: String,
+    /// Drop radius in mm (airy, mie).
+    #[serde(default)]
+    pub droplet_radius: Option<PositiveNumber>,
+    /// Internal reflections to include (descartes, airy): a subset of [1, 2]; default
+    /// both.
+    #[serde(default)]
+    pub orders: Option<Vec<u32>>,
+    /// unpolarised (default), s or p (descartes, airy, mie).
+    #[serde(default)]
+    pub polarisation: Option<String>,
+    /// Multiplies the model's radiance; default 1.
+    #[serde(default)]
+    pub scale: Option<PositiveNumber>,
 }
 
 /// `[camera]`: the seed's pinhole camera.

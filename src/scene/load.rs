@@ -553,6 +553,13 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         }
     }
 
+    let sky = match &file.sky {
+        Some(sf) => Some(std::sync::Arc::new(
+            build_sky(sf, &lights, &background).map_err(err)?,
+        )),
+        None => None,
+    };
+
     let c = &file.camera;
     if !(c.look_at.0 - c.eye.0).length().is_finite() {
         return Err(err(format!(
@@ -579,6 +586,7 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         material_names,
         lights,
         background,
+        sky,
         settings,
     })
 }
@@ -664,6 +672,103 @@ fn build_material(
                 },
             })
         }
+    })
+}
+
+/// Builds and tabulates the `[sky]` model with the scene's first sun light.
+fn build_sky(
+    sf: &super::file::SkyFile,
+    lights: &[Light],
+    background: &DenseSpectrum,
+) -> std::result::Result<super::SceneSky, String> {
+    use crate::sky::{
+        AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky,
+    };
+    let sun = lights.iter().find_map(|l| match l {
+        Light::Sun(s) => Some(s),
+        _ => None,
+    });
+    let Some(sun) = sun else {
+        return Err("sky: expected a light of type \"sun\" (the sky takes its direction and angular radius)".into());
+    };
+    let alpha = sun.angular_radius as f64;
+    let model = sf.model.as_str();
+    let physical = matches!(model, "descartes" | "airy" | "mie");
+    if sf.orders.is_some() && !matches!(model, "descartes" | "airy") {
+        return Err(format!("sky.orders: applies to descartes and airy, not {model}"));
+    }
+    if sf.polarisation.is_some() && !physical {
+        return Err(format!("sky.polarisation: applies to descartes, airy and mie, not {model}"));
+    }
+    if sf.droplet_radius.is_some() && !matches!(model, "airy" | "mie") {
+        return Err(format!("sky.droplet_radius: applies to airy and mie, not {model}"));
+    }
+    let orders = match &sf.orders {
+        None => vec![1, 2],
+        Some(o) if !o.is_empty() && o.iter().all(|k| *k == 1 || *k == 2) => {
+            let mut o = o.clone();
+            o.sort_unstable();
+            o.dedup();
+            o
+        }
+        Some(o) => return Err(format!("sky.orders: expected a non-empty subset of [1, 2], got {o:?}")),
+    };
+    let pol = match sf.polarisation.as_deref().unwrap_or("unpolarised") {
+        "unpolarised" | "unpolarized" => Polarisation::Unpolarised,
+        "s" => Polarisation::S,
+        "p" => Polarisation::P,
+        other => return Err(format!("sky.polarisation: expected unpolarised, s or p, got {other:?}")),
+    };
+    let radius = || -> std::result::Result<f64, String> {
+        let r = sf
+            .droplet_radius
+            .map(|r| r.0 as f64)
+            .ok_or_else(|| format!("sky.droplet_radius: the {model} model needs a drop radius in mm"))?;
+        if r > crate::sky::profile::MIE_MAX_RADIUS_MM {
+            return Err(format!(
+                "sky.droplet_radius: expected at most {} mm, got {r}",
+                crate::sky::profile::MIE_MAX_RADIUS_MM
+            ));
+        }
+        Ok(r)
+    };
+    let sky = match model {
+        "constant" => Sky::Constant(ConstantSky::new(background.clone())),
+        "aristotle" => Sky::Aristotle(AristotleSky::new(alpha, background.clone())),
+        "descartes" => {
+            let mut d = DescartesSky::water(alpha);
+            d.orders = orders;
+            d.polarisation = pol;
+            Sky::Descartes(d)
+        }
+        "airy" => {
+            let mut a = AirySky::water(radius()?, alpha);
+            a.orders = orders;
+            a.polarisation = pol;
+            Sky::Airy(a)
+        }
+        "mie" => {
+            let mut m = MieSky::water(radius()?, alpha);
+            m.polarisation = pol;
+            Sky::Mie(m)
+        }
+        other => {
+            return Err(format!(
+                "sky.model: expected one of constant, aristotle, descartes, airy, mie, got {other:?}"
+            ))
+        }
+    };
+    let scale = sf.scale.map_or(1.0, |s| s.0);
+    Ok(super::SceneSky {
+        model: model.to_string(),
+        table: crate::sky::table::SkyTable::build(&sky),
+        sun_dir: -sun.direction,
+        factor: if physical {
+            sun.irradiance.scaled(scale)
+        } else {
+            DenseSpectrum::constant(scale)
+        },
+        replaces_background: !physical,
     })
 }
 

@@ -47,5 +47,24 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Radiance seen along rays that leave the scene.
     pub background: DenseSpectrum,
+    /// A rainbow sky, when the scene has one.
+    pub sky: Option<std::sync::Arc<SceneSky>>,
     pub settings: RenderSettings,
+}
+
+/// A sky model ready for rendering: tabulated over (θ, λ), tied to the scene's sun.
+#[derive(Debug)]
+pub struct SceneSky {
+    /// The model's name, for messages.
+    pub model: String,
+    pub table: crate::sky::table::SkyTable,
+    /// Unit direction toward the sun.
+    pub sun_dir: glam::Vec3,
+    /// Per-wavelength factor on the table: the sun's irradiance times `scale` for the
+    /// physical models (their profile is radiance per unit solar irradiance), `scale`
+    /// alone for the Aristotelian and constant skies.
+    pub factor: DenseSpectrum,
+    /// True when the model already contains the background (aristotle, constant), so it
+    /// replaces it rather than adding to it.
+    pub replaces_background: bool,
 }

@@ -36,6 +36,7 @@ pub mod constant;
 pub mod descartes;
 pub mod mie;
 pub mod profile;
+pub mod table;
 
 pub use airy::AirySky;
 pub use aristotle::AristotleSky;

@@ -1,0 +1,131 @@
+//! A sky model tabulated over (θ, λ) for rendering. The physical models evaluate a
+//! disk convolution on every call (tens of µs), far too slow per lane per escaping ray;
+//! the table is built once per scene, in parallel, and read by bilinear interpolation.
+//!
+//! Grid: θ from 0 to 180° in steps of 0.01° over 35–56° (the primary bow, Alexander's
+//! band and the secondary bow, where profiles change fastest) and 0.25° elsewhere; λ
+//! every 5 nm over 360–830 nm. Interpolating between 5 nm rows moves a bow by at most
+//! its own dispersion over 5 nm (≈ 0.03°), well inside the sun's 0.53° disk.
+use super::Sky;
+use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN};
+use rayon::prelude::*;
+
+const FINE_FROM: f64 = 35.0;
+const FINE_TO: f64 = 56.0;
+const FINE_STEP: f64 = 0.01;
+const COARSE_STEP: f64 = 0.25;
+const LAMBDA_STEP: f32 = 5.0;
+
+#[derive(Clone, Debug)]
+pub struct SkyTable {
+    /// θ of each column, degrees, increasing.
+    theta_deg: Vec<f64>,
+    n_lambda: usize,
+    /// Row-major: values[l * n_theta + t].
+    values: Vec<f32>,
+}
+
+fn theta_grid() -> Vec<f64> {
+    let mut g = Vec::new();
+    let push_range = |from: f64, to: f64, step: f64, g: &mut Vec<f64>| {
+        let n = ((to - from) / step).round() as usize;
+        for i in 0..n {
+            g.push(from + i as f64 * step);
+        }
+    };
+    push_range(0.0, FINE_FROM, COARSE_STEP, &mut g);
+    push_range(FINE_FROM, FINE_TO, FINE_STEP, &mut g);
+    push_range(FINE_TO, 180.0, COARSE_STEP, &mut g);
+    g.push(180.0);
+    g
+}
+
+impl SkyTable {
+    /// Evaluates `sky.profile` on the grid, λ rows in parallel (deterministic: each
+    /// value is computed independently).
+    pub fn build(sky: &Sky) -> SkyTable {
+        let theta_deg = theta_grid();
+        let n_lambda = ((LAMBDA_MAX - LAMBDA_MIN) / LAMBDA_STEP).round() as usize + 1;
+        let rows: Vec<Vec<f32>> = (0..n_lambda)
+            .into_par_iter()
+            .map(|l| {
+                let lambda = LAMBDA_MIN + l as f32 * LAMBDA_STEP;
+                theta_deg
+                    .iter()
+                    .map(|t| sky.profile(t.to_radians(), lambda).max(0.0))
+                    .collect()
+            })
+            .collect();
+        SkyTable {
+            theta_deg,
+            n_lambda,
+            values: rows.concat(),
+        }
+    }
+
+    /// Column index and weight for θ in degrees.
+    #[inline]
+    fn column(&self, theta_deg: f64) -> (usize, f32) {
+        let t = theta_deg.clamp(0.0, 180.0);
+        let i = if t < FINE_FROM {
+            (t / COARSE_STEP) as usize
+        } else if t < FINE_TO {
+            (FINE_FROM / COARSE_STEP) as usize + ((t - FINE_FROM) / FINE_STEP) as usize
+        } else {
+            (FINE_FROM / COARSE_STEP) as usize
+                + ((FINE_TO - FINE_FROM) / FINE_STEP).round() as usize
+                + ((t - FINE_TO) / COARSE_STEP) as usize
+        };
+        let i = i.min(self.theta_deg.len() - 2);
+        let (a, b) = (self.theta_deg[i], self.theta_deg[i + 1]);
+        (i, (((t - a) / (b - a)) as f32).clamp(0.0, 1.0))
+    }
+
+    /// The tabulated profile at θ (degrees) and λ (nm), bilinear.
+    #[inline]
+    pub fn eval(&self, theta_deg: f64, lambda_nm: f32) -> f32 {
+        let (i, wt) = self.column(theta_deg);
+        let x = ((lambda_nm - LAMBDA_MIN) / LAMBDA_STEP).clamp(0.0, (self.n_lambda - 1) as f32);
+        let l = (x as usize).min(self.n_lambda - 2);
+        let wl = x - l as f32;
+        let n = self.theta_deg.len();
+        let at = |l: usize, i: usize| self.values[l * n + i];
+        let r0 = at(l, i) + wt * (at(l, i + 1) - at(l, i));
+        let r1 = at(l + 1, i) + wt * (at(l + 1, i + 1) - at(l + 1, i));
+        r0 + wl * (r1 - r0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sky::DescartesSky;
+
+    #[test]
+    fn table_matches_the_model_between_its_nodes() {
+        let sky = Sky::Descartes(DescartesSky::water(0.2666f64.to_radians()));
+        let t = SkyTable::build(&sky);
+        // Grid columns are where the table was evaluated.
+        for &(theta, lambda) in &[(41.2, 450.0f32), (42.0, 650.0), (50.5, 500.0), (52.3, 600.0)] {
+            let exact = sky.profile((theta as f64).to_radians(), lambda);
+            let got = t.eval(theta, lambda);
+            assert!((got - exact).abs() <= 1e-6 + 1e-4 * exact.abs(), "θ {theta}: {got} vs {exact}");
+        }
+        // Between nodes the error stays small against the bow's peak.
+        let peak = sky.profile(41.9f64.to_radians(), 600.0);
+        let mut worst = 0.0f32;
+        for k in 0..2000 {
+            let theta = 36.0 + 19.0 * k as f64 / 2000.0 + 0.0031;
+            let lambda = 402.5 + (k % 80) as f32 * 4.1;
+            let e = (t.eval(theta, lambda) - sky.profile(theta.to_radians(), lambda)).abs();
+            worst = worst.max(e);
+        }
+        assert!(worst < 0.1 * peak, "worst interpolation error {worst} against peak {peak}");
+        // Column lookup is consistent at the grid's seams.
+        for th in [0.0, 34.99, 35.0, 35.005, 55.999, 56.0, 56.1, 179.9, 180.0] {
+            let (i, w) = t.column(th);
+            assert!(t.theta_deg[i] <= th + 1e-9 && th <= t.theta_deg[i + 1] + 1e-9, "{th}");
+            assert!((0.0..=1.0).contains(&w));
+        }
+    }
+}
