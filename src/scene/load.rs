@@ -681,9 +681,7 @@ fn build_sky(
     lights: &[Light],
     background: &DenseSpectrum,
 ) -> std::result::Result<super::SceneSky, String> {
-    use crate::sky::{
-        AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky,
-    };
+    use crate::sky::{AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky};
     let sun = lights.iter().find_map(|l| match l {
         Light::Sun(s) => Some(s),
         _ => None,
@@ -695,13 +693,19 @@ fn build_sky(
     let model = sf.model.as_str();
     let physical = matches!(model, "descartes" | "airy" | "mie");
     if sf.orders.is_some() && !matches!(model, "descartes" | "airy") {
-        return Err(format!("sky.orders: applies to descartes and airy, not {model}"));
+        return Err(format!(
+            "sky.orders: applies to descartes and airy, not {model}"
+        ));
     }
     if sf.polarisation.is_some() && !physical {
-        return Err(format!("sky.polarisation: applies to descartes, airy and mie, not {model}"));
+        return Err(format!(
+            "sky.polarisation: applies to descartes, airy and mie, not {model}"
+        ));
     }
     if sf.droplet_radius.is_some() && !matches!(model, "airy" | "mie") {
-        return Err(format!("sky.droplet_radius: applies to airy and mie, not {model}"));
+        return Err(format!(
+            "sky.droplet_radius: applies to airy and mie, not {model}"
+        ));
     }
     let orders = match &sf.orders {
         None => vec![1, 2],
@@ -711,19 +715,26 @@ fn build_sky(
             o.dedup();
             o
         }
-        Some(o) => return Err(format!("sky.orders: expected a non-empty subset of [1, 2], got {o:?}")),
+        Some(o) => {
+            return Err(format!(
+                "sky.orders: expected a non-empty subset of [1, 2], got {o:?}"
+            ))
+        }
     };
     let pol = match sf.polarisation.as_deref().unwrap_or("unpolarised") {
         "unpolarised" | "unpolarized" => Polarisation::Unpolarised,
         "s" => Polarisation::S,
         "p" => Polarisation::P,
-        other => return Err(format!("sky.polarisation: expected unpolarised, s or p, got {other:?}")),
+        other => {
+            return Err(format!(
+                "sky.polarisation: expected unpolarised, s or p, got {other:?}"
+            ))
+        }
     };
     let radius = || -> std::result::Result<f64, String> {
-        let r = sf
-            .droplet_radius
-            .map(|r| r.0 as f64)
-            .ok_or_else(|| format!("sky.droplet_radius: the {model} model needs a drop radius in mm"))?;
+        let r = sf.droplet_radius.map(|r| r.0 as f64).ok_or_else(|| {
+            format!("sky.droplet_radius: the {model} model needs a drop radius in mm")
+        })?;
         if r > crate::sky::profile::MIE_MAX_RADIUS_MM {
             return Err(format!(
                 "sky.droplet_radius: expected at most {} mm, got {r}",
@@ -752,11 +763,9 @@ fn build_sky(
             m.polarisation = pol;
             Sky::Mie(m)
         }
-        other => {
-            return Err(format!(
-                "sky.model: expected one of constant, aristotle, descartes, airy, mie, got {other:?}"
-            ))
-        }
+        other => return Err(format!(
+            "sky.model: expected one of constant, aristotle, descartes, airy, mie, got {other:?}"
+        )),
     };
     let scale = sf.scale.map_or(1.0, |s| s.0);
     Ok(super::SceneSky {

@@ -106,10 +106,18 @@ mod tests {
         let sky = Sky::Descartes(DescartesSky::water(0.2666f64.to_radians()));
         let t = SkyTable::build(&sky);
         // Grid columns are where the table was evaluated.
-        for &(theta, lambda) in &[(41.2, 450.0f32), (42.0, 650.0), (50.5, 500.0), (52.3, 600.0)] {
+        for &(theta, lambda) in &[
+            (41.2, 450.0f32),
+            (42.0, 650.0),
+            (50.5, 500.0),
+            (52.3, 600.0),
+        ] {
             let exact = sky.profile((theta as f64).to_radians(), lambda);
             let got = t.eval(theta, lambda);
-            assert!((got - exact).abs() <= 1e-6 + 1e-4 * exact.abs(), "θ {theta}: {got} vs {exact}");
+            assert!(
+                (got - exact).abs() <= 1e-6 + 1e-4 * exact.abs(),
+                "θ {theta}: {got} vs {exact}"
+            );
         }
         // Between nodes the error stays small against the bow's peak.
         let peak = sky.profile(41.9f64.to_radians(), 600.0);
@@ -120,11 +128,17 @@ mod tests {
             let e = (t.eval(theta, lambda) - sky.profile(theta.to_radians(), lambda)).abs();
             worst = worst.max(e);
         }
-        assert!(worst < 0.1 * peak, "worst interpolation error {worst} against peak {peak}");
+        assert!(
+            worst < 0.1 * peak,
+            "worst interpolation error {worst} against peak {peak}"
+        );
         // Column lookup is consistent at the grid's seams.
         for th in [0.0, 34.99, 35.0, 35.005, 55.999, 56.0, 56.1, 179.9, 180.0] {
             let (i, w) = t.column(th);
-            assert!(t.theta_deg[i] <= th + 1e-9 && th <= t.theta_deg[i + 1] + 1e-9, "{th}");
+            assert!(
+                t.theta_deg[i] <= th + 1e-9 && th <= t.theta_deg[i + 1] + 1e-9,
+                "{th}"
+            );
             assert!((0.0..=1.0).contains(&w));
         }
     }

@@ -1,0 +1,115 @@
+//! Skies in scenes: `[sky]` loads with the scene's sun and gives clear errors, and a
+//! rendered Descartes sky puts the primary bow, Alexander's dark band and the secondary
+//! bow at the angles geometric optics predicts.
+use heron::camera::Camera;
+use heron::render::{render, RenderOptions};
+use heron::scene::load::load_scene_from_str;
+use heron::scene::load_scene;
+use std::path::Path;
+
+fn scenes() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+const BASE: &str = r#"
+[camera]
+eye = [0.0, 1.5, 0.0]
+look_at = [0.0, 1.75, -1.0]
+resolution = [8, 8]
+[[lights]]
+type = "sun"
+direction = [0.0, -0.258819, -0.965926]
+irradiance = 3.0
+"#;
+
+fn load_err(extra: &str) -> String {
+    let text = format!("{BASE}\n{extra}");
+    match load_scene_from_str(&text, Path::new("sky.toml")) {
+        Ok(_) => panic!("accepted: {extra}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn sky_section_errors_name_the_key() {
+    for (extra, needle) in [
+        ("[sky]\nmodel = \"rainbowz\"", "sky.model"),
+        ("[sky]\nmodel = \"descartes\"\norders = [3]", "sky.orders"),
+        ("[sky]\nmodel = \"airy\"", "sky.droplet_radius"),
+        (
+            "[sky]\nmodel = \"descartes\"\ndroplet_radius = 0.5",
+            "sky.droplet_radius",
+        ),
+        (
+            "[sky]\nmodel = \"aristotle\"\npolarisation = \"s\"",
+            "sky.polarisation",
+        ),
+        (
+            "[sky]\nmodel = \"mie\"\ndroplet_radius = 5.0",
+            "sky.droplet_radius",
+        ),
+        ("[sky]\nmodel = \"descartes\"\ncolour = 1", "colour"),
+    ] {
+        let e = load_err(extra);
+        assert!(
+            e.contains(needle) && e.contains("sky.toml"),
+            "{extra:?}: {e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    // No sun, no sky.
+    let e = match load_scene_from_str(
+        "[camera]\neye = [0, 1, 0]\nlook_at = [0, 1, -1]\nresolution = [4, 4]\n[sky]\nmodel = \"descartes\"\n",
+        Path::new("nosun.toml"),
+    ) {
+        Ok(_) => panic!("a sky without a sun was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("sun"), "{e}");
+}
+
+#[test]
+fn rendered_descartes_sky_has_its_bows_and_dark_band_where_optics_puts_them() {
+    let mut s = load_scene(&scenes().join("rainbow-descartes.toml")).unwrap();
+    let sky = s.sky.clone().expect("the scene has a sky");
+    // A tall, narrow view straight up through the top of the bows: one column, θ
+    // from the antisolar point grows with the row.
+    let c = &s.camera;
+    let (w, h) = (1u32, 400u32);
+    s.camera = Camera::new(c.eye, c.look_at, c.up, 0.6, w, h).unwrap();
+    let mut o = RenderOptions::from_scene(&s);
+    o.spp = 64;
+    let (film, _) = render(&s, &o).unwrap();
+    let rows: Vec<(f64, f32)> = (0..h)
+        .map(|y| {
+            let d = s.camera.direction(0.5, y as f32 + 0.5);
+            let theta = heron::sky::antisolar_angle(d, sky.sun_dir).to_degrees();
+            (theta, film.xyz[y as usize][1])
+        })
+        .collect();
+    let near = |lo: f64, hi: f64| -> Vec<(f64, f32)> {
+        rows.iter()
+            .copied()
+            .filter(|(t, _)| *t >= lo && *t <= hi)
+            .collect()
+    };
+    let brightest = |v: &[(f64, f32)]| {
+        v.iter()
+            .copied()
+            .fold((0.0, f32::MIN), |a, b| if b.1 > a.1 { b } else { a })
+    };
+    let (t1, y1) = brightest(&near(38.0, 44.0));
+    let (t2, y2) = brightest(&near(49.0, 55.0));
+    // Luminance-weighted bows of water: primary near 42°, secondary near 51°.
+    assert!((41.0..43.0).contains(&t1), "primary bow at {t1}°");
+    assert!((50.0..52.5).contains(&t2), "secondary bow at {t2}°");
+    let band: Vec<f32> = near(44.5, 48.5).iter().map(|r| r.1).collect();
+    let band_max = band.iter().copied().fold(f32::MIN, f32::max);
+    let inside: f32 =
+        near(30.0, 35.0).iter().map(|r| r.1).sum::<f32>() / near(30.0, 35.0).len() as f32;
+    // Alexander's dark band: darker than the sky inside the primary and than both bows.
+    assert!(
+        band_max < inside && band_max < y2 && y2 < y1,
+        "band {band_max}, inside {inside}, bows {y1} {y2}"
+    );
+}
