@@ -112,7 +112,7 @@ mod tests {
             (50.5, 500.0),
             (52.3, 600.0),
         ] {
-            let exact = sky.profile((theta as f64).to_radians(), lambda);
+            let exact = sky.profile(f64::to_radians(theta), lambda);
             let got = t.eval(theta, lambda);
             assert!(
                 (got - exact).abs() <= 1e-6 + 1e-4 * exact.abs(),
