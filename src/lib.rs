@@ -17,6 +17,7 @@ pub mod light;
 pub mod math;
 pub mod render;
 pub mod scene;
+pub mod sky;
 pub mod spectrum;
 pub mod trace;
 

@@ -34,6 +34,96 @@ enum Command {
     Bench(BenchCommand),
     /// Print the CIE XYZ, xy and linear sRGB of a spectral distribution CSV as JSON.
     Color(ColorArgs),
+    /// Rainbow skies: radiance profiles of the sky models (heron::sky).
+    #[command(subcommand)]
+    Sky(SkyCommand),
+}
+
+#[derive(Subcommand)]
+enum SkyCommand {
+    /// CSV of radiance against the angle from the antisolar point (degrees), one column
+    /// per wavelength. Units: dσ/dΩ/(πa²) per sr for descartes, airy and mie (see
+    /// heron::sky); the texture's radiance for aristotle.
+    Profile(SkyProfileArgs),
+    /// Mie amplitudes S1, S2 (Bohren & Huffman) of a sphere, for tests/python/test_mie.py.
+    #[command(hide = true)]
+    MiePhase {
+        /// Real relative refractive index.
+        #[arg(long)]
+        m: f64,
+        /// Size parameter 2πa/λ.
+        #[arg(long)]
+        x: f64,
+        /// Scattering angles (degrees): from, to, step.
+        #[arg(long, default_value_t = 0.0)]
+        from: f64,
+        #[arg(long, default_value_t = 180.0)]
+        to: f64,
+        #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+        step: f64,
+    },
+}
+
+#[derive(clap::Args)]
+struct SkyProfileArgs {
+    /// constant, aristotle, descartes, airy or mie.
+    #[arg(long)]
+    model: String,
+    /// Sun angular radius in degrees.
+    #[arg(long, default_value_t = 0.2666, allow_hyphen_values = true)]
+    sun_radius: f64,
+    /// Drop radius in mm (airy, mie; descartes does not depend on it).
+    #[arg(long, allow_hyphen_values = true)]
+    droplet_radius: Option<f64>,
+    /// Wavelengths in nm, comma-separated.
+    #[arg(long)]
+    lambda: String,
+    /// First angle from the antisolar point, degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    from: f64,
+    /// Last angle, degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    to: f64,
+    /// Angle step, degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    step: f64,
+    /// Internal reflections: 1, 2 or both (descartes, airy).
+    #[arg(long)]
+    k: Option<String>,
+    /// unpolarised, s or p (descartes, airy, mie).
+    #[arg(long)]
+    polarisation: Option<String>,
+    /// Background radiance (constant: default 1; aristotle: default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    background: Option<f64>,
+}
+
+fn cmd_sky(c: SkyCommand) -> Result<()> {
+    let csv = match c {
+        SkyCommand::Profile(a) => {
+            heron::sky::profile::profile_csv(&heron::sky::profile::ProfileRequest {
+                model: a.model,
+                sun_radius_deg: a.sun_radius,
+                droplet_radius_mm: a.droplet_radius,
+                lambdas: a.lambda,
+                from_deg: a.from,
+                to_deg: a.to,
+                step_deg: a.step,
+                k: a.k,
+                polarisation: a.polarisation,
+                background: a.background,
+            })?
+        }
+        SkyCommand::MiePhase {
+            m,
+            x,
+            from,
+            to,
+            step,
+        } => heron::sky::profile::mie_phase_csv(m, x, from, to, step)?,
+    };
+    print!("{csv}");
+    Ok(())
 }
 
 #[derive(Subcommand)]
@@ -268,6 +358,7 @@ fn main() {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
         }
         Command::Color(args) => cmd_color(args),
+        Command::Sky(c) => cmd_sky(c),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

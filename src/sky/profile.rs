@@ -1,0 +1,232 @@
+//! `heron sky profile`: radiance against the angle from the antisolar point as CSV, one
+//! column per wavelength; and `heron sky mie-phase` (hidden), the raw Mie amplitudes for
+//! the miepython comparison in tests/python/test_mie.py.
+use super::{AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky};
+use crate::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
+use crate::{HeronError, Result};
+use std::fmt::Write;
+
+/// What `heron sky profile` was asked for (angles in degrees, radius in mm).
+#[derive(Clone, Debug)]
+pub struct ProfileRequest {
+    pub model: String,
+    pub sun_radius_deg: f64,
+    pub droplet_radius_mm: Option<f64>,
+    pub lambdas: String,
+    pub from_deg: f64,
+    pub to_deg: f64,
+    pub step_deg: f64,
+    pub k: Option<String>,
+    pub polarisation: Option<String>,
+    /// Background radiance for `constant` (default 1) and `aristotle` (default 0).
+    pub background: Option<f64>,
+}
+
+fn bad(msg: String) -> HeronError {
+    HeronError::Invalid(msg)
+}
+
+/// Parses `--lambda NM[,NM…]`: each in 360–830 nm.
+pub fn parse_lambdas(s: &str) -> Result<Vec<f32>> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|t| {
+            let t = t.trim();
+            let l: f32 = t
+                .parse()
+                .ok()
+                .filter(|x: &f32| x.is_finite())
+                .ok_or_else(|| bad(format!("--lambda: expected numbers in nm, got {t:?}")))?;
+            if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&l) {
+                return Err(bad(format!(
+                    "--lambda: expected wavelengths in 360–830 nm, got {t}"
+                )));
+            }
+            Ok(l)
+        })
+        .collect::<Result<_>>()?;
+    Ok(v)
+}
+
+fn parse_orders(k: Option<&str>) -> Result<Vec<u32>> {
+    match k.unwrap_or("both") {
+        "1" => Ok(vec![1]),
+        "2" => Ok(vec![2]),
+        "both" => Ok(vec![1, 2]),
+        other => Err(bad(format!("--k: expected 1, 2 or both, got {other:?}"))),
+    }
+}
+
+fn parse_polarisation(p: Option<&str>) -> Result<Polarisation> {
+    match p.unwrap_or("unpolarised") {
+        "unpolarised" | "unpolarized" => Ok(Polarisation::Unpolarised),
+        "s" => Ok(Polarisation::S),
+        "p" => Ok(Polarisation::P),
+        other => Err(bad(format!(
+            "--polarisation: expected unpolarised, s or p, got {other:?}"
+        ))),
+    }
+}
+
+/// Largest drop radius accepted for `mie` (x ≈ 35 000 at 360 nm: seconds per wavelength).
+pub const MIE_MAX_RADIUS_MM: f64 = 2.0;
+/// Largest number of rows.
+pub const MAX_ROWS: usize = 2_000_000;
+
+/// Builds the model of a request (validating every value).
+pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
+    let alpha = req.sun_radius_deg.to_radians();
+    super::check_sun_radius(alpha)?;
+    let model = req.model.as_str();
+    let uses_orders = matches!(model, "descartes" | "airy");
+    let uses_pol = matches!(model, "descartes" | "airy" | "mie");
+    if req.k.is_some() && !uses_orders && is_model(model) {
+        return Err(bad(format!(
+            "--k applies to descartes and airy, not {model}"
+        )));
+    }
+    if req.polarisation.is_some() && !uses_pol && is_model(model) {
+        return Err(bad(format!(
+            "--polarisation applies to descartes, airy and mie, not {model}"
+        )));
+    }
+    let orders = parse_orders(req.k.as_deref())?;
+    let pol = parse_polarisation(req.polarisation.as_deref())?;
+    let radius = |max_mm: f64| -> Result<f64> {
+        let r = req.droplet_radius_mm.ok_or_else(|| {
+            bad(format!(
+                "--droplet-radius: the {model} model needs a drop radius in mm"
+            ))
+        })?;
+        if !(r.is_finite() && r > 0.0 && r <= max_mm) {
+            return Err(bad(format!(
+                "--droplet-radius: expected a radius in (0, {max_mm}] mm for {model}, got {r}"
+            )));
+        }
+        // Airy and Mie need x = 2πa/λ well above 1 for the bows to exist at all.
+        Ok(r)
+    };
+    let background = |default: f64| -> Result<DenseSpectrum> {
+        let b = req.background.unwrap_or(default);
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(bad(format!(
+                "--background: expected a radiance ≥ 0, got {b}"
+            )));
+        }
+        Ok(DenseSpectrum::constant(b as f32))
+    };
+    Ok(match model {
+        "constant" => Sky::Constant(ConstantSky::new(background(1.0)?)),
+        "aristotle" => Sky::Aristotle(AristotleSky::new(alpha, background(0.0)?)),
+        "descartes" => {
+            let mut s = DescartesSky::water(alpha);
+            s.orders = orders;
+            s.polarisation = pol;
+            Sky::Descartes(s)
+        }
+        "airy" => {
+            let mut s = AirySky::water(radius(10.0)?, alpha);
+            s.orders = orders;
+            s.polarisation = pol;
+            Sky::Airy(s)
+        }
+        "mie" => {
+            let mut s = MieSky::water(radius(MIE_MAX_RADIUS_MM)?, alpha);
+            s.polarisation = pol;
+            Sky::Mie(s)
+        }
+        other => {
+            return Err(bad(format!(
+                "--model: unknown model {other:?}; expected constant, aristotle, descartes, airy or mie"
+            )))
+        }
+    })
+}
+
+fn is_model(m: &str) -> bool {
+    matches!(m, "constant" | "aristotle" | "descartes" | "airy" | "mie")
+}
+
+/// The θ values (degrees) of a request.
+pub fn angles(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
+    if !(from.is_finite() && to.is_finite() && step.is_finite()) {
+        return Err(bad("--from, --to, --step: expected finite numbers".into()));
+    }
+    if step <= 0.0 {
+        return Err(bad(format!(
+            "--step: expected a positive angle, got {step}"
+        )));
+    }
+    if !(0.0..=180.0).contains(&from) || !(0.0..=180.0).contains(&to) {
+        return Err(bad(format!(
+            "--from, --to: expected angles in 0–180° from the antisolar point, got {from} and {to}"
+        )));
+    }
+    if from > to {
+        return Err(bad(format!("--from {from} is larger than --to {to}")));
+    }
+    let n = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() as usize + 1;
+    if n > MAX_ROWS {
+        return Err(bad(format!(
+            "--step {step}: {n} rows, more than {MAX_ROWS}; use a larger step"
+        )));
+    }
+    Ok((0..n)
+        .map(|i| {
+            let t = from + step * i as f64;
+            (t * 1e9).round() / 1e9
+        })
+        .collect())
+}
+
+/// The CSV text of a request: `theta_deg,<λ1>nm,…`, one row per angle.
+pub fn profile_csv(req: &ProfileRequest) -> Result<String> {
+    let lambdas = parse_lambdas(&req.lambdas)?;
+    let thetas = angles(req.from_deg, req.to_deg, req.step_deg)?;
+    let sky = build_sky(req)?;
+    if let Sky::Mie(m) = &sky {
+        m.prepare(&lambdas);
+    }
+    let mut out = String::from("theta_deg");
+    for l in &lambdas {
+        write!(out, ",{l}nm").unwrap();
+    }
+    out.push('\n');
+    for &t in &thetas {
+        write!(out, "{t}").unwrap();
+        for &l in &lambdas {
+            write!(out, ",{:.6e}", sky.profile(t.to_radians(), l)).unwrap();
+        }
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+/// `heron sky mie-phase`: S₁, S₂ of a sphere of real index `m` and size parameter `x` at
+/// scattering angles from..to (degrees) as CSV `angle_deg,s1_re,s1_im,s2_re,s2_im`
+/// (Bohren & Huffman's convention, no normalisation).
+pub fn mie_phase_csv(m: f64, x: f64, from: f64, to: f64, step: f64) -> Result<String> {
+    if !(m.is_finite() && m > 1.0 && m < 3.0) {
+        return Err(bad(format!(
+            "--m: expected a real index in (1, 3), got {m}"
+        )));
+    }
+    if !(x.is_finite() && x > 0.0 && x <= 100_000.0) {
+        return Err(bad(format!(
+            "--x: expected a size parameter in (0, 1e5], got {x}"
+        )));
+    }
+    let thetas = angles(from, to, step)?;
+    let c = super::mie::coefficients(m, x);
+    let mut out = String::from("angle_deg,s1_re,s1_im,s2_re,s2_im\n");
+    for t in thetas {
+        let (s1, s2) = super::mie::amplitudes(&c, t.to_radians().cos());
+        writeln!(
+            out,
+            "{t},{:.17e},{:.17e},{:.17e},{:.17e}",
+            s1.re, s1.im, s2.re, s2.im
+        )
+        .unwrap();
+    }
+    Ok(out)
+}
