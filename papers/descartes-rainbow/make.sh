@@ -6,6 +6,7 @@
 # Needs a release build of heron (target/release/heron, or HERON_BIN) and the project's
 # .venv (scripts/setup.sh; or HERON_PYTHON). Same heron and .venv => same bytes.
 set -euo pipefail
+export PYTHONDONTWRITEBYTECODE=1
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../.." && pwd)"
 out="${1:-$here}"
