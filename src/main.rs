@@ -87,7 +87,8 @@ struct SkyProfileArgs {
     /// Angle step, degrees.
     #[arg(long, allow_hyphen_values = true)]
     step: f64,
-    /// Internal reflections: 1, 2 or both (descartes, airy).
+    /// Internal reflections: 1, 2 or both (descartes, airy); descartes also 0 (external
+    /// reflection) or all (0, 1 and 2).
     #[arg(long)]
     k: Option<String>,
     /// unpolarised, s or p (descartes, airy, mie).

@@ -322,11 +322,12 @@ fn airy_main_peak_is_on_the_bright_side_by_the_expected_amount() {
 #[test]
 fn airy_agrees_with_mie_near_the_primary_bow() {
     // Peak positions (real sun, primary): Airy theory is an asymptotic approximation for
-    // large x, so the tolerance is 0.04° at a = 0.25 mm (x ≈ 2400–3500) and 0.01° at 1 mm
-    // (x ≈ 11 400); Mie also carries the external reflection and the other orders.
+    // large x, so the tolerance is 0.03° at a = 0.25 mm (x ≈ 2400–3500; measured 0.014°
+    // and 0.006°) and 0.005° at 1 mm (x ≈ 11 400; measured < 0.001°); Mie also carries the
+    // external reflection and the other orders. Peak values within 5 % (measured ≤ 1.3 %).
     for (a_mm, lambdas, tol) in [
-        (0.25, vec![450.0f32, 650.0], 0.04),
-        (1.0, vec![550.0f32], 0.01),
+        (0.25, vec![450.0f32, 650.0], 0.03),
+        (1.0, vec![550.0f32], 0.005),
     ] {
         let mut a = AirySky::water(a_mm, SUN.to_radians());
         a.orders = vec![1];
@@ -343,7 +344,7 @@ fn airy_agrees_with_mie_near_the_primary_bow() {
                 "a = {a_mm} mm, {lambda} nm: Descartes {t0:.3}°, Airy peak {pa:.3}° ({va:.4}), Mie peak {pm:.3}° ({vm:.4})"
             );
             assert!((pa - pm).abs() < tol, "peaks {pa}° vs {pm}°");
-            assert!((va / vm - 1.0).abs() < 0.1, "peak values {va} vs {vm}");
+            assert!((va / vm - 1.0).abs() < 0.05, "peak values {va} vs {vm}");
         }
     }
 }

@@ -48,12 +48,17 @@ pub fn parse_lambdas(s: &str) -> Result<Vec<f32>> {
     Ok(v)
 }
 
-fn parse_orders(k: Option<&str>) -> Result<Vec<u32>> {
-    match k.unwrap_or("both") {
-        "1" => Ok(vec![1]),
-        "2" => Ok(vec![2]),
-        "both" => Ok(vec![1, 2]),
-        other => Err(bad(format!("--k: expected 1, 2 or both, got {other:?}"))),
+/// `--k`: 1, 2 or both; descartes also takes 0 (external reflection) and all (0, 1, 2).
+fn parse_orders(k: Option<&str>, model: &str) -> Result<Vec<u32>> {
+    match (k.unwrap_or("both"), model) {
+        ("1", _) => Ok(vec![1]),
+        ("2", _) => Ok(vec![2]),
+        ("both", _) => Ok(vec![1, 2]),
+        ("0", "descartes") => Ok(vec![0]),
+        ("all", "descartes") => Ok(vec![0, 1, 2]),
+        (other, _) => Err(bad(format!(
+            "--k: expected 1, 2 or both (descartes also 0 or all), got {other:?}"
+        ))),
     }
 }
 
@@ -90,7 +95,7 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
             "--polarisation applies to descartes, airy and mie, not {model}"
         )));
     }
-    let orders = parse_orders(req.k.as_deref())?;
+    let orders = parse_orders(req.k.as_deref(), model)?;
     let pol = parse_polarisation(req.polarisation.as_deref())?;
     let radius = |max_mm: f64| -> Result<f64> {
         let r = req.droplet_radius_mm.ok_or_else(|| {

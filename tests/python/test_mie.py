@@ -1,0 +1,108 @@
+"""heron's Lorenz–Mie series (src/sky/mie.rs) against miepython 3.3.0 (pinned).
+
+heron prints the amplitude functions of a sphere through a hidden debug subcommand,
+
+    heron sky mie-phase --m M --x X --from DEG --to DEG --step DEG
+
+as CSV `angle_deg,s1_re,s1_im,s2_re,s2_im` (scattering angle; Bohren & Huffman's S1, S2,
+unnormalised). miepython's `S1_S2(m, x, mu, norm="wiscombe")` returns the same
+unnormalised amplitudes. The sky's profile is built from |S1|² and |S2|² only (the
+phase convention of S does not matter), so those are compared, and the unpolarised
+phase function (|S1|² + |S2|²)/2.
+
+Water, m = 1.3330 (n at about 589 nm; real: absorption is neglected in heron's sky) and
+m = 1.3435 (about 400 nm), at size parameters x = 1, 10, 100, 1000 and 5000 (a 0.5 mm
+drop in red light is x ≈ 5000), over 0–180° every 0.5° plus the rainbow region
+130–145° every 0.01°.
+
+Agreement: |heron − miepython| ≤ 1e-6·|miepython| + 1e-9·max over angles, for |S1|²,
+|S2|² and the phase function (the floor is for the deep minima of the patterns, where
+the relative error of two float64 series is meaningless).
+"""
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+import pytest
+
+miepython = pytest.importorskip("miepython")
+
+from heronrun import require_heron_bin  # noqa: E402
+
+REL = 1e-6
+FLOOR = 1e-9
+
+
+def heron_amplitudes(m: float, x: float, start: float, stop: float, step: float):
+    out = subprocess.run(
+        [
+            str(require_heron_bin()),
+            "sky",
+            "mie-phase",
+            "--m",
+            repr(m),
+            "--x",
+            repr(x),
+            "--from",
+            repr(start),
+            "--to",
+            repr(stop),
+            "--step",
+            repr(step),
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    lines = out.stdout.strip().splitlines()
+    assert lines[0] == "angle_deg,s1_re,s1_im,s2_re,s2_im"
+    a = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    return a[:, 0], a[:, 1] + 1j * a[:, 2], a[:, 3] + 1j * a[:, 4]
+
+
+def check(name: str, got: np.ndarray, want: np.ndarray) -> float:
+    tol = REL * np.abs(want) + FLOOR * np.max(np.abs(want))
+    err = np.abs(got - want)
+    worst = int(np.argmax(err / tol))
+    assert np.all(err <= tol), (
+        f"{name}: worst at index {worst}: heron {got[worst]!r} vs miepython {want[worst]!r}"
+    )
+    return float(np.max(err / np.maximum(np.abs(want), 1e-300)))
+
+
+@pytest.mark.parametrize("m", [1.3330, 1.3435])
+@pytest.mark.parametrize("x", [1.0, 10.0, 100.0, 1000.0, 5000.0])
+@pytest.mark.parametrize("grid", [(0.0, 180.0, 0.5), (130.0, 145.0, 0.01)])
+def test_mie_amplitudes_match_miepython(m: float, x: float, grid) -> None:
+    angles, s1, s2 = heron_amplitudes(m, x, *grid)
+    expected_n = int(round((grid[1] - grid[0]) / grid[2])) + 1
+    assert len(angles) == expected_n
+    mu = np.cos(np.radians(angles))
+    r1, r2 = miepython.S1_S2(m, x, mu, norm="wiscombe")
+    check(f"|S1|² m={m} x={x}", np.abs(s1) ** 2, np.abs(r1) ** 2)
+    check(f"|S2|² m={m} x={x}", np.abs(s2) ** 2, np.abs(r2) ** 2)
+    check(
+        f"phase m={m} x={x}",
+        0.5 * (np.abs(s1) ** 2 + np.abs(s2) ** 2),
+        0.5 * (np.abs(r1) ** 2 + np.abs(r2) ** 2),
+    )
+
+
+def test_tolerance_catches_a_wrong_index() -> None:
+    """A 1e-4 change of m at x = 1000 must fail the comparison."""
+    angles, s1, _ = heron_amplitudes(1.3330, 1000.0, 130.0, 145.0, 0.01)
+    r1, _ = miepython.S1_S2(1.3331, 1000.0, np.cos(np.radians(angles)), norm="wiscombe")
+    with pytest.raises(AssertionError):
+        check("wrong m", np.abs(s1) ** 2, np.abs(r1) ** 2)
+
+
+def test_mie_phase_rejects_bad_values() -> None:
+    for args in (["--m", "0.5", "--x", "10"], ["--m", "1.33", "--x", "-1"]):
+        out = subprocess.run(
+            [str(require_heron_bin()), "sky", "mie-phase", *args],
+            capture_output=True,
+            text=True,
+        )
+        assert out.returncode == 1
+        assert len(out.stderr.strip().splitlines()) == 1
