@@ -36,6 +36,9 @@ for pol in s p; do
     "$heron" sky profile --model descartes --k both --polarisation "$pol" --lambda 550 \
         --from 30 --to 60 --step 0.1 > "$out/data/dark_band_550nm_$pol.csv"
 done
+# With the external reflection (k = 0) as well: the band is no longer black.
+"$heron" sky profile --model descartes --k all --lambda 450,550,650 \
+    --from 30 --to 60 --step 0.1 > "$out/data/dark_band_k012.csv"
 
 # Geometric (descartes) vs Airy vs Mie near the primary bow, real solar disk.
 for a in 0.1 1; do

@@ -157,18 +157,22 @@ def dark_band(out: pathlib.Path) -> None:
     fig, axes = plt.subplots(3, 1, figsize=(8.0, 7.0), sharex=True,
                              gridspec_kw={"height_ratios": [3, 2.2, 0.7]})
     ax = axes[0]
+    h012, d012 = hf.read_csv(out / "data" / "dark_band_k012.csv")
     for lam in (450.0, 550.0, 650.0):
         j = int(np.flatnonzero(lams == lam)[0])
         ax.plot(theta, p[:, j], color=hf.wavelength_colour(lam), label=f"{lam:g} nm")
+    j = 1 + hf.profile_columns(h012).index(550.0)
+    ax.plot(d012[:, 0], d012[:, j], ":", color="k", lw=1.0,
+            label="550 nm with external reflection (k = 0, 1, 2)")
     ax.set_yscale("log")
-    ax.set_ylim(1e-3, 3.0)
+    ax.set_ylim(5e-4, 3.0)
     ax.set_ylabel("p(θ) = dσ/dΩ / πa²  (sr⁻¹)")
     ax.set_title("Descartes sky, k = 1 and 2, solar disk 0.2666°: Alexander's dark band "
                  "(p = 0 between the bows)", fontsize=9)
     dark = theta[np.all(p == 0.0, axis=1)]
     ax.axvspan(dark[0], dark[-1], color="0.85", lw=0)
-    ax.text(0.5 * (dark[0] + dark[-1]), 2.6e-3,
-            f"p = 0 at every wavelength\n{dark[0]:.1f}°–{dark[-1]:.1f}°", ha="center",
+    ax.text(0.5 * (dark[0] + dark[-1]), 1.4e-2,
+            f"k = 1, 2: p = 0 at every\nwavelength, {dark[0]:.1f}°–{dark[-1]:.1f}°", ha="center",
             fontsize=8)
     ax.legend(loc="upper right")
     ax = axes[1]
