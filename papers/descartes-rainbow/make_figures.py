@@ -123,6 +123,8 @@ def deviation_curve(heron: hf.Heron, out: pathlib.Path) -> None:
         inset.set_xlim(bmin - 0.05, bmin + 0.04)
         inset.set_ylim(dlo - 0.6, dhi + 1.5)
         inset.tick_params(labelsize=7)
+        inset.xaxis.set_major_locator(plt.MaxNLocator(4))
+        inset.yaxis.set_major_locator(plt.MaxNLocator(4))
         inset.set_title("near the minimum", fontsize=7)
         ax.set_xlabel("impact parameter b (drop radius 1)")
         ax.set_ylabel("deviation D (°)")
