@@ -25,7 +25,10 @@ fn sky(c: &mut Criterion) {
     let sun = Vec3::new(0.0, 0.26, 0.97).normalize();
     let d = dirs(sun);
     let models: Vec<(&str, Sky)> = vec![
-        ("aristotle", Sky::Aristotle(AristotleSky::new(alpha, DenseSpectrum::constant(0.3)))),
+        (
+            "aristotle",
+            Sky::Aristotle(AristotleSky::new(alpha, DenseSpectrum::constant(0.3))),
+        ),
         ("descartes", Sky::Descartes(DescartesSky::water(alpha))),
         ("airy_0.5mm", Sky::Airy(AirySky::water(0.5, alpha))),
         ("mie_0.1mm", Sky::Mie(MieSky::water(0.1, alpha))),

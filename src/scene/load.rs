@@ -763,9 +763,11 @@ fn build_sky(
             m.polarisation = pol;
             Sky::Mie(m)
         }
-        other => return Err(format!(
+        other => {
+            return Err(format!(
             "sky.model: expected one of constant, aristotle, descartes, airy, mie, got {other:?}"
-        )),
+        ))
+        }
     };
     let scale = sf.scale.map_or(1.0, |s| s.0);
     Ok(super::SceneSky {
