@@ -52,6 +52,16 @@ fn quad(origin: Vec3, e1: Vec3, e2: Vec3, material: u32) -> Shape {
     }
 }
 
+/// The square y = 0, |x|, |z| ≤ `half`, facing +y.
+fn floor(half: f32, material: u32) -> Shape {
+    quad(
+        Vec3::new(-half, 0.0, -half),
+        Vec3::new(0.0, 0.0, 2.0 * half),
+        Vec3::new(2.0 * half, 0.0, 0.0),
+        material,
+    )
+}
+
 fn sphere(center: Vec3, radius: f32, material: u32) -> Shape {
     Shape {
         kind: ShapeKind::Sphere { center, radius },
@@ -136,12 +146,7 @@ fn lambertian_under_a_directional_light_matches_rho_over_pi_e_cos() {
     let light_dir = Vec3::new(theta.sin(), -theta.cos(), 0.0);
     let s = scene(
         cam.clone(),
-        vec![quad(
-            Vec3::new(-50.0, 0.0, -50.0),
-            Vec3::new(0.0, 0.0, 100.0),
-            Vec3::new(100.0, 0.0, 0.0),
-            0,
-        )],
+        vec![floor(50.0, 0)],
         vec![lambertian(0.5)],
         vec![Light::Directional(DirectionalLight {
             direction: light_dir,
@@ -169,12 +174,7 @@ fn lambertian_under_a_point_light_falls_off_as_cos_over_r_squared() {
     let cam = Camera::new(Vec3::new(0.0, 4.0, 0.0), Vec3::ZERO, Vec3::Z, 40.0, 3, 3).unwrap();
     let s = scene(
         cam.clone(),
-        vec![quad(
-            Vec3::new(-5.0, 0.0, -5.0),
-            Vec3::new(0.0, 0.0, 10.0),
-            Vec3::new(10.0, 0.0, 0.0),
-            0,
-        )],
+        vec![floor(5.0, 0)],
         vec![lambertian(0.8)],
         vec![Light::Point(PointLight {
             position: Vec3::new(0.0, h, 0.0),
@@ -202,12 +202,7 @@ fn no_shadow_acne_at_grazing_light() {
     let theta = 88f32.to_radians();
     let s = scene(
         cam.clone(),
-        vec![quad(
-            Vec3::new(-20.0, 0.0, -20.0),
-            Vec3::new(0.0, 0.0, 40.0),
-            Vec3::new(40.0, 0.0, 0.0),
-            0,
-        )],
+        vec![floor(20.0, 0)],
         vec![lambertian(1.0)],
         vec![Light::Directional(DirectionalLight {
             direction: Vec3::new(theta.sin(), -theta.cos(), 0.0),
@@ -241,15 +236,7 @@ fn shadow_rays_are_blocked_between_but_not_beyond_the_light() {
     let lit = |sphere_y: f32| {
         let s = scene(
             cam.clone(),
-            vec![
-                quad(
-                    Vec3::new(-5.0, 0.0, -5.0),
-                    Vec3::new(0.0, 0.0, 10.0),
-                    Vec3::new(10.0, 0.0, 0.0),
-                    0,
-                ),
-                sphere(Vec3::new(0.0, sphere_y, 0.0), 0.2, 0),
-            ],
+            vec![floor(5.0, 0), sphere(Vec3::new(0.0, sphere_y, 0.0), 0.2, 0)],
             vec![lambertian(0.8)],
             vec![Light::Point(PointLight {
                 position: Vec3::new(0.0, 2.0, 0.0),
@@ -279,15 +266,7 @@ fn image_is_identical_for_any_thread_count() {
     let cam = camera(Vec3::new(2.0, 1.5, 2.0), Vec3::new(0.0, 0.5, 0.0), 37, 29);
     let s = scene(
         cam,
-        vec![
-            quad(
-                Vec3::new(-5.0, 0.0, -5.0),
-                Vec3::new(0.0, 0.0, 10.0),
-                Vec3::new(10.0, 0.0, 0.0),
-                0,
-            ),
-            sphere(Vec3::new(0.0, 0.5, 0.0), 0.3, 1),
-        ],
+        vec![floor(5.0, 0), sphere(Vec3::new(0.0, 0.5, 0.0), 0.3, 1)],
         vec![
             lambertian(0.6),
             Material::Dielectric(Dielectric {
@@ -382,12 +361,7 @@ fn sun_lights_like_its_irradiance_and_shows_its_disk() {
     let cam = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 16, 16).unwrap();
     let s = scene(
         cam.clone(),
-        vec![quad(
-            Vec3::new(-50.0, 0.0, -50.0),
-            Vec3::new(0.0, 0.0, 100.0),
-            Vec3::new(100.0, 0.0, 0.0),
-            0,
-        )],
+        vec![floor(50.0, 0)],
         vec![lambertian(0.5)],
         vec![Light::Sun(sun.clone())],
         0.0,
