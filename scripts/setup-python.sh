@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Creates the project's Python environment <repo>/.venv (git-ignored) with exactly the
 # pinned packages of tests/python/requirements.txt: colour-science and friends for the
-# colour checks in tests/python and for scripts/gen_spectra.py.
+# colour checks in tests/python and for scripts/gen_spectra.py, and Mitsuba 3 (with
+# Dr.Jit), the reference renderer for the path tracer comparison tests and benchmarks.
 #
 # Idempotent: .venv/.requirements.sha256 records the sha256 of the requirements file the
 # environment was built from; when it matches, nothing is done. When it differs (or the
@@ -81,7 +82,10 @@ if ! "$VENV/bin/python" -m pip check; then
     die "pip check failed: tests/python/requirements.txt is missing a dependency or pins incompatible versions"
 fi
 
-if ! "$VENV/bin/python" -c 'import colour, numpy, scipy, OpenEXR, OpenImageIO, PIL, pytest, miepython' ; then
+# Mitsuba's variant is chosen only inside this check (scalar_spectral needs no libLLVM;
+# the llvm_* variants load Debian's libllvm19 at run time, see scripts/setup.sh).
+if ! "$VENV/bin/python" -c 'import colour, numpy, scipy, OpenEXR, OpenImageIO, PIL, pytest, miepython, drjit
+import mitsuba as mi; mi.set_variant("scalar_spectral")' ; then
     die "the installed packages do not import (see the traceback above)"
 fi
 

@@ -8,7 +8,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-APT_PACKAGES=(libembree-dev embree-tools pkg-config python3-venv python3-pip)
+# libllvm19: libLLVM.so.19.1 for the LLVM backend of Dr.Jit (Mitsuba 3's llvm_ad_* variants,
+# the reference renderer in .venv). Dr.Jit dlopens the last libLLVM*.so.* it finds in
+# /usr/lib/x86_64-linux-gnu, which is libLLVM.so.19.1 once this is installed; with only
+# Debian's libllvm15 it picks LLVM 15, which aborts in Dr.Jit's kernels ("LLVM ERROR: Cannot
+# select ... fminimum"). To pin it explicitly:
+# DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
+APT_PACKAGES=(libembree-dev embree-tools pkg-config python3-venv python3-pip libllvm19)
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
