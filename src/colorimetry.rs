@@ -199,59 +199,10 @@ impl SpectrumCsv {
 
     /// Parses `text`; `path` only names the file in error messages.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let file = path.display();
-        let err =
-            |line: usize, msg: String| HeronError::Invalid(format!("{file}: line {line}: {msg}"));
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let mut samples: Vec<(f32, f32)> = Vec::new();
-        let mut prev_line = 0;
-        let mut seen_content = false;
-        for (i, raw) in text.lines().enumerate() {
-            let n = i + 1;
-            let line = raw.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-            let first = !seen_content;
-            seen_content = true;
-            if first && fields[0].parse::<f64>().is_err() {
-                continue; // header line
-            }
-            if fields.len() != 2 {
-                return Err(err(
-                    n,
-                    format!(
-                        "expected two comma-separated numbers `wavelength_nm,value`, found {} field{} in {}",
-                        fields.len(),
-                        if fields.len() == 1 { "" } else { "s" },
-                        quote(line)
-                    ),
-                ));
-            }
-            let wl = number(fields[0]).map_err(|m| err(n, format!("wavelength (nm): {m}")))?;
-            let v = number(fields[1]).map_err(|m| err(n, format!("value: {m}")))?;
-            if let Some(&(w0, _)) = samples.last() {
-                if wl <= w0 {
-                    return Err(err(
-                        n,
-                        format!(
-                            "expected wavelengths in strictly increasing order, got {} nm after {} nm (line {prev_line})",
-                            fields[0], w0
-                        ),
-                    ));
-                }
-            }
-            samples.push((wl, v));
-            prev_line = n;
-        }
-        if samples.len() < 2 {
-            return Err(HeronError::Invalid(format!(
-                "{file}: expected at least 2 rows `wavelength_nm,value`, found {}",
-                samples.len()
-            )));
-        }
-        Ok(SpectrumCsv { samples })
+        let rows = parse_columns(text, path, &["wavelength_nm", "value"])?;
+        Ok(SpectrumCsv {
+            samples: rows.iter().map(|r| (r[0], r[1])).collect(),
+        })
     }
 
     /// The distribution on heron's 1 nm grid over 360–830 nm
@@ -264,6 +215,78 @@ impl SpectrumCsv {
     pub fn range(&self) -> (f32, f32) {
         (self.samples[0].0, self.samples[self.samples.len() - 1].0)
     }
+}
+
+/// Rows of a CSV whose first column is a wavelength in nm (strictly increasing) and
+/// whose other columns are numbers, named by `columns` (e.g. `["wavelength_nm", "n", "k"]`)
+/// in error messages; `#` comments, blank lines and one header line are skipped. At
+/// least two rows. Every error names the file and the line.
+pub fn parse_columns(text: &str, path: &Path, columns: &[&str]) -> Result<Vec<Vec<f32>>> {
+    let file = path.display();
+    let err = |line: usize, msg: String| HeronError::Invalid(format!("{file}: line {line}: {msg}"));
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let count_word = match columns.len() {
+        2 => "two",
+        3 => "three",
+        _ => "the",
+    };
+    let layout = columns.join(",");
+    let mut rows: Vec<Vec<f32>> = Vec::new();
+    let mut prev_line = 0;
+    let mut seen_content = false;
+    for (i, raw) in text.lines().enumerate() {
+        let n = i + 1;
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let first = !seen_content;
+        seen_content = true;
+        if first && fields[0].parse::<f64>().is_err() {
+            continue; // header line
+        }
+        if fields.len() != columns.len() {
+            return Err(err(
+                n,
+                format!(
+                    "expected {count_word} comma-separated numbers `{layout}`, found {} field{} in {}",
+                    fields.len(),
+                    if fields.len() == 1 { "" } else { "s" },
+                    quote(line)
+                ),
+            ));
+        }
+        let mut row = Vec::with_capacity(columns.len());
+        for (k, f) in fields.iter().enumerate() {
+            let what = if k == 0 {
+                "wavelength (nm)"
+            } else {
+                columns[k]
+            };
+            row.push(number(f).map_err(|m| err(n, format!("{what}: {m}")))?);
+        }
+        if let Some(prev) = rows.last() {
+            if row[0] <= prev[0] {
+                return Err(err(
+                    n,
+                    format!(
+                        "expected wavelengths in strictly increasing order, got {} nm after {} nm (line {prev_line})",
+                        fields[0], prev[0]
+                    ),
+                ));
+            }
+        }
+        rows.push(row);
+        prev_line = n;
+    }
+    if rows.len() < 2 {
+        return Err(HeronError::Invalid(format!(
+            "{file}: expected at least 2 rows `{layout}`, found {}",
+            rows.len()
+        )));
+    }
+    Ok(rows)
 }
 
 fn quote(s: &str) -> String {

@@ -2,6 +2,8 @@
 //!
 //! See ARCHITECTURE.md for the map of the code and how one sample flows.
 #![deny(unsafe_code)]
+// `!(x > 0.0)` is how the sampling code rejects NaN along with non-positive values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
 pub mod bench;
@@ -16,6 +18,7 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod render;
+pub mod sampler;
 pub mod scene;
 pub mod sky;
 pub mod spectrum;

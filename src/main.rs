@@ -201,6 +201,9 @@ struct ConvergeArgs {
     /// How hero wavelengths are drawn in the measured runs: uniform or visible.
     #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
     wavelengths: String,
+    /// whitted or path; default: the scene's.
+    #[arg(long, value_parser = ["whitted", "path"])]
+    integrator: Option<String>,
 }
 
 fn wavelength_sampler(name: &str) -> heron::spectrum::WavelengthSampler {
@@ -300,6 +303,14 @@ struct RenderArgs {
     /// How hero wavelengths are drawn: uniform or visible (pdf ∝ 1/cosh²(0.0072(λ − 538))).
     #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
     wavelengths: String,
+    /// whitted (the seed's tracer) or path (path tracing with MIS); default: the scene's
+    /// [render] integrator, else whitted.
+    #[arg(long, value_parser = ["whitted", "path"])]
+    integrator: Option<String>,
+    /// Maximum number of scattering events per path (overrides the scene's
+    /// render.max_depth).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    max_depth: Option<u32>,
     /// Do not draw the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -391,8 +402,15 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         bail!("--spp: expected at least 1");
     }
-    let scene = load_scene(&args.scene)?;
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(d) = args.max_depth {
+        scene.settings.max_depth = d;
+    }
     let mut opts = RenderOptions::from_scene(&scene);
+    if let Some(i) = &args.integrator {
+        opts.integrator = heron::integrator::IntegratorKind::parse(i)
+            .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?;
+    }
     if let Some(s) = args.spp {
         opts.spp = s;
     }
@@ -433,12 +451,13 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         p.commit()?;
     }
     eprintln!(
-        "{}: {}x{} at {} spp, {} lanes in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
+        "{}: {}x{} at {} spp, {} lanes, {} in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
         display(&exr_path),
         film.width,
         film.height,
         opts.spp,
         opts.lanes,
+        opts.integrator.name(),
         stats.wall.as_secs_f64(),
         stats.total_rays(),
         stats.counters.rays,
@@ -460,13 +479,18 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
     base.seed = a.seed;
     base.threads = a.threads.map_or(0, usize::from);
     base.wavelengths = wavelength_sampler(&a.wavelengths);
+    if let Some(i) = &a.integrator {
+        base.integrator = heron::integrator::IntegratorKind::parse(i)
+            .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?;
+    }
     let (ref_wall, rows) =
         heron::converge::converge(&scene, &base, a.reference_spp, &a.lanes, &a.spp)?;
     println!(
-        "# {}: {}x{}, {} wavelengths, reference {} spp x 8 lanes ({:.1} s)",
+        "# {}: {}x{}, {}, {} wavelengths, reference {} spp x 8 lanes ({:.1} s)",
         a.scene.display(),
         scene.camera.width,
         scene.camera.height,
+        base.integrator.name(),
         a.wavelengths,
         a.reference_spp,
         ref_wall

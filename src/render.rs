@@ -1,16 +1,20 @@
-//! Rendering: tiles on rayon, camera rays traced as Embree 8-wide packets, the
-//! integrator per lane, and deterministic seeding.
+//! Rendering: tiles on rayon, camera rays traced as Embree 8-wide packets, the chosen
+//! integrator per pixel sample, splats from anywhere in the image, and deterministic
+//! seeding.
 //!
-//! Determinism: every (pixel, sample) has its own random stream (math::rng), each pixel's
-//! samples are summed in sample order by the one worker that owns its tile, and tiles are
-//! gathered in tile order, so the image is bit-identical whatever the thread count.
-use crate::accel::embree::{self, RayQuery};
-use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins};
+//! Determinism: every (pixel, sample) has its own random numbers (the sampler depends
+//! only on seed, pixel and sample index), each pixel's samples are summed in sample
+//! order by the one worker that owns its tile, and tiles are gathered in tile order.
+//! Splats (contributions an integrator makes to other pixels than its own) are kept in
+//! a list per tile, in the order they were made, and added to the film tile by tile in
+//! tile order, pass by pass. So the image is bit-identical whatever the thread count.
+use crate::accel::embree::{self, Hit, RayQuery};
+use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
-use crate::integrator::{whitted, Context, TraceCounters};
-use crate::math::Rng;
+use crate::integrator::{self, Context, IntegratorKind, TraceCounters};
+use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectrum::{SampledWavelengths, WavelengthSampler};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampler};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -34,6 +38,8 @@ pub struct RenderOptions {
     /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
     /// (0: none).
     pub spectral_bins: usize,
+    /// The integrator (default: the scene's `[render] integrator`).
+    pub integrator: IntegratorKind,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
 }
@@ -48,6 +54,7 @@ impl RenderOptions {
             packets: true,
             wavelengths: WavelengthSampler::Uniform,
             spectral_bins: 0,
+            integrator: scene.settings.integrator,
             progress: None,
         }
     }
@@ -105,18 +112,6 @@ pub fn build_accel(scene: &Scene, device: &embree::Device) -> Result<embree::Sce
         }
     }
     Ok(b.commit()?)
-}
-
-struct TileResult {
-    x0: u32,
-    y0: u32,
-    w: u32,
-    h: u32,
-    xyz: Vec<[f32; 3]>,
-    /// Per pixel, `bins` values (empty without spectral output).
-    spectral: Vec<f32>,
-    counters: TraceCounters,
-    nonfinite: u64,
 }
 
 /// A scene ready to trace: the Embree device and committed scene, built once and
@@ -186,76 +181,204 @@ fn render_with(
     pool: &rayon::ThreadPool,
     opts: &RenderOptions,
 ) -> Result<(Film, RenderStats)> {
+    let ctx = Context { scene, accel };
+    let kind = opts.integrator;
+    let integrate = move |n: Lanes| -> SampleFn {
+        match n {
+            Lanes::One => SampleFn::One(Box::new(move |c, r, h, wl, s, k, _| {
+                integrator::radiance::<1>(kind, c, r, h, wl, s, k)
+            })),
+            Lanes::Four => SampleFn::Four(Box::new(move |c, r, h, wl, s, k, _| {
+                integrator::radiance::<4>(kind, c, r, h, wl, s, k)
+            })),
+            Lanes::Eight => SampleFn::Eight(Box::new(move |c, r, h, wl, s, k, _| {
+                integrator::radiance::<8>(kind, c, r, h, wl, s, k)
+            })),
+        }
+    };
+    render_passes(&ctx, pool, opts, opts.spp, &integrate)
+}
+
+/// The lane counts a render can use, chosen once per render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Lanes {
+    One,
+    Four,
+    Eight,
+}
+
+/// What one pixel sample computes: (context, camera ray, its first hit if traced,
+/// wavelengths, sampler, counters, splats) -> radiance along the camera ray. Chosen once
+/// per render, so the per-sample call is one indirect call on top of the integrator's
+/// `match`.
+pub(crate) type SampleFnN<const N: usize> = Box<
+    dyn Fn(
+            &Context,
+            Ray,
+            Option<Option<Hit>>,
+            &SampledWavelengths<N>,
+            &mut Sampler,
+            &mut TraceCounters,
+            &mut Splats,
+        ) -> SampledSpectrum<N>
+        + Send
+        + Sync,
+>;
+
+pub(crate) enum SampleFn {
+    One(SampleFnN<1>),
+    Four(SampleFnN<4>),
+    Eight(SampleFnN<8>),
+}
+
+/// Renders `spp` samples per pixel in passes of `pass_spp` samples (a pass boundary only
+/// matters to splats, whose lists are kept per tile for one pass; one pass when the
+/// integrator does not splat).
+pub(crate) fn render_passes(
+    ctx: &Context,
+    pool: &rayon::ThreadPool,
+    opts: &RenderOptions,
+    pass_spp: u32,
+    integrate: &(dyn Fn(Lanes) -> SampleFn + Sync),
+) -> Result<(Film, RenderStats)> {
     if opts.spp == 0 {
         return Err(HeronError::Invalid("spp must be at least 1".into()));
     }
-    if ![1, 4, 8].contains(&opts.lanes) {
-        return Err(HeronError::Invalid(format!(
-            "lanes: expected 1, 4 or 8, got {}",
-            opts.lanes
-        )));
-    }
-    let ctx = Context { scene, accel };
+    let lanes = match opts.lanes {
+        1 => Lanes::One,
+        4 => Lanes::Four,
+        8 => Lanes::Eight,
+        n => {
+            return Err(HeronError::Invalid(format!(
+                "lanes: expected 1, 4 or 8, got {n}"
+            )))
+        }
+    };
+    let sample = integrate(lanes);
+    let scene = ctx.scene;
     let cam = &scene.camera;
     let (tw, th) = (cam.width.div_ceil(TILE), cam.height.div_ceil(TILE));
     let tiles: Vec<(u32, u32)> = (0..th)
         .flat_map(|ty| (0..tw).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let n_tiles = tiles.len() as u64;
+    let pass_spp = pass_spp.clamp(1, opts.spp);
+    let passes: Vec<(u32, u32)> = (0..opts.spp)
+        .step_by(pass_spp as usize)
+        .map(|s0| (s0, (s0 + pass_spp).min(opts.spp)))
+        .collect();
+    let n_work = tiles.len() as u64 * passes.len() as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
-    let start = Instant::now();
-    let results: Vec<TileResult> = pool.install(|| {
-        tiles
-            .par_iter()
-            .map(|&(x0, y0)| {
-                let r = match opts.lanes {
-                    1 => render_tile::<1>(&ctx, opts, x0, y0),
-                    4 => render_tile::<4>(&ctx, opts, x0, y0),
-                    _ => render_tile::<8>(&ctx, opts, x0, y0),
-                };
-                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                if let Some(p) = &opts.progress {
-                    p(k, n_tiles);
-                }
-                r
-            })
-            .collect()
-    });
-    let wall = start.elapsed();
     let bins = (opts.spectral_bins > 0).then_some(SpectralBins {
         count: opts.spectral_bins,
     });
     let npix = (cam.width * cam.height) as usize;
-    let mut film = Film {
-        width: cam.width,
-        height: cam.height,
-        xyz: vec![[0.0; 3]; npix],
-        spectral: bins.map(|b| (b, vec![0.0; npix * b.count])),
-    };
+    let nb = opts.spectral_bins;
+    // Unnormalised sums over the whole render: XYZ and bins per pixel, finite samples per
+    // pixel, and splatted XYZ.
+    let mut sum_xyz = vec![[0.0f64; 3]; npix];
+    let mut sum_bins = vec![0.0f64; npix * nb];
+    let mut good = vec![0u32; npix];
+    let mut splat = vec![[0.0f64; 3]; npix];
+    let mut any_splat = false;
     let mut stats = RenderStats {
-        wall,
         samples: cam.width as u64 * cam.height as u64 * opts.spp as u64,
         ..Default::default()
     };
-    for t in results {
-        for y in 0..t.h {
-            for x in 0..t.w {
-                let (dst, src) = (
-                    ((t.y0 + y) * cam.width + t.x0 + x) as usize,
-                    (y * t.w + x) as usize,
-                );
-                film.xyz[dst] = t.xyz[src];
-                if let Some((b, data)) = &mut film.spectral {
-                    data[dst * b.count..(dst + 1) * b.count]
-                        .copy_from_slice(&t.spectral[src * b.count..(src + 1) * b.count]);
+    let start = Instant::now();
+    for &(s0, s1) in &passes {
+        let results: Vec<TileResult> = pool.install(|| {
+            tiles
+                .par_iter()
+                .map(|&(x0, y0)| {
+                    let r = match &sample {
+                        SampleFn::One(f) => render_tile::<1>(ctx, opts, x0, y0, s0..s1, f),
+                        SampleFn::Four(f) => render_tile::<4>(ctx, opts, x0, y0, s0..s1, f),
+                        SampleFn::Eight(f) => render_tile::<8>(ctx, opts, x0, y0, s0..s1, f),
+                    };
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    if let Some(p) = &opts.progress {
+                        p(k, n_work);
+                    }
+                    r
+                })
+                .collect()
+        });
+        for t in results {
+            for y in 0..t.h {
+                for x in 0..t.w {
+                    let (dst, src) = (
+                        ((t.y0 + y) * cam.width + t.x0 + x) as usize,
+                        (y * t.w + x) as usize,
+                    );
+                    for (a, b) in sum_xyz[dst].iter_mut().zip(t.xyz[src]) {
+                        *a += b;
+                    }
+                    good[dst] += t.good[src];
+                    for b in 0..nb {
+                        sum_bins[dst * nb + b] += t.spectral[src * nb + b];
+                    }
                 }
             }
+            for &(p, c) in &t.splats.list {
+                any_splat = true;
+                for (a, b) in splat[p as usize].iter_mut().zip(c) {
+                    *a += b as f64;
+                }
+            }
+            stats.counters.rays += t.counters.rays;
+            stats.counters.shadow_rays += t.counters.shadow_rays;
+            stats.nonfinite += t.nonfinite + t.splats.nonfinite;
         }
-        stats.counters.rays += t.counters.rays;
-        stats.counters.shadow_rays += t.counters.shadow_rays;
-        stats.nonfinite += t.nonfinite;
     }
+    stats.wall = start.elapsed();
+    // Non-finite samples are left out and counted: a pixel's mean is over its finite
+    // samples. Splats are estimates of the whole image per sample, so they are divided
+    // by the number of samples per pixel.
+    let inv = |n: u32| if n > 0 { 1.0 / n as f64 } else { 0.0 };
+    let inv_spp = 1.0 / opts.spp as f64;
+    let xyz = (0..npix)
+        .map(|i| {
+            let k = inv(good[i]);
+            let mut c = [0.0f32; 3];
+            for j in 0..3 {
+                let v = sum_xyz[i][j] * k;
+                c[j] = if any_splat {
+                    (v + splat[i][j] * inv_spp) as f32
+                } else {
+                    v as f32
+                };
+            }
+            c
+        })
+        .collect();
+    let spectral = bins.map(|b| {
+        let data = (0..npix * nb)
+            .map(|j| (sum_bins[j] * inv(good[j / nb])) as f32)
+            .collect();
+        (b, data)
+    });
+    let film = Film {
+        width: cam.width,
+        height: cam.height,
+        xyz,
+        spectral,
+    };
     Ok((film, stats))
+}
+
+struct TileResult {
+    x0: u32,
+    y0: u32,
+    w: u32,
+    h: u32,
+    /// Per pixel: sums of XYZ and of the spectral bins over the finite samples, and
+    /// their count.
+    xyz: Vec<[f64; 3]>,
+    spectral: Vec<f64>,
+    good: Vec<u32>,
+    splats: Splats,
+    counters: TraceCounters,
+    nonfinite: u64,
 }
 
 fn render_tile<const N: usize>(
@@ -263,6 +386,8 @@ fn render_tile<const N: usize>(
     opts: &RenderOptions,
     x0: u32,
     y0: u32,
+    samples: std::ops::Range<u32>,
+    sample_fn: &SampleFnN<N>,
 ) -> TileResult {
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
@@ -275,7 +400,9 @@ fn render_tile<const N: usize>(
     let mut counters = TraceCounters::default();
     let mut nonfinite = 0u64;
     let mut good = vec![0u32; (w * h) as usize];
-    let mut rngs: [Rng; PACKET] = std::array::from_fn(|_| Rng::new(0, 0));
+    let mut splats = Splats::new(cam.width * cam.height);
+    let base = Sampler::independent(opts.seed, cam.width);
+    let mut samplers: [Sampler; PACKET] = std::array::from_fn(|_| base.clone());
     let mut rays = [RayQuery {
         origin: cam.eye,
         dir: glam::Vec3::Z,
@@ -291,15 +418,14 @@ fn render_tile<const N: usize>(
             } else {
                 (1u8 << lanes) - 1
             };
-            for s in 0..opts.spp {
+            for s in samples.clone() {
                 for k in 0..lanes {
                     let (px, py) = (x0 + xs + k as u32, y0 + y);
-                    let pixel = py as u64 * cam.width as u64 + px as u64;
-                    let mut rng = Rng::for_sample(opts.seed, pixel, s as u64);
-                    let (jx, jy) = (rng.uniform(), rng.uniform());
-                    wls[k] = SampledWavelengths::sample(opts.wavelengths, rng.uniform());
-                    rays[k].dir = cam.direction(px as f32 + jx, py as f32 + jy);
-                    rngs[k] = rng;
+                    let sampler = &mut samplers[k];
+                    sampler.start_pixel_sample(px, py, s);
+                    let j = sampler.get_pixel_2d();
+                    wls[k] = SampledWavelengths::sample(opts.wavelengths, sampler.get_1d());
+                    rays[k].dir = cam.direction(px as f32 + j.x, py as f32 + j.y);
                 }
                 let hits = if opts.packets {
                     counters.rays += lanes as u64;
@@ -309,13 +435,14 @@ fn render_tile<const N: usize>(
                 };
                 for k in 0..lanes {
                     let ray = Ray::new(cam.eye, rays[k].dir, 0.0, f32::INFINITY);
-                    let l = whitted::radiance(
+                    let l = sample_fn(
                         ctx,
                         ray,
                         hits.map(|h| h[k]),
                         &wls[k],
-                        &mut rngs[k],
+                        &mut samplers[k],
                         &mut counters,
+                        &mut splats,
                     );
                     let i = (y * w + xs + k as u32) as usize;
                     if !l.is_finite() {
@@ -335,21 +462,6 @@ fn render_tile<const N: usize>(
             }
         }
     }
-    // Non-finite samples are left out and counted: the mean is over the finite ones.
-    let inv = |n: u32| if n > 0 { 1.0 / n as f64 } else { 0.0 };
-    let xyz = xyz
-        .iter()
-        .zip(&good)
-        .map(|(c, &n)| {
-            let k = inv(n);
-            [(c[0] * k) as f32, (c[1] * k) as f32, (c[2] * k) as f32]
-        })
-        .collect();
-    let spectral = spectral
-        .iter()
-        .enumerate()
-        .map(|(j, &v)| (v * inv(good[j / opts.spectral_bins.max(1)])) as f32)
-        .collect();
     TileResult {
         x0,
         y0,
@@ -357,6 +469,8 @@ fn render_tile<const N: usize>(
         h,
         xyz,
         spectral,
+        good,
+        splats,
         counters,
         nonfinite,
     }

@@ -1,18 +1,19 @@
 //! `heron trace`: one ray at one wavelength through a scene, event by event, with the
-//! renderer's own code (Embree queries, `Interaction`, `reflect`, `refract`, the Fresnel
-//! equations, the ε offset). For prism and droplet experiments.
+//! renderer's own code (Embree queries, `Interaction`, the materials' `sample` restricted
+//! to their delta lobes, the ε offset). For prism and droplet experiments.
 //!
-//! At a dielectric the ray refracts unless the `path` string says `R` (reflect) or `T`
-//! (transmit) for that dielectric event; total internal reflection forces `R`. Mirrors
-//! reflect; Lambertian and plain glossy surfaces absorb; a miss escapes.
+//! At a surface with a reflecting and a transmitting delta lobe (a smooth dielectric, or
+//! the seed's glossy over glass) the ray refracts unless the `path` string says `R`
+//! (reflect) or `T` (transmit) for that event; total internal reflection forces `R`.
+//! Surfaces with only a reflecting delta lobe (mirrors, smooth metals) reflect; the
+//! others (Lambertian, glossy, rough) absorb; a miss escapes.
 use crate::accel::embree::{self, RayQuery};
-use crate::bsdf::dielectric::refract;
-use crate::bsdf::fresnel::fresnel_dielectric;
-use crate::bsdf::mirror::reflect;
-use crate::bsdf::Material;
+use crate::bsdf::{BsdfContext, LobeFlags};
 use crate::geometry::{Interaction, Ray};
 use crate::scene::Scene;
+use crate::spectrum::SampledWavelengths;
 use crate::{HeronError, Result};
+use glam::Vec2;
 use glam::Vec3;
 use serde::Serialize;
 
@@ -140,41 +141,52 @@ pub fn trace(
             fresnel_r: None,
             distance: Some(hit.t),
         };
-        let dielectric = match material {
-            Material::Dielectric(d) => Some(d),
-            Material::Glossy(g) => g.base.as_ref(),
-            _ => None,
+        let flags = material.flags();
+        let frame = it.frame();
+        let wo_local = frame.to_local(wo);
+        let wl = SampledWavelengths::<1> {
+            lambda: [lambda_nm],
+            pdf: [1.0],
         };
-        let out = match (material, dielectric) {
-            (Material::Mirror(_), _) => {
-                ev.kind = EventKind::Reflect;
-                Some(reflect(wo, it.normal))
-            }
-            (_, Some(d)) => {
-                let n = d.ior.eval(lambda_nm);
-                let (ni, nt) = if it.front_face { (1.0, n) } else { (n, 1.0) };
+        let spec = |side: LobeFlags| {
+            let ctx = BsdfContext::radiance::<1>().with_lobes(LobeFlags::SPECULAR | side);
+            material
+                .sample(wo_local, 0.5, Vec2::ZERO, &wl, &ctx)
+                .map(|b| frame.to_world(b.wi))
+        };
+        let two_sided_delta =
+            flags.contains(LobeFlags::SPECULAR | LobeFlags::REFLECTION | LobeFlags::TRANSMISSION);
+        let out = if two_sided_delta {
+            if let Some(d) = material.interface() {
+                let (ni, nt) = d.indices(lambda_nm, it.front_face);
                 ev.n_i = Some(ni);
                 ev.n_t = Some(nt);
-                let eta = it.ior1_over_ior2;
-                ev.fresnel_r = Some(fresnel_dielectric(wo.dot(it.normal), eta));
-                let want_reflect = reflect_at.get(dielectric_events).copied().unwrap_or(false);
-                dielectric_events += 1;
-                match refract(wo, it.normal, eta) {
-                    None => {
-                        ev.kind = EventKind::TotalInternalReflection;
-                        Some(reflect(wo, it.normal))
-                    }
-                    Some(_) if want_reflect => {
-                        ev.kind = EventKind::Reflect;
-                        Some(reflect(wo, it.normal))
-                    }
-                    Some(t) => {
-                        ev.kind = EventKind::Refract;
-                        Some(t)
-                    }
+                ev.fresnel_r = Some(d.fresnel_r(wo_local, lambda_nm));
+            }
+            let want_reflect = reflect_at.get(dielectric_events).copied().unwrap_or(false);
+            dielectric_events += 1;
+            match spec(LobeFlags::TRANSMISSION) {
+                None => {
+                    ev.kind = EventKind::TotalInternalReflection;
+                    spec(LobeFlags::REFLECTION)
+                }
+                Some(_) if want_reflect => {
+                    ev.kind = EventKind::Reflect;
+                    // The lecture's pure refraction gives reflection no weight outside
+                    // total internal reflection; the law of reflection still says where
+                    // an R event goes.
+                    spec(LobeFlags::REFLECTION).or(Some(crate::bsdf::reflect(wo, it.normal)))
+                }
+                Some(t) => {
+                    ev.kind = EventKind::Refract;
+                    Some(t)
                 }
             }
-            _ => None,
+        } else if flags.contains(LobeFlags::SPECULAR | LobeFlags::REFLECTION) {
+            ev.kind = EventKind::Reflect;
+            spec(LobeFlags::REFLECTION)
+        } else {
+            None
         };
         ev.outgoing = out.map(arr);
         events.push(ev);

@@ -9,19 +9,20 @@ use heron::geometry::{Mesh, Shape, ShapeKind};
 use heron::light::{Light, PointLight};
 use heron::math::Rng;
 use heron::render::{render, RenderOptions, Renderer};
-use heron::scene::{RenderSettings, Scene};
+use heron::scene::{RenderSettings, Scene, SceneParts};
 use heron::spectrum::ior::{self, Ior};
 use heron::spectrum::DenseSpectrum;
 use heron::trace::{trace, EventKind, TraceReport};
 
 fn glass_scene(shapes: Vec<Shape>, ior: Ior) -> Scene {
-    Scene {
+    Scene::from_parts(SceneParts {
         source: "test".into(),
         camera: Camera::new(Vec3::new(0.0, 0.0, -5.0), Vec3::ZERO, Vec3::Y, 1.0, 8, 8).unwrap(),
         shapes,
-        materials: vec![Material::Dielectric(Dielectric { ior, fresnel: true })],
+        materials: vec![Material::Dielectric(Dielectric::new(ior, true))],
         material_names: vec!["glass".into()],
         lights: vec![],
+        shape_light: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
         settings: RenderSettings {
@@ -29,8 +30,9 @@ fn glass_scene(shapes: Vec<Shape>, ior: Ior) -> Scene {
             max_depth: 32,
             epsilon: 1e-4,
             seed: 0,
+            ..Default::default()
         },
-    }
+    })
 }
 
 /// The 60° prism of scenes/meshes/prism60.obj.

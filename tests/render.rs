@@ -8,7 +8,7 @@ use heron::film::Film;
 use heron::geometry::{Mesh, Shape, ShapeKind};
 use heron::light::{DirectionalLight, Light, PointLight};
 use heron::render::{render, RenderOptions};
-use heron::scene::{RenderSettings, Scene};
+use heron::scene::{RenderSettings, Scene, SceneParts};
 use heron::spectrum::ior::Ior;
 use heron::spectrum::DenseSpectrum;
 use std::f32::consts::PI;
@@ -24,13 +24,14 @@ fn scene(
     lights: Vec<Light>,
     bg: f32,
 ) -> Scene {
-    Scene {
+    Scene::from_parts(SceneParts {
         source: "test".into(),
         camera,
         shapes,
         material_names: (0..materials.len()).map(|i| format!("m{i}")).collect(),
         materials,
         lights,
+        shape_light: vec![],
         background: DenseSpectrum::constant(bg),
         sky: None,
         settings: RenderSettings {
@@ -38,8 +39,9 @@ fn scene(
             max_depth: 64,
             epsilon: 1e-4,
             seed: 5,
+            ..Default::default()
         },
-    }
+    })
 }
 
 fn quad(origin: Vec3, e1: Vec3, e2: Vec3, material: u32) -> Shape {
@@ -94,22 +96,13 @@ fn white_furnace_specular_objects_vanish() {
         Material::Mirror(Mirror {
             rho_s: DenseSpectrum::constant(1.0),
         }),
-        Material::Dielectric(Dielectric {
-            ior: Ior::Constant(1.5),
-            fresnel: true,
-        }),
-        Material::Dielectric(Dielectric {
-            ior: Ior::Constant(2.42),
-            fresnel: false,
-        }),
+        Material::Dielectric(Dielectric::new(Ior::Constant(1.5), true)),
+        Material::Dielectric(Dielectric::new(Ior::Constant(2.42), false)),
         Material::Glossy(Glossy {
             rho_d: DenseSpectrum::constant(0.0),
             rho_s: 0.1,
             shininess: 42.0,
-            base: Some(Dielectric {
-                ior: Ior::Constant(1.5),
-                fresnel: true,
-            }),
+            base: Some(Dielectric::new(Ior::Constant(1.5), true)),
         }),
     ];
     for m in materials {
@@ -269,10 +262,7 @@ fn image_is_identical_for_any_thread_count() {
         vec![floor(5.0, 0), sphere(Vec3::new(0.0, 0.5, 0.0), 0.3, 1)],
         vec![
             lambertian(0.6),
-            Material::Dielectric(Dielectric {
-                ior: Ior::Constant(1.5),
-                fresnel: true,
-            }),
+            Material::Dielectric(Dielectric::new(Ior::Constant(1.5), true)),
         ],
         vec![Light::Point(PointLight {
             position: Vec3::new(0.0, 1.0, 0.0),

@@ -122,8 +122,11 @@ fn default_scene_has_the_lecture_numbers() {
     let expect = (c.look_at - c.eye).normalize();
     assert!((centre - expect).length() < 1e-6, "{centre} vs {expect}");
 
-    // Point light of intensity π: π times D65 scaled to Y = 1.
-    assert_eq!(s.lights.len(), 1);
+    // Point light of intensity π: π times D65 scaled to Y = 1; the background is the
+    // environment light after it.
+    assert_eq!(s.lights.len(), 2);
+    assert_eq!(s.environment, Some(1));
+    assert!(matches!(s.lights[1], Light::Environment(_)));
     let Light::Point(p) = &s.lights[0] else {
         panic!("light {:?}", s.lights[0])
     };
@@ -336,17 +339,17 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[[shapes]]\ntype = 3\n", &["shapes[0].type: expected", "sphere", "got 3"]),
     ("", "[materials.x]\ntype = \"glas\"\n",
      &["materials.x.type: unknown variant \"glas\", expected one of lambertian, mirror, dielectric, glossy"]),
-    ("", "[[lights]]\ntype = \"spot\"\n",
-     &["lights[0].type: unknown variant \"spot\", expected one of point, directional"]),
+    ("", "[[lights]]\ntype = \"laser\"\n",
+     &["lights[0].type: unknown variant \"laser\", expected one of point, directional, sun, spot"]),
     // Unknown keys
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = 0.5\ncolour = 1\n",
      &["unknown key \"colour\" at materials.x (expected one of type, rho_d)"]),
     ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\nradus = 1\n",
-     &["unknown key \"radus\" at shapes[0] (expected one of type, center, radius, material)"]),
+     &["unknown key \"radus\" at shapes[0] (expected one of type, center, radius, material, emission, two_sided)"]),
     ("", "[materials.x]\ntype = \"mirror\"\nior = 1.5\n",
      &["unknown key \"ior\" at materials.x (expected one of type, rho_s)"]),
     ("", "[render]\nsamples = 4\n",
-     &["unknown key \"samples\" at render (expected one of spp, max_depth, epsilon, seed)"]),
+     &["unknown key \"samples\" at render (expected one of spp, max_depth, epsilon, seed, integrator, rr_depth, light_sampler)"]),
     ("backgroun = 1\n", "", &["unknown key \"backgroun\" at the top level", "background"]),
     ("", "[camera.extra]\nx = 1\n", &["unknown key \"extra\" at camera (expected one of eye, "]),
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { spectrum = \"E\", scal = 1 }\n",

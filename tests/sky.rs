@@ -7,7 +7,7 @@ use heron::camera::Camera;
 use heron::geometry::{Shape, ShapeKind};
 use heron::math::Rng;
 use heron::render::Renderer;
-use heron::scene::{RenderSettings, Scene};
+use heron::scene::{RenderSettings, Scene, SceneParts};
 use heron::sky::aristotle::{self, AristotleSky};
 use heron::sky::{airy, descartes, AirySky, DescartesSky, MieSky, Polarisation, Sky};
 use heron::spectrum::{cie, ior, DenseSpectrum};
@@ -512,7 +512,7 @@ fn sky_profile_cli_rejects_bad_values_in_one_line() {
 // ---------------------------------------------------------------- Monte Carlo
 
 fn water_drop_scene() -> Scene {
-    Scene {
+    Scene::from_parts(SceneParts {
         source: "test".into(),
         camera: Camera::new(Vec3::new(0.0, 0.0, -5.0), Vec3::ZERO, Vec3::Y, 1.0, 8, 8).unwrap(),
         shapes: vec![Shape {
@@ -522,12 +522,13 @@ fn water_drop_scene() -> Scene {
             },
             material: 0,
         }],
-        materials: vec![Material::Dielectric(Dielectric {
-            ior: ior::named("water").unwrap(),
-            fresnel: true,
-        })],
+        materials: vec![Material::Dielectric(Dielectric::new(
+            ior::named("water").unwrap(),
+            true,
+        ))],
         material_names: vec!["water".into()],
         lights: vec![],
+        shape_light: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
         settings: RenderSettings {
@@ -535,8 +536,9 @@ fn water_drop_scene() -> Scene {
             max_depth: 32,
             epsilon: 1e-4,
             seed: 0,
+            ..Default::default()
         },
-    }
+    })
 }
 
 /// Parallel rays (sunlight travelling along +z) hit a unit water sphere at impact

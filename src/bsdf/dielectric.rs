@@ -1,17 +1,182 @@
 //! Smooth dielectric interface: refraction after the seed ("Refraction and total internal
 //! reflection"), with a Fresnel-weighted choice between reflection and refraction.
+//!
+//! As a BSDF (pbrt-v4 §9.5) it is two deltas: reflection with weight R and transmission
+//! with weight T = 1 − R, where R is the unpolarised Fresnel reflectance
+//! ([`super::fresnel`]). Sampling picks reflection with probability R, so each branch
+//! has throughput 1 (the seed's tracer with Fresnel weighting, estimated with one ray).
+//! Transmitted radiance is scaled by (n_i/n_t)² (radiance is not invariant across an
+//! interface; Veach 1997 §5.2), importance is not.
+//!
+//! With `fresnel = false` the lecture's pure refraction: always refract, reflect only on
+//! total internal reflection.
+//!
+//! **Dispersion.** With n(λ) the direction of refraction differs per lane; the
+//! refraction follows the hero (lane 0) and ends the companions (hero × N, others × 0).
+//! A reflection sends every lane the same way, so they stay, each weighted by its own
+//! R(λᵢ) while the choice was made with the hero's R(λ₀): lane i's factor is
+//! R(λᵢ)/R(λ₀). With `fresnel = false` the choice between the two is deterministic in the
+//! hero (TIR or not), so a companion whose own choice would differ cannot be weighted;
+//! both branches then end the companions. This is the one place in heron where that
+//! decision is written.
+use super::fresnel::fresnel_dielectric;
+use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::spectrum::ior::Ior;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
-    /// Index of refraction of the inside relative to the outside (air/vacuum = 1), a
-    /// function of wavelength.
+    /// Index of refraction inside (on the side opposite the outward normal), a function
+    /// of wavelength.
     pub ior: Ior,
+    /// Index of the medium outside (default 1, air or vacuum); e.g. water around a glass.
+    pub outside: Ior,
     /// Weight reflection and refraction by the Fresnel equations (default). When false,
     /// the lecture's pure refraction: always refract, reflect only on total internal
     /// reflection.
     pub fresnel: bool,
+}
+
+const REFL: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::REFLECTION);
+const TRANS: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::TRANSMISSION);
+
+impl Dielectric {
+    /// An interface between `ior` inside and vacuum (n = 1) outside.
+    pub fn new(ior: Ior, fresnel: bool) -> Self {
+        Dielectric {
+            ior,
+            outside: Ior::Constant(1.0),
+            fresnel,
+        }
+    }
+
+    /// True when the relative index depends on wavelength.
+    #[inline]
+    pub fn is_dispersive(&self) -> bool {
+        self.ior.is_dispersive() || self.outside.is_dispersive()
+    }
+
+    /// Relative index n_inside/n_outside at `lambda` nm.
+    #[inline]
+    pub fn eta(&self, lambda: f32) -> f32 {
+        match self.outside {
+            Ior::Constant(1.0) => self.ior.eval(lambda),
+            _ => self.ior.eval(lambda) / self.outside.eval(lambda),
+        }
+    }
+
+    /// (n_i, n_t): the indices on the incident side and beyond, for a ray arriving from
+    /// outside (`front_face`) or inside.
+    #[inline]
+    pub fn indices(&self, lambda: f32, front_face: bool) -> (f32, f32) {
+        let (n_in, n_out) = (self.ior.eval(lambda), self.outside.eval(lambda));
+        if front_face {
+            (n_out, n_in)
+        } else {
+            (n_in, n_out)
+        }
+    }
+
+    /// The seed's ior1_over_ior2 = n_i/n_t.
+    #[inline]
+    pub fn ior1_over_ior2(&self, lambda: f32, front_face: bool) -> f32 {
+        let eta = self.eta(lambda);
+        if front_face {
+            1.0 / eta
+        } else {
+            eta
+        }
+    }
+
+    /// Unpolarised Fresnel reflectance for light leaving along local `wo`.
+    #[inline]
+    pub fn fresnel_r(&self, wo: Vec3, lambda: f32) -> f32 {
+        fresnel_dielectric(wo.z.abs(), self.ior1_over_ior2(lambda, wo.z > 0.0))
+    }
+
+    pub fn flags(&self) -> LobeFlags {
+        let t = if self.is_dispersive() {
+            TRANS | LobeFlags::WAVELENGTH_DEPENDENT
+        } else {
+            TRANS
+        };
+        REFL | t
+    }
+
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>> {
+        let front = wo.z > 0.0;
+        let eta_io = self.ior1_over_ior2(wl.lambda[0], front);
+        let n = if front { Vec3::Z } else { Vec3::NEG_Z };
+        let cos_o = wo.z.abs();
+        let wt = refract(wo, n, eta_io);
+        let r = if self.fresnel {
+            fresnel_dielectric(cos_o, eta_io)
+        } else if wt.is_none() {
+            1.0
+        } else {
+            0.0
+        };
+        let pr = if ctx.lobes.allows(REFL) { r } else { 0.0 };
+        let pt = if ctx.lobes.allows(TRANS) {
+            1.0 - r
+        } else {
+            0.0
+        };
+        if pr + pt <= 0.0 {
+            return None;
+        }
+        let split = ctx.companions_alive && self.is_dispersive();
+        if uc < pr / (pr + pt) {
+            let wi = reflect_local(wo);
+            let mut f = SampledSpectrum::<N>::splat(r / cos_o);
+            if split && self.fresnel {
+                for i in 1..N {
+                    f.0[i] =
+                        fresnel_dielectric(cos_o, self.ior1_over_ior2(wl.lambda[i], front)) / cos_o;
+                }
+            } else if split {
+                f.terminate_secondary();
+            }
+            return Some(BsdfSample {
+                wi,
+                f,
+                pdf: pr / (pr + pt),
+                flags: REFL,
+                eta: 1.0,
+                ended_companions: split && !self.fresnel,
+            });
+        }
+        let wi = wt?;
+        let etap = 1.0 / eta_io;
+        let mut ft = (1.0 - r) / wi.z.abs();
+        if ctx.mode == TransportMode::Radiance {
+            ft /= etap * etap;
+        }
+        let mut f = SampledSpectrum::<N>::splat(ft);
+        if split {
+            f.terminate_secondary();
+        }
+        Some(BsdfSample {
+            wi,
+            f,
+            pdf: pt / (pr + pt),
+            flags: if self.is_dispersive() {
+                TRANS | LobeFlags::WAVELENGTH_DEPENDENT
+            } else {
+                TRANS
+            },
+            eta: etap,
+            ended_companions: split,
+        })
+    }
 }
 
 /// Refracted direction after the seed's formula
@@ -100,7 +265,7 @@ mod tests {
 
     #[test]
     fn reflection_law_angle_in_equals_angle_out() {
-        use crate::bsdf::mirror::reflect;
+        use crate::bsdf::reflect;
         let mut rng = Rng::new(3, 9);
         for _ in 0..10_000 {
             let n = random_unit_toward(Vec3::Z, &mut rng);

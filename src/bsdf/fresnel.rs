@@ -26,6 +26,39 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     0.5 * (s + p)
 }
 
+/// Fresnel reflectance of a dielectric interface for light leaving along a direction
+/// whose cosine with the (outward) normal is `cos` (either sign), where
+/// `eta` = n_inside/n_outside: the pbrt-v4 `FrDielectric` convention, for microfacet
+/// normals.
+#[inline]
+pub fn fresnel_dielectric_signed(cos: f32, eta: f32) -> f32 {
+    if cos < 0.0 {
+        fresnel_dielectric(-cos, eta)
+    } else {
+        fresnel_dielectric(cos, 1.0 / eta)
+    }
+}
+
+/// Unpolarised reflectance of a conductor with complex index η = n + i k (relative to
+/// the outside medium) for light at cos θi = `cos_i` (Born & Wolf, "Principles of
+/// Optics", 7th ed., §14.2; the form of pbrt-v4 `FrComplex`): Snell's law with complex
+/// η gives a complex cos θt, and R = (|r_s|² + |r_p|²)/2 with the Fresnel amplitude
+/// ratios r_s = (cos θi − η cos θt)/(cos θi + η cos θt) and
+/// r_p = (η cos θi − cos θt)/(η cos θi + cos θt).
+#[inline]
+pub fn fresnel_conductor(cos_i: f32, n: f32, k: f32) -> f32 {
+    use num_complex::Complex32;
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let eta = Complex32::new(n, k);
+    let sin2_i = 1.0 - cos_i * cos_i;
+    let sin2_t = Complex32::new(sin2_i, 0.0) / (eta * eta);
+    let cos_t = (Complex32::new(1.0, 0.0) - sin2_t).sqrt();
+    let ci = Complex32::new(cos_i, 0.0);
+    let r_p = (eta * ci - cos_t) / (eta * ci + cos_t);
+    let r_s = (ci - eta * cos_t) / (ci + eta * cos_t);
+    0.5 * (r_p.norm_sqr() + r_s.norm_sqr())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,6 +101,30 @@ mod tests {
         let tp = 2.0 * ni * cos_i / (nt * cos_i + ni * cos_t);
         let k = (nt * cos_t) / (ni * cos_i);
         (k * ts * ts, k * tp * tp)
+    }
+
+    #[test]
+    fn conductor_reduces_to_the_dielectric_and_to_its_normal_incidence_form() {
+        // k = 0: a dielectric of index n (light from n = 1).
+        for &n in &[1.2f32, 1.5, 2.4] {
+            for k in 0..=100 {
+                let c = k as f32 / 100.0;
+                let a = fresnel_conductor(c, n, 0.0);
+                let b = fresnel_dielectric(c, 1.0 / n);
+                assert!((a - b).abs() < 2e-5, "n = {n}, cos = {c}: {a} vs {b}");
+            }
+        }
+        // Normal incidence: ((n − 1)² + k²)/((n + 1)² + k²); gold at 550 nm ≈ 0.79.
+        for &(n, k) in &[(0.424f32, 2.472f32), (0.06, 3.6), (0.97, 6.46), (2.0, 0.5)] {
+            let r0 = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
+            assert!((fresnel_conductor(1.0, n, k) - r0).abs() < 1e-5);
+            // Grazing incidence reflects everything, and R stays in [0, 1].
+            assert!((fresnel_conductor(0.0, n, k) - 1.0).abs() < 1e-5);
+            for j in 0..=100 {
+                let r = fresnel_conductor(j as f32 / 100.0, n, k);
+                assert!((0.0..=1.0 + 1e-6).contains(&r));
+            }
+        }
     }
 
     #[test]

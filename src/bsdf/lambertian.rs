@@ -1,8 +1,70 @@
-//! Perfectly diffuse reflector, f_d = ρd/π (seed, "Interaction of eye rays").
-use crate::spectrum::DenseSpectrum;
+//! Perfectly diffuse reflector, f_d = ρd/π (seed, "Interaction of eye rays"), sampled
+//! with the cosine-weighted hemisphere (pdf cos θi/π), so f cos θi / pdf = ρd.
+//!
+//! Two-sided, as the seed's shading with the normal turned toward the viewer is: light
+//! and viewer on the same side of the surface, either side.
+use super::{same_hemisphere, BsdfContext, BsdfSample, LobeFlags};
+use crate::math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+use std::f32::consts::FRAC_1_PI;
 
 #[derive(Clone, Debug)]
 pub struct Lambertian {
     /// Diffuse reflectance ρd(λ) in [0, 1].
     pub rho_d: DenseSpectrum,
+}
+
+const LOBE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
+
+impl Lambertian {
+    #[inline]
+    pub fn eval<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        if !same_hemisphere(wo, wi) {
+            return SampledSpectrum::zero();
+        }
+        wl.eval(&self.rho_d) * FRAC_1_PI
+    }
+
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>> {
+        if !ctx.lobes.allows(LOBE) {
+            return None;
+        }
+        let mut wi = cosine_hemisphere(u);
+        if wo.z < 0.0 {
+            wi.z = -wi.z;
+        }
+        let pdf = cosine_hemisphere_pdf(wi.z.abs());
+        if pdf == 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: wl.eval(&self.rho_d) * FRAC_1_PI,
+            pdf,
+            flags: LOBE,
+            eta: 1.0,
+            ended_companions: false,
+        })
+    }
+}
+
+#[inline]
+pub fn pdf(wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f32 {
+    if !ctx.lobes.allows(LOBE) || !same_hemisphere(wo, wi) {
+        return 0.0;
+    }
+    cosine_hemisphere_pdf(wi.z.abs())
 }

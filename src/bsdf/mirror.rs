@@ -1,7 +1,11 @@
 //! Perfect specular reflector (seed, "Reflected rays"): the law of reflection,
-//! ωr = 2(ωi·n)n − ωi, with ωi pointing away from the surface.
-use crate::spectrum::DenseSpectrum;
+//! ωr = 2(ωi·n)n − ωi, with ωi pointing away from the surface. As a BSDF it is the
+//! delta ρs δ(ωi − ωr)/|cos θi|, so the throughput changes by ρs.
+use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags};
+use crate::spectrum::{DenseSpectrum, SampledWavelengths};
 use glam::Vec3;
+
+pub use super::reflect;
 
 #[derive(Clone, Debug)]
 pub struct Mirror {
@@ -9,9 +13,27 @@ pub struct Mirror {
     pub rho_s: DenseSpectrum,
 }
 
-/// Mirror direction of `wi` (unit, pointing away from the surface) about the unit
-/// normal `n`.
-#[inline]
-pub fn reflect(wi: Vec3, n: Vec3) -> Vec3 {
-    2.0 * wi.dot(n) * n - wi
+const LOBE: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::REFLECTION);
+
+impl Mirror {
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>> {
+        if !ctx.lobes.allows(LOBE) {
+            return None;
+        }
+        let wi = reflect_local(wo);
+        Some(BsdfSample {
+            wi,
+            f: wl.eval(&self.rho_s) / wi.z.abs(),
+            pdf: 1.0,
+            flags: LOBE,
+            eta: 1.0,
+            ended_companions: false,
+        })
+    }
 }

@@ -4,13 +4,24 @@
 //! f(ωi, ωo) = ρd/π + ρs (s+2)/(2π) (ωo·ωr)^s,  ωr = 2(ωi·n)n − ωi,
 //!
 //! which, as a BRDF on its own, loses energy but never creates it when ρd + ρs ≤ 1.
+//!
+//! Sampled as a mixture (Lafortune & Willems 1994, §4): the diffuse term by the cosine
+//! hemisphere, the specular lobe about the mirror direction ωr(ωo) with density
+//! (s+1)/(2π) cos^s α, cos α = u^(1/(s+1)), each chosen in proportion to its weight (ρd
+//! averaged over the lanes, ρs). A lobe direction below the surface carries no energy
+//! (the model's loss).
+//!
 //! The course's glossy-over-refractive combination (`base`) adds the dielectric's
-//! continuation at full weight on top (integrator::whitted), so with ρd > 0 that
-//! combination can reflect more than it receives; the course's scenes use ρd = 0.
-use super::Dielectric;
-use crate::spectrum::DenseSpectrum;
-use glam::Vec3;
-use std::f32::consts::PI;
+//! delta lobes at full weight on top of the Phong lobes. The Whitted integrator takes
+//! the Phong part from the lights and continues through the base, as the course does;
+//! with ρd > 0 that combination can reflect more than it receives (the course's scenes
+//! use ρd = 0). The path tracer samples the same sum, base weight 1.
+use super::{reflect_local, same_hemisphere, BsdfContext, BsdfSample, Dielectric, LobeFlags};
+use crate::math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use crate::math::Frame;
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, PI};
 
 #[derive(Clone, Debug)]
 pub struct Glossy {
@@ -24,16 +35,168 @@ pub struct Glossy {
     pub base: Option<Dielectric>,
 }
 
+const DIFFUSE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
+const LOBE: LobeFlags = LobeFlags::GLOSSY.union(LobeFlags::REFLECTION);
+
 /// The specular lobe ρs (s+2)/(2π) max(0, ωo·ωr)^s for unit ωi, ωo (away from the
 /// surface) and unit normal n on their side.
 #[inline]
 pub fn phong_specular(rho_s: f32, s: f32, wi: Vec3, wo: Vec3, n: Vec3) -> f32 {
-    let wr = super::mirror::reflect(wi, n);
+    let wr = super::reflect(wi, n);
     let c = wo.dot(wr);
     if c <= 0.0 {
         return 0.0;
     }
     rho_s * (s + 2.0) / (2.0 * PI) * c.powf(s)
+}
+
+/// Density (s+1)/(2π) cos^s α of the lobe sampled about ωr.
+#[inline]
+fn lobe_pdf(s: f32, wr: Vec3, wi: Vec3) -> f32 {
+    let c = wr.dot(wi);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    (s + 1.0) / (2.0 * PI) * c.powf(s)
+}
+
+impl Glossy {
+    pub fn flags(&self) -> LobeFlags {
+        let mut f = LobeFlags::NONE;
+        if self.rho_d.max_value() > 0.0 {
+            f = f | DIFFUSE;
+        }
+        if self.rho_s > 0.0 {
+            f = f | LOBE;
+        }
+        if let Some(b) = &self.base {
+            f = f | b.flags();
+        }
+        f
+    }
+
+    /// Selection weights of the diffuse term, the lobe and the base under `ctx.lobes`:
+    /// the mean of ρd over the lanes (so that a lane whose ρd is positive is never left
+    /// without a sampling strategy), ρs, and 1 for the base's R + T.
+    #[inline]
+    fn weights<const N: usize>(
+        &self,
+        rho_d: &SampledSpectrum<N>,
+        ctx: &BsdfContext,
+    ) -> (f32, f32, f32) {
+        let wd = if ctx.lobes.allows(DIFFUSE) {
+            rho_d.0.iter().sum::<f32>() / N as f32
+        } else {
+            0.0
+        };
+        let ws = if ctx.lobes.allows(LOBE) {
+            self.rho_s
+        } else {
+            0.0
+        };
+        let wb = match &self.base {
+            Some(b) if ctx.lobes.intersects(b.flags()) => 1.0,
+            _ => 0.0,
+        };
+        (wd, ws, wb)
+    }
+
+    #[inline]
+    pub fn eval<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        if !same_hemisphere(wo, wi) {
+            return SampledSpectrum::zero();
+        }
+        let fd = wl.eval(&self.rho_d) * FRAC_1_PI;
+        let fs = phong_specular(self.rho_s, self.shininess, wi, wo, Vec3::Z);
+        fd + SampledSpectrum::splat(fs)
+    }
+
+    #[inline]
+    fn pdf_mix(&self, wo: Vec3, wi: Vec3, wd: f32, ws: f32, total: f32) -> f32 {
+        if !same_hemisphere(wo, wi) || total <= 0.0 {
+            return 0.0;
+        }
+        (wd * cosine_hemisphere_pdf(wi.z.abs())
+            + ws * lobe_pdf(self.shininess, reflect_local(wo), wi))
+            / total
+    }
+
+    #[inline]
+    pub fn pdf<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> f32 {
+        let (wd, ws, wb) = self.weights(&wl.eval(&self.rho_d), ctx);
+        self.pdf_mix(wo, wi, wd, ws, wd + ws + wb)
+    }
+
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>> {
+        let rho_d = wl.eval(&self.rho_d);
+        let (wd, ws, wb) = self.weights(&rho_d, ctx);
+        let total = wd + ws + wb;
+        if total <= 0.0 {
+            return None;
+        }
+        let (pd, ps) = (wd / total, ws / total);
+        if uc >= pd + ps {
+            // The refractive base; its own choice reuses what is left of uc.
+            let pb = wb / total;
+            let b = self.base.as_ref()?;
+            let uc = ((uc - pd - ps) / pb).min(1.0 - f32::EPSILON / 2.0);
+            let mut s = b.sample(wo, uc, wl, ctx)?;
+            s.pdf *= pb;
+            return Some(s);
+        }
+        let wi = if uc < pd {
+            let mut wi = cosine_hemisphere(u);
+            if wo.z < 0.0 {
+                wi.z = -wi.z;
+            }
+            wi
+        } else {
+            let s = self.shininess;
+            let cos_a = u.x.powf(1.0 / (s + 1.0));
+            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+            let phi = 2.0 * PI * u.y;
+            Frame::from_z(reflect_local(wo)).to_world(Vec3::new(
+                sin_a * phi.cos(),
+                sin_a * phi.sin(),
+                cos_a,
+            ))
+        };
+        if !same_hemisphere(wo, wi) {
+            return None;
+        }
+        let pdf = self.pdf_mix(wo, wi, wd, ws, total);
+        if pdf <= 0.0 {
+            return None;
+        }
+        let fs = phong_specular(self.rho_s, self.shininess, wi, wo, Vec3::Z);
+        Some(BsdfSample {
+            wi,
+            f: rho_d * FRAC_1_PI + SampledSpectrum::splat(fs),
+            pdf,
+            flags: if uc < pd { DIFFUSE } else { LOBE },
+            eta: 1.0,
+            ended_companions: false,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -89,7 +252,7 @@ mod tests {
     fn lobe_peaks_in_the_mirror_direction() {
         let n = Vec3::Z;
         let wi = Vec3::new(0.6, 0.0, 0.8);
-        let wr = super::super::mirror::reflect(wi, n);
+        let wr = super::super::reflect(wi, n);
         let peak = phong_specular(1.0, 42.0, wi, wr, n);
         assert!((peak - 44.0 / (2.0 * PI)).abs() < 1e-4);
         let off = phong_specular(1.0, 42.0, wi, (wr + 0.1 * Vec3::X).normalize(), n);

@@ -73,6 +73,50 @@ pub fn add_to_bins<const N: usize>(
     }
 }
 
+/// Contributions an integrator makes to pixels other than the one it samples (light
+/// tracing, bidirectional connections to the camera): kept in the order they are made,
+/// per tile and pass, and added to the film in tile order by `render.rs`, so splatting
+/// keeps the image independent of the thread count. A splat is an estimate of the
+/// image's value per pixel sample: the film adds Σ splats / spp.
+#[derive(Clone, Debug, Default)]
+pub struct Splats {
+    /// (pixel index, row-major from the top-left; CIE XYZ).
+    pub list: Vec<(u32, [f32; 3])>,
+    /// Splats left out because they were NaN or infinite.
+    pub nonfinite: u64,
+    pixels: u32,
+}
+
+impl Splats {
+    pub fn new(pixels: u32) -> Self {
+        Splats {
+            list: Vec::new(),
+            nonfinite: 0,
+            pixels,
+        }
+    }
+
+    /// Adds radiance `l` at wavelengths `wl` to `pixel` (outside the image: ignored).
+    #[inline]
+    pub fn add<const N: usize>(
+        &mut self,
+        pixel: u32,
+        l: &SampledSpectrum<N>,
+        wl: &SampledWavelengths<N>,
+    ) {
+        if pixel >= self.pixels {
+            return;
+        }
+        if !l.is_finite() {
+            self.nonfinite += 1;
+            return;
+        }
+        if !l.is_zero() {
+            self.list.push((pixel, xyz_of_sample(l, wl)));
+        }
+    }
+}
+
 /// A finished image: mean XYZ per pixel, row-major from the top-left, and optionally
 /// the mean spectral radiance in each of `bins` per pixel (pixel-major).
 #[derive(Clone, Debug, PartialEq)]

@@ -1,9 +1,10 @@
 //! The surface interaction: the seed's HitInfo, with the fields the lecture adds for
 //! specular and glossy shading (shader index, ior1_over_ior2, specular, shininess) and
-//! the path depth.
+//! the path depth, plus the geometry the materials' local frame is built from.
 use super::{Ray, Shape, ShapeKind};
 use crate::accel::embree::Hit;
 use crate::bsdf::Material;
+use crate::math::Frame;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -15,11 +16,16 @@ pub struct Interaction {
     pub position: Vec3,
     /// Unit normal turned to face the incoming ray (ωo·n ≥ 0).
     pub normal: Vec3,
+    /// Unit geometric normal pointing out of the shape (a triangle's counter-clockwise
+    /// side): the z axis of the materials' local frame.
+    pub n_outward: Vec3,
     /// True when the ray arrived on the side the outward normal points to (for a closed
     /// shape: from outside).
     pub front_face: bool,
     /// The lecture's shader index: the material in `Scene::materials`.
     pub material: u32,
+    /// The shape hit (its Embree geometry ID).
+    pub shape: u32,
     /// Relative index n_i/n_t for a ray crossing here (1 for non-refractive materials).
     pub ior1_over_ior2: f32,
     /// Specular reflectance ρs (glossy materials; 0 otherwise).
@@ -54,27 +60,26 @@ impl Interaction {
         };
         let front_face = outward.dot(ray.dir) < 0.0;
         let normal = if front_face { outward } else { -outward };
-        let (ior, specular, shininess) = match material {
-            Material::Dielectric(d) => (d.ior.eval(lambda), 0.0, 0.0),
-            Material::Glossy(g) => (
-                g.base.as_ref().map_or(1.0, |b| b.ior.eval(lambda)),
-                g.rho_s,
-                g.shininess,
-            ),
-            _ => (1.0, 0.0, 0.0),
-        };
-        let ior1_over_ior2 = if front_face { 1.0 / ior } else { ior };
+        let (ior1_over_ior2, specular, shininess) = material.hit_info(lambda, front_face);
         Interaction {
             has_hit: true,
             dist: hit.t,
             position,
             normal,
+            n_outward: outward,
             front_face,
             material: shape.material,
+            shape: hit.geom_id,
             ior1_over_ior2,
             specular,
             shininess,
             depth,
         }
+    }
+
+    /// The materials' local frame: z along the outward normal.
+    #[inline]
+    pub fn frame(&self) -> Frame {
+        Frame::from_z(self.n_outward)
     }
 }

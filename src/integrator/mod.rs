@@ -1,9 +1,55 @@
-//! Integrators. `whitted` is the seed lecture's recursive tracer written as the
-//! lecture's loop: the shader overwrites the ray and increments the depth.
+//! Integrators, one file each, chosen once per render by [`IntegratorKind`]:
+//!
+//! - `whitted`: the seed lecture's recursive tracer written as the lecture's loop: the
+//!   shader overwrites the ray and increments the depth;
+//! - `path`: a spectral unidirectional path tracer with next-event estimation and
+//!   multiple importance sampling.
+//!
+//! Both see materials and lights only through their methods (`bsdf`, `light`), and draw
+//! every random number through the [`Sampler`] interface. `render.rs` owns tiles,
+//! packets, passes and the film, and calls [`radiance`] once per pixel sample (pbrt-v4's
+//! `RayIntegrator::EvaluatePixelSample`).
+pub mod path;
 pub mod whitted;
 
-use crate::accel::embree;
+use crate::accel::embree::{self, Hit, RayQuery};
+use crate::geometry::Ray;
+use crate::sampler::Sampler;
 use crate::scene::Scene;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// The integrators a scene or the CLI can choose.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum IntegratorKind {
+    /// The seed's Whitted tracer: shadow rays to the lights at diffuse and glossy
+    /// surfaces, specular continuation; the default for the course's scenes.
+    #[default]
+    Whitted,
+    /// Unidirectional path tracing with next-event estimation and MIS.
+    Path,
+}
+
+impl IntegratorKind {
+    pub const NAMES: &'static [&'static str] = &["whitted", "path"];
+
+    pub fn parse(name: &str) -> Result<IntegratorKind, String> {
+        match name {
+            "whitted" => Ok(IntegratorKind::Whitted),
+            "path" => Ok(IntegratorKind::Path),
+            other => Err(format!(
+                "expected one of {}, got {other:?}",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "whitted",
+            IntegratorKind::Path => "path",
+        }
+    }
+}
 
 /// What an integrator needs to trace: the scene and its committed Embree scene.
 #[derive(Clone, Copy)]
@@ -19,4 +65,62 @@ pub struct TraceCounters {
     pub rays: u64,
     /// Occlusion (shadow) rays.
     pub shadow_rays: u64,
+}
+
+/// Radiance arriving along the camera ray `ray` at the wavelengths `wl`, by the
+/// integrator `kind`. `first_hit` is the camera ray's closest hit when it was already
+/// traced (in an Embree packet); `None` traces it here.
+#[inline]
+pub fn radiance<const N: usize>(
+    kind: IntegratorKind,
+    ctx: &Context,
+    ray: Ray,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+) -> SampledSpectrum<N> {
+    match kind {
+        IntegratorKind::Whitted => whitted::radiance(ctx, ray, first_hit, wl, sampler, counters),
+        IntegratorKind::Path => path::radiance(ctx, ray, first_hit, wl, sampler, counters),
+    }
+}
+
+#[inline]
+pub(crate) fn query(ray: &Ray) -> RayQuery {
+    RayQuery {
+        origin: ray.origin,
+        dir: ray.dir,
+        tnear: ray.t_min,
+        tfar: ray.t_max,
+    }
+}
+
+/// Whether a shadow ray from `x` toward unit `wi` is blocked before `dist` (the seed:
+/// t_min = ε, t_max = dist − ε; no cutoff for lights at infinity). A light closer than
+/// 2ε counts as blocked.
+#[inline]
+pub(crate) fn occluded(
+    ctx: &Context,
+    x: glam::Vec3,
+    wi: glam::Vec3,
+    dist: f32,
+    counters: &mut TraceCounters,
+) -> bool {
+    let eps = ctx.scene.settings.epsilon;
+    let t_max = if dist.is_finite() {
+        dist - eps
+    } else {
+        f32::INFINITY
+    };
+    if t_max <= eps {
+        return true;
+    }
+    counters.shadow_rays += 1;
+    ctx.accel.occluded1(&RayQuery {
+        origin: x,
+        dir: wi,
+        tnear: eps,
+        tfar: t_max,
+    })
 }

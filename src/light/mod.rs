@@ -1,15 +1,194 @@
-//! Light sources; a closed enum dispatched by `match`.
+//! Light sources, one file per kind, behind a closed enum dispatched by `match`.
+//!
+//! Every light samples itself (pbrt-v4 `base/light.h`; Mitsuba 3 `Emitter`):
+//! - [`Light::sample_li`]: from a receiving point, a direction toward the light with the
+//!   incident radiance, its density in solid angle and the distance for the shadow ray;
+//! - [`Light::pdf_li`]: that density for a direction found otherwise (a BSDF sample
+//!   that hit the light), for multiple importance sampling;
+//! - [`Light::le`] / [`AreaLight::l`]: the radiance a ray sees when it reaches the light;
+//! - [`Light::sample_le`]: an emitted ray with its position and direction densities, for
+//!   paths that start at the lights.
+//!
+//! Delta lights (point, spot, directional) are reached only by sampling them. Lights at
+//! infinity (directional, sun, environment) use the scene's bounding sphere for
+//! `sample_le` and for their power.
+pub mod area;
 pub mod directional;
+pub mod environment;
 pub mod point;
+pub mod sampler;
+pub mod spot;
 pub mod sun;
 
+pub use area::{AreaLight, AreaShape, SurfacePoint};
 pub use directional::DirectionalLight;
+pub use environment::EnvironmentLight;
 pub use point::PointLight;
+pub use sampler::LightSampler;
+pub use spot::SpotLight;
 pub use sun::SunLight;
+
+use crate::math::warp::concentric_disk;
+use crate::math::Frame;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+
+/// A direction toward a light from a receiving point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLiSample<const N: usize> {
+    /// Incident radiance per lane (for a delta light: the radiance times its delta's
+    /// solid angle, i.e. irradiance at normal incidence).
+    pub l: SampledSpectrum<N>,
+    /// Unit direction from the receiver toward the light.
+    pub wi: Vec3,
+    /// Density in solid angle (1 for a delta light).
+    pub pdf: f32,
+    /// Distance to the sampled point (infinite for lights at infinity).
+    pub dist: f32,
+    pub delta: bool,
+}
+
+/// A ray leaving a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLeSample<const N: usize> {
+    pub origin: Vec3,
+    /// Unit direction of travel.
+    pub dir: Vec3,
+    /// Emitted radiance (point and spot lights: intensity) per lane.
+    pub l: SampledSpectrum<N>,
+    /// Density of the origin (per area; 1 for a point).
+    pub pdf_pos: f32,
+    /// Density of the direction (per solid angle; 1 for a delta direction).
+    pub pdf_dir: f32,
+    /// The emitting surface's normal, for area lights.
+    pub normal: Option<Vec3>,
+}
+
+/// The scene's bounding sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneBounds {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl SceneBounds {
+    /// The area of a disk of the sphere's radius, π R².
+    pub fn disk_area(&self) -> f32 {
+        std::f32::consts::PI * self.radius * self.radius
+    }
+
+    /// A point uniform on the disk of radius R that faces unit `w`, placed at distance R
+    /// from the centre toward `w` (so rays from it along −w cover the sphere), and its
+    /// area density 1/(π R²).
+    pub fn disk_point(&self, w: Vec3, u: Vec2) -> (Vec3, f32) {
+        let f = Frame::from_z(w);
+        let d = concentric_disk(u) * self.radius;
+        (
+            self.center + self.radius * w + d.x * f.s + d.y * f.t,
+            1.0 / self.disk_area(),
+        )
+    }
+}
 
 #[derive(Clone, Debug)]
 pub enum Light {
     Point(PointLight),
+    Spot(SpotLight),
     Directional(DirectionalLight),
     Sun(SunLight),
+    Area(AreaLight),
+    Environment(EnvironmentLight),
+}
+
+impl Light {
+    /// True for lights that only sampling can reach (point, spot, directional).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        matches!(
+            self,
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_)
+        )
+    }
+
+    /// True for lights at infinity (directional, sun, environment).
+    #[inline]
+    pub fn is_infinite(&self) -> bool {
+        matches!(
+            self,
+            Light::Directional(_) | Light::Sun(_) | Light::Environment(_)
+        )
+    }
+
+    /// A direction toward the light from `p`; `u` is used by lights with extent.
+    #[inline]
+    pub fn sample_li<const N: usize>(
+        &self,
+        p: Vec3,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+    ) -> Option<LightLiSample<N>> {
+        match self {
+            Light::Point(l) => l.sample_li(p, wl),
+            Light::Spot(l) => l.sample_li(p, wl),
+            Light::Directional(l) => Some(l.sample_li(wl)),
+            Light::Sun(l) => Some(l.sample_li(u, wl)),
+            Light::Area(l) => l.sample_li(p, u, wl),
+            Light::Environment(l) => l.sample_li(u, wl),
+        }
+    }
+
+    /// Solid-angle density of `sample_li` from `p` for direction `wi`; for an area light,
+    /// `hit` is the point of the light that `wi` reaches. Zero for delta lights.
+    #[inline]
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, hit: Option<&SurfacePoint>) -> f32 {
+        match self {
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_) => 0.0,
+            Light::Sun(l) => l.pdf_li(wi),
+            Light::Area(l) => hit.map_or(0.0, |h| l.pdf_li(p, h)),
+            Light::Environment(l) => l.pdf_li(wi),
+        }
+    }
+
+    /// Radiance a ray leaving the scene in direction `dir` receives from this light
+    /// (zero for lights that are not at infinity or not seen).
+    #[inline]
+    pub fn le<const N: usize>(&self, dir: Vec3, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        match self {
+            Light::Sun(l) => l.le(dir, wl),
+            Light::Environment(l) => l.le(dir, wl),
+            _ => SampledSpectrum::zero(),
+        }
+    }
+
+    /// An emitted ray; `u1` picks the position (or, at infinity, the direction) and `u2`
+    /// the other.
+    #[inline]
+    pub fn sample_le<const N: usize>(
+        &self,
+        u1: Vec2,
+        u2: Vec2,
+        wl: &SampledWavelengths<N>,
+        bounds: &SceneBounds,
+    ) -> Option<LightLeSample<N>> {
+        match self {
+            Light::Point(l) => Some(l.sample_le(u2, wl)),
+            Light::Spot(l) => l.sample_le(u2, wl),
+            Light::Directional(l) => Some(l.sample_le(u1, wl, bounds)),
+            Light::Sun(l) => Some(l.sample_le(u1, u2, wl, bounds)),
+            Light::Area(l) => l.sample_le(u1, u2, wl),
+            Light::Environment(l) => l.sample_le(u1, u2, wl, bounds),
+        }
+    }
+
+    /// Emitted power averaged over 360–830 nm (per nm), for choosing lights by power.
+    pub fn phi(&self, bounds: &SceneBounds) -> f32 {
+        match self {
+            Light::Point(l) => l.phi(),
+            Light::Spot(l) => l.phi(),
+            Light::Directional(l) => l.phi(bounds),
+            Light::Sun(l) => l.phi(bounds),
+            Light::Area(l) => l.phi(),
+            Light::Environment(l) => l.phi(bounds),
+        }
+    }
 }

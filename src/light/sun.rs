@@ -1,12 +1,16 @@
 //! The sun: a distant disk of angular radius α (default 0.2666°, the mean solar radius
 //! seen from Earth; 0.262–0.271° over the year), given by its irradiance E at normal
 //! incidence. Its disk has radiance L = E/Ω with Ω = 2π(1 − cos α), seen by rays that
-//! leave the scene towards it. Shadow rays sample the disk uniformly in solid angle, so
-//! shadows have the sun's penumbra. The seed's Aristotelian rainbow needs the disk's
-//! extent; so does a prism's spectrum, which is the disk's image spread by dispersion.
-use crate::math::Rng;
-use crate::spectrum::DenseSpectrum;
-use glam::Vec3;
+//! leave the scene towards it. Light sampling draws directions uniformly in solid angle
+//! over the disk (pdf 1/Ω), so shadows have the sun's penumbra, and a path that finds
+//! the disk by BSDF sampling is weighted against it by MIS. The seed's Aristotelian
+//! rainbow needs the disk's extent; so does a prism's spectrum, which is the disk's image
+//! spread by dispersion.
+use super::{LightLeSample, LightLiSample, SceneBounds};
+use crate::math::warp::uniform_cone;
+use crate::math::Frame;
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
 
 /// The mean angular radius of the sun, degrees.
 pub const SUN_ANGULAR_RADIUS_DEG: f32 = 0.2666;
@@ -24,6 +28,8 @@ pub struct SunLight {
     sin2: f32,
     /// Disk radiance L = E/Ω.
     pub radiance: DenseSpectrum,
+    /// The frame whose z axis points at the sun.
+    frame: Frame,
 }
 
 impl SunLight {
@@ -32,13 +38,15 @@ impl SunLight {
         let a = angular_radius as f64;
         let omc = 2.0 * (0.5 * a).sin().powi(2);
         let solid_angle = 2.0 * std::f64::consts::PI * omc;
+        let direction = direction.normalize();
         SunLight {
-            direction: direction.normalize(),
+            direction,
             radiance: irradiance.scaled((1.0 / solid_angle) as f32),
             irradiance,
             angular_radius,
             one_minus_cos: omc as f32,
             sin2: a.sin().powi(2) as f32,
+            frame: Frame::from_z(-direction),
         }
     }
 
@@ -57,20 +65,76 @@ impl SunLight {
 
     /// A direction towards the disk, uniform in solid angle (pdf 1/Ω).
     #[inline]
-    pub fn sample_direction(&self, rng: &mut Rng) -> Vec3 {
-        let s = -self.direction;
-        let u = rng.uniform() * self.one_minus_cos;
-        let cos = 1.0 - u;
-        let sin = (u * (2.0 - u)).max(0.0).sqrt();
-        let phi = 2.0 * std::f32::consts::PI * rng.uniform();
-        let (t, b) = s.any_orthonormal_pair();
-        (sin * phi.cos()) * t + (sin * phi.sin()) * b + cos * s
+    pub fn sample_direction(&self, u: Vec2) -> Vec3 {
+        self.frame.to_world(uniform_cone(u, self.one_minus_cos))
+    }
+
+    /// Radiance arriving along a ray that leaves the scene in direction `d`.
+    #[inline]
+    pub fn le<const N: usize>(&self, d: Vec3, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        if self.sees_disk(d) {
+            wl.eval(&self.radiance)
+        } else {
+            SampledSpectrum::zero()
+        }
+    }
+
+    #[inline]
+    pub fn sample_li<const N: usize>(
+        &self,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+    ) -> LightLiSample<N> {
+        LightLiSample {
+            l: wl.eval(&self.radiance),
+            wi: self.sample_direction(u),
+            pdf: 1.0 / self.solid_angle(),
+            dist: f32::INFINITY,
+            delta: false,
+        }
+    }
+
+    #[inline]
+    pub fn pdf_li(&self, wi: Vec3) -> f32 {
+        if self.sees_disk(wi) {
+            1.0 / self.solid_angle()
+        } else {
+            0.0
+        }
+    }
+
+    /// A ray from the disk's direction through a point uniform on the disk covering the
+    /// scene's bounding sphere.
+    #[inline]
+    pub fn sample_le<const N: usize>(
+        &self,
+        u1: Vec2,
+        u2: Vec2,
+        wl: &SampledWavelengths<N>,
+        bounds: &SceneBounds,
+    ) -> LightLeSample<N> {
+        let w = self.sample_direction(u1);
+        let (origin, pdf_pos) = bounds.disk_point(w, u2);
+        LightLeSample {
+            origin,
+            dir: -w,
+            l: wl.eval(&self.radiance),
+            pdf_pos,
+            pdf_dir: 1.0 / self.solid_angle(),
+            normal: None,
+        }
+    }
+
+    /// Φ = π R² E over the scene's bounding disk.
+    pub fn phi(&self, bounds: &SceneBounds) -> f32 {
+        bounds.disk_area() * self.irradiance.mean()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Rng;
 
     #[test]
     fn samples_cover_the_disk_uniformly_and_nothing_else() {
@@ -81,13 +145,14 @@ mod tests {
         );
         let s = -sun.direction;
         let mut rng = Rng::new(2, 4);
+        assert!((sun.pdf_li(-sun.direction) * sun.solid_angle() - 1.0).abs() < 1e-5);
         // Uniform in solid angle: the fraction inside half the angular radius is
         // (1 − cos(α/2)) / (1 − cos α) ≈ 1/4.
         let half = 0.5 * sun.angular_radius;
         let n = 100_000;
         let mut inner = 0;
         for _ in 0..n {
-            let d = sun.sample_direction(&mut rng);
+            let d = sun.sample_direction(Vec2::new(rng.uniform(), rng.uniform()));
             assert!((d.length() - 1.0).abs() < 1e-5);
             assert!(sun.sees_disk(d), "a sample outside the disk");
             if d.cross(s).length() < half.sin() {

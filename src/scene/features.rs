@@ -40,18 +40,17 @@ impl Features {
         };
         let lit = scene.lights.iter().any(|l| match l {
             Light::Point(p) => p.intensity.max_value() > 0.0,
+            Light::Spot(p) => p.intensity.max_value() > 0.0,
             Light::Directional(d) => d.radiance.max_value() > 0.0,
             Light::Sun(s) => s.irradiance.max_value() > 0.0,
+            Light::Area(a) => a.emission.max_value() > 0.0,
+            // The seed's tracer does not sample the environment.
+            Light::Environment(_) => false,
         });
-        let non_specular =
-            used().any(|m| matches!(m, Material::Lambertian(_) | Material::Glossy(_)));
+        let non_specular = used().any(|m| m.flags().has_non_specular());
         Features {
             shadows: lit && non_specular,
-            specular: used().any(|m| match m {
-                Material::Mirror(_) | Material::Dielectric(_) => true,
-                Material::Glossy(g) => g.base.is_some(),
-                Material::Lambertian(_) => false,
-            }),
+            specular: used().any(|m| m.flags().is_specular()),
             glossy: used().any(|m| matches!(m, Material::Glossy(_))),
         }
     }

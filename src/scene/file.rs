@@ -129,6 +129,15 @@ pub struct RenderFile {
     pub epsilon: Option<PositiveNumber>,
     #[serde(default)]
     pub seed: Option<u64>,
+    /// whitted (the seed's tracer, the default) or path.
+    #[serde(default)]
+    pub integrator: Option<String>,
+    /// Path depth from which Russian roulette may end paths (path integrator); default 5.
+    #[serde(default)]
+    pub rr_depth: Option<u32>,
+    /// How the path integrator picks a light: power (default) or uniform.
+    #[serde(default)]
+    pub light_sampler: Option<String>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.
@@ -139,10 +148,11 @@ pub enum MaterialFile {
     Mirror(MirrorFile),
     Dielectric(DielectricFile),
     Glossy(GlossyFile),
+    Conductor(ConductorFile),
 }
 
 /// The `type` values of [`MaterialFile`], in declaration order.
-pub const MATERIAL_TYPES: &[&str] = &["lambertian", "mirror", "dielectric", "glossy"];
+pub const MATERIAL_TYPES: &[&str] = &["lambertian", "mirror", "dielectric", "glossy", "conductor"];
 
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -165,6 +175,32 @@ pub struct DielectricFile {
     /// Default true; false is the lecture's pure refraction.
     #[serde(default)]
     pub fresnel: Option<bool>,
+    /// GGX roughness α in [0, 1]; 0 (default) is the smooth interface.
+    #[serde(default)]
+    pub roughness: Option<UnitNumber>,
+    /// Index of the medium outside the surface (the side its normal points to); default 1.
+    #[serde(default)]
+    pub outside_ior: Option<IorSpec>,
+}
+
+/// A metal with a spectral complex index, smooth or rough.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConductorFile {
+    pub metal: MetalSpec,
+    /// GGX roughness α in [0, 1]; 0 (default) is the smooth metal.
+    #[serde(default)]
+    pub roughness: Option<UnitNumber>,
+}
+
+/// A metal's complex index: a catalogue name (Ag, Al, Au, Cu), `{ table = "nk.csv" }`
+/// (rows `wavelength_nm,n,k` covering 360–830 nm, relative to the scene file) or
+/// `{ n = .., k = .. }` (constant).
+#[derive(Clone, Debug, PartialEq)]
+pub enum MetalSpec {
+    Named(String),
+    Table(String),
+    Constant { n: f32, k: f32 },
 }
 
 /// The seed's modified Phong model, optionally over a refractive base (`ior`).
@@ -200,7 +236,15 @@ pub const SHAPE_TYPES: &[&str] = &["sphere", "triangle", "plane", "quad", "mesh"
 pub struct SphereFile {
     pub center: Point3,
     pub radius: PositiveNumber,
-    pub material: String,
+    /// Required unless `emission` is given (then default: black, a pure emitter).
+    #[serde(default)]
+    pub material: Option<String>,
+    /// Radiance emitted from the surface: the shape becomes an area light.
+    #[serde(default)]
+    pub emission: Option<Emission>,
+    /// Emit from both sides (default: only the side the outward normal points to).
+    #[serde(default)]
+    pub two_sided: Option<bool>,
 }
 
 #[derive(Debug, serde::Deserialize)]
@@ -209,7 +253,12 @@ pub struct TriangleFile {
     /// Counter-clockwise seen from the front: the geometric normal is
     /// (v1 − v0) × (v2 − v0).
     pub vertices: [Point3; 3],
-    pub material: String,
+    #[serde(default)]
+    pub material: Option<String>,
+    #[serde(default)]
+    pub emission: Option<Emission>,
+    #[serde(default)]
+    pub two_sided: Option<bool>,
 }
 
 /// An infinite plane, stored as a square of half-extent `size` centred at `point`.
@@ -221,7 +270,12 @@ pub struct PlaneFile {
     /// Half-extent of the square; default 1000.
     #[serde(default)]
     pub size: Option<PositiveNumber>,
-    pub material: String,
+    #[serde(default)]
+    pub material: Option<String>,
+    #[serde(default)]
+    pub emission: Option<Emission>,
+    #[serde(default)]
+    pub two_sided: Option<bool>,
 }
 
 /// The parallelogram origin + s·edge1 + t·edge2, s, t ∈ [0, 1]; normal edge1 × edge2.
@@ -231,7 +285,12 @@ pub struct QuadFile {
     pub origin: Point3,
     pub edge1: Direction3,
     pub edge2: Direction3,
-    pub material: String,
+    #[serde(default)]
+    pub material: Option<String>,
+    #[serde(default)]
+    pub emission: Option<Emission>,
+    #[serde(default)]
+    pub two_sided: Option<bool>,
 }
 
 /// A Wavefront OBJ triangle mesh.
@@ -253,6 +312,11 @@ pub struct MeshFile {
     /// Default `[0, 0, 0]`.
     #[serde(default)]
     pub translate: Option<Point3>,
+    /// Radiance emitted by every triangle of the mesh: it becomes an area light.
+    #[serde(default)]
+    pub emission: Option<Emission>,
+    #[serde(default)]
+    pub two_sided: Option<bool>,
 }
 
 /// `[[lights]]`, tagged by `type`.
@@ -262,10 +326,33 @@ pub enum LightFile {
     Point(PointLightFile),
     Directional(DirectionalLightFile),
     Sun(SunLightFile),
+    Spot(SpotLightFile),
 }
 
 /// The `type` values of [`LightFile`], in declaration order.
-pub const LIGHT_TYPES: &[&str] = &["point", "directional", "sun"];
+pub const LIGHT_TYPES: &[&str] = &["point", "directional", "sun", "spot"];
+
+/// A spot light (pbrt-v4's falloff): full intensity within cone_angle − cone_delta of
+/// its axis, smoothly down to 0 at cone_angle.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotLightFile {
+    pub position: Point3,
+    /// The axis, the direction the light travels; normalised on load.
+    pub direction: Direction3,
+    /// Radiant intensity on the axis, a colour.
+    pub intensity: Emission,
+    /// Half-angle of the cone in degrees, in (0, 90]; default 30.
+    #[serde(default)]
+    pub cone_angle: Option<PositiveNumber>,
+    /// Width of the falloff ring in degrees, in [0, cone_angle]; default 5.
+    #[serde(default)]
+    pub cone_delta: Option<NonNegativeNumber>,
+}
+
+/// A finite number ≥ 0 (for angles that may be 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NonNegativeNumber(pub f32);
 
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -649,6 +736,63 @@ impl<'de> Deserialize<'de> for IorSpec {
                 ))),
                 _ => Err(D::Error::custom(expected())),
             },
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for NonNegativeNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match finite_f32(&v) {
+            Some(x) if x >= 0.0 => Ok(NonNegativeNumber(x)),
+            _ => Err(D::Error::custom(format!(
+                "expected a finite number >= 0, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for MetalSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use crate::spectrum::metals::METAL_NAMES;
+        let v = raw(d)?;
+        let expected = || {
+            format!(
+                "expected a metal of the catalogue ({}), {{ table = \"nk.csv\" }} or {{ n = .., k = .. }}, got {}",
+                METAL_NAMES.join(", "),
+                show(&v)
+            )
+        };
+        match &v {
+            toml::Value::String(name) => {
+                if METAL_NAMES.contains(&name.as_str()) {
+                    Ok(MetalSpec::Named(name.clone()))
+                } else {
+                    Err(D::Error::custom(format!(
+                        "unknown metal {name:?}, expected one of {}",
+                        METAL_NAMES.join(", ")
+                    )))
+                }
+            }
+            toml::Value::Table(t) => {
+                if let (1, Some(toml::Value::String(f))) = (t.len(), t.get("table")) {
+                    return Ok(MetalSpec::Table(f.clone()));
+                }
+                let n = t.get("n").and_then(finite_f32);
+                let k = t.get("k").and_then(finite_f32);
+                match (t.len(), n, k) {
+                    (2, Some(n), Some(k)) if n > 0.0 && k >= 0.0 => {
+                        Ok(MetalSpec::Constant { n, k })
+                    }
+                    (2, Some(_), Some(_)) => Err(D::Error::custom(format!(
+                        "expected n > 0 and k >= 0, got {}",
+                        show(&v)
+                    ))),
+                    _ => Err(D::Error::custom(expected())),
+                }
+            }
+            _ => Err(D::Error::custom(expected())),
         }
     }
 }

@@ -20,16 +20,21 @@
 pub(crate) mod obj;
 
 use super::file::{
-    show, Colour, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec, LambertianFile,
-    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, SceneFile,
-    ShapeFile, SphereFile, SunLightFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
+    show, Colour, ConductorFile, DielectricFile, DirectionalLightFile, Emission, GlossyFile,
+    IorSpec, LambertianFile, LightFile, MaterialFile, MeshFile, MetalSpec, MirrorFile, PlaneFile,
+    PointLightFile, QuadFile, SceneFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile,
+    TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
 };
 use super::{RenderSettings, Scene};
-use crate::bsdf::{Dielectric, Glossy, Lambertian, Material, Mirror};
+use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
+use crate::bsdf::{
+    ComplexIor, Conductor, Dielectric, Glossy, Lambertian, Material, Mirror, RoughConductor,
+    RoughDielectric,
+};
 use crate::camera::Camera;
 use crate::error::{HeronError, Result};
 use crate::geometry::{Mesh, Shape, ShapeKind};
-use crate::light::{DirectionalLight, Light, PointLight, SunLight};
+use crate::light::{DirectionalLight, Light, PointLight, SpotLight, SunLight};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
@@ -223,6 +228,7 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("materials", "mirror") => check::<MirrorFile>(t),
         ("materials", "dielectric") => check::<DielectricFile>(t),
         ("materials", "glossy") => check::<GlossyFile>(t),
+        ("materials", "conductor") => check::<ConductorFile>(t),
         ("shapes", "sphere") => check::<SphereFile>(t),
         ("shapes", "triangle") => check::<TriangleFile>(t),
         ("shapes", "plane") => check::<PlaneFile>(t),
@@ -231,6 +237,7 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("lights", "point") => check::<PointLightFile>(t),
         ("lights", "directional") => check::<DirectionalLightFile>(t),
         ("lights", "sun") => check::<SunLightFile>(t),
+        ("lights", "spot") => check::<SpotLightFile>(t),
         _ => None,
     }?;
     let mut full = item_path.to_vec();
@@ -416,6 +423,18 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         materials.push(build_material(&key("materials", name), m, &base_dir).map_err(err)?);
         material_names.push(name.clone());
     }
+    // A shape that emits and names no material is a pure emitter: it gets a black
+    // Lambertian, appended after the named materials so their indices do not move.
+    let black = materials.len() as u32;
+    if file.shapes.iter().any(|s| {
+        let (m, e, _) = shape_emission(s);
+        m.is_none() && e.is_some()
+    }) {
+        materials.push(Material::Lambertian(Lambertian {
+            rho_d: DenseSpectrum::constant(0.0),
+        }));
+        material_names.push("(black emitter)".into());
+    }
     let index: HashMap<&str, u32> = material_names
         .iter()
         .enumerate()
@@ -432,8 +451,26 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         })
     };
 
-    // Shapes, in file order.
+    // The material of a simple shape: named, or black for a pure emitter.
+    let resolve = |at: &str, s: &ShapeFile| -> Result<u32> {
+        let (material, emission, two_sided) = shape_emission(s);
+        if two_sided.is_some() && emission.is_none() {
+            return Err(err(format!(
+                "{at}.two_sided: applies to emitting shapes, but emission is not given"
+            )));
+        }
+        match (material, emission) {
+            (Some(name), _) => lookup(format!("{at}.material"), name),
+            (None, Some(_)) => Ok(black),
+            (None, None) => Err(err(format!(
+                "{at}.material: missing required key (expected the name of a material, or an emission)"
+            ))),
+        }
+    };
+
+    // Shapes, in file order; each remembers the file entry it came from.
     let mut shapes = Vec::with_capacity(file.shapes.len());
+    let mut shape_entry: Vec<usize> = Vec::with_capacity(file.shapes.len());
     for (i, s) in file.shapes.iter().enumerate() {
         let at = format!("shapes[{i}]");
         match s {
@@ -442,10 +479,10 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                     center: sp.center.0,
                     radius: sp.radius.0,
                 },
-                material: lookup(format!("{at}.material"), &sp.material)?,
+                material: resolve(&at, s)?,
             }),
             ShapeFile::Triangle(t) => {
-                let material = lookup(format!("{at}.material"), &t.material)?;
+                let material = resolve(&at, s)?;
                 let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
                 if is_degenerate(v[0], v[1], v[2]) {
                     return Err(err(format!(
@@ -456,7 +493,7 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                 shapes.push(mesh_shape(v.to_vec(), vec![[0, 1, 2]], material));
             }
             ShapeFile::Plane(p) => {
-                let material = lookup(format!("{at}.material"), &p.material)?;
+                let material = resolve(&at, s)?;
                 let n = p.normal.unit();
                 let size = p.size.map_or(1000.0, |s| s.0);
                 // Tangents with t × b = n, so (v1 − v0) × (v2 − v0) points along n.
@@ -477,7 +514,7 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                 shapes.push(mesh_shape(v, vec![[0, 1, 2], [0, 2, 3]], material));
             }
             ShapeFile::Quad(q) => {
-                let material = lookup(format!("{at}.material"), &q.material)?;
+                let material = resolve(&at, s)?;
                 let (o, e1, e2) = (q.origin.0, q.edge1.0, q.edge2.0);
                 let v = vec![o, o + e1, o + e1 + e2, o + e2];
                 if v.iter().any(|x| !x.is_finite()) {
@@ -495,9 +532,16 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                 shapes.push(mesh_shape(v, vec![[0, 1, 2], [0, 2, 3]], material));
             }
             ShapeFile::Mesh(m) => {
-                shapes.extend(build_mesh(path, &base_dir, &at, m, &lookup)?);
+                if m.two_sided.is_some() && m.emission.is_none() {
+                    return Err(err(format!(
+                        "{at}.two_sided: applies to emitting shapes, but emission is not given"
+                    )));
+                }
+                let fallback = m.emission.as_ref().map(|_| black);
+                shapes.extend(build_mesh(path, &base_dir, &at, m, &lookup, fallback)?);
             }
         }
+        shape_entry.resize(shapes.len(), i);
     }
 
     // Lights, in file order.
@@ -529,8 +573,62 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                     deg.to_radians(),
                 )))
             }
+            LightFile::Spot(s) => {
+                let angle = s.cone_angle.map_or(30.0, |a| a.0);
+                let delta = s.cone_delta.map_or(5.0, |a| a.0);
+                if angle > 90.0 {
+                    return Err(err(format!(
+                        "lights[{i}].cone_angle: expected degrees in (0, 90], got {angle}"
+                    )));
+                }
+                if delta > angle {
+                    return Err(err(format!(
+                        "lights[{i}].cone_delta: expected degrees in [0, cone_angle = {angle}], got {delta}"
+                    )));
+                }
+                Ok(Light::Spot(SpotLight {
+                    position: s.position.0,
+                    direction: s.direction.unit(),
+                    intensity: s.intensity.spectrum(),
+                    cos_falloff_start: (angle - delta).to_radians().cos(),
+                    cos_falloff_end: angle.to_radians().cos(),
+                }))
+            }
         })
         .collect::<Result<Vec<_>>>()?;
+    let mut lights = lights;
+
+    // Area lights: one per emitting shape, after the file's lights.
+    let mut shape_light = vec![crate::scene::NO_LIGHT; shapes.len()];
+    for (k, shape) in shapes.iter().enumerate() {
+        let (_, emission, two_sided) = shape_emission(&file.shapes[shape_entry[k]]);
+        let Some(e) = emission else { continue };
+        if e.0.max_value() <= 0.0 {
+            continue;
+        }
+        let geometry = match &shape.kind {
+            ShapeKind::Sphere { center, radius } => crate::light::AreaLight::new(
+                k as u32,
+                e.spectrum(),
+                two_sided.unwrap_or(false),
+                crate::light::AreaShape::Sphere {
+                    center: *center,
+                    radius: *radius,
+                },
+            ),
+            ShapeKind::Mesh(m) => crate::light::AreaLight::triangles(
+                k as u32,
+                e.spectrum(),
+                two_sided.unwrap_or(false),
+                m.indices
+                    .iter()
+                    .map(|t| t.map(|v| m.positions[v as usize]))
+                    .collect(),
+            ),
+        };
+        shape_light[k] = lights.len() as u32;
+        lights.push(Light::Area(geometry));
+    }
 
     let background = file
         .background
@@ -550,6 +648,24 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         }
         if let Some(x) = r.seed {
             settings.seed = x;
+        }
+        if let Some(name) = &r.integrator {
+            settings.integrator = crate::integrator::IntegratorKind::parse(name)
+                .map_err(|e| err(format!("render.integrator: {e}")))?;
+        }
+        if let Some(x) = r.rr_depth {
+            settings.rr_depth = x;
+        }
+        if let Some(name) = &r.light_sampler {
+            settings.light_sampler = match name.as_str() {
+                "power" => crate::light::sampler::LightSamplerKind::Power,
+                "uniform" => crate::light::sampler::LightSamplerKind::Uniform,
+                other => {
+                    return Err(err(format!(
+                        "render.light_sampler: expected power or uniform, got {other:?}"
+                    )))
+                }
+            };
         }
     }
 
@@ -578,22 +694,53 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     )
     .map_err(|e| err(format!("camera: {e}")))?;
 
-    Ok(Scene {
+    Ok(Scene::from_parts(super::SceneParts {
         source: path.to_path_buf(),
         camera,
         shapes,
         materials,
         material_names,
         lights,
+        shape_light,
         background,
         sky,
         settings,
-    })
+    }))
+}
+
+/// The sphere around the shapes' bounding box (a unit sphere at the origin for a scene
+/// without shapes).
+pub fn scene_bounds(shapes: &[Shape]) -> crate::light::SceneBounds {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for s in shapes {
+        match &s.kind {
+            ShapeKind::Sphere { center, radius } => {
+                lo = lo.min(*center - Vec3::splat(*radius));
+                hi = hi.max(*center + Vec3::splat(*radius));
+            }
+            ShapeKind::Mesh(m) => {
+                for p in &m.positions {
+                    lo = lo.min(*p);
+                    hi = hi.max(*p);
+                }
+            }
+        }
+    }
+    if !(lo.x <= hi.x) {
+        return crate::light::SceneBounds {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        };
+    }
+    let center = 0.5 * (lo + hi);
+    crate::light::SceneBounds {
+        center,
+        radius: (0.5 * (hi - lo).length()).max(1e-6),
+    }
 }
 
 /// The refractive-index model of `spec`; a table file is read relative to `base_dir`.
 fn build_ior(at: &str, spec: &IorSpec, base_dir: &Path) -> std::result::Result<Ior, String> {
-    let at = format!("{at}.ior");
     let ior = match spec {
         IorSpec::Constant(n) => Ior::Constant(*n),
         IorSpec::Named(name) => crate::spectrum::ior::named(name)
@@ -615,6 +762,26 @@ fn build_ior(at: &str, spec: &IorSpec, base_dir: &Path) -> std::result::Result<I
     Ok(ior)
 }
 
+/// The complex index of `spec`; a table is read relative to `base_dir`.
+fn build_metal(
+    at: &str,
+    spec: &MetalSpec,
+    base_dir: &Path,
+) -> std::result::Result<ComplexIor, String> {
+    let at = format!("{at}.metal");
+    match spec {
+        MetalSpec::Named(name) => crate::spectrum::metals::named(name)
+            .ok_or_else(|| format!("{at}: unknown metal {name:?}")),
+        MetalSpec::Table(file) => {
+            crate::spectrum::metals::read_nk(&base_dir.join(file)).map_err(|e| format!("{at}: {e}"))
+        }
+        MetalSpec::Constant { n, k } => Ok(ComplexIor {
+            n: DenseSpectrum::constant(*n),
+            k: DenseSpectrum::constant(*k),
+        }),
+    }
+}
+
 fn build_material(
     at: &str,
     m: &MaterialFile,
@@ -631,10 +798,41 @@ fn build_material(
                 .as_ref()
                 .map_or_else(|| DenseSpectrum::constant(1.0), |r| r.spectrum()),
         }),
-        MaterialFile::Dielectric(d) => Material::Dielectric(Dielectric {
-            ior: build_ior(at, &d.ior, base_dir)?,
-            fresnel: d.fresnel.unwrap_or(true),
-        }),
+        MaterialFile::Dielectric(d) => {
+            let mut interface = Dielectric::new(
+                build_ior(&format!("{at}.ior"), &d.ior, base_dir)?,
+                d.fresnel.unwrap_or(true),
+            );
+            if let Some(o) = &d.outside_ior {
+                interface.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir)?;
+            }
+            let alpha = d.roughness.map_or(0.0, |r| r.0);
+            if alpha < MIN_ALPHA {
+                Material::Dielectric(interface)
+            } else {
+                if d.fresnel == Some(false) {
+                    return Err(format!(
+                        "{at}.fresnel: false applies to the smooth interface (the lecture's pure refraction), not with roughness = {alpha}"
+                    ));
+                }
+                Material::RoughDielectric(RoughDielectric {
+                    interface,
+                    distribution: TrowbridgeReitz { alpha },
+                })
+            }
+        }
+        MaterialFile::Conductor(c) => {
+            let ior = build_metal(at, &c.metal, base_dir)?;
+            let alpha = c.roughness.map_or(0.0, |r| r.0);
+            if alpha < MIN_ALPHA {
+                Material::Conductor(Conductor { ior })
+            } else {
+                Material::RoughConductor(RoughConductor {
+                    ior,
+                    distribution: TrowbridgeReitz { alpha },
+                })
+            }
+        }
         MaterialFile::Glossy(g) => {
             if g.fresnel.is_some() && g.ior.is_none() {
                 return Err(format!(
@@ -664,10 +862,10 @@ fn build_material(
                 rho_s,
                 shininess: g.shininess.0,
                 base: match &g.ior {
-                    Some(spec) => Some(Dielectric {
-                        ior: build_ior(at, spec, base_dir)?,
-                        fresnel: g.fresnel.unwrap_or(true),
-                    }),
+                    Some(spec) => Some(Dielectric::new(
+                        build_ior(&format!("{at}.ior"), spec, base_dir)?,
+                        g.fresnel.unwrap_or(true),
+                    )),
                     None => None,
                 },
             })
@@ -783,6 +981,17 @@ fn build_sky(
     })
 }
 
+/// A shape entry's material name, emission and two-sidedness.
+fn shape_emission(s: &ShapeFile) -> (Option<&String>, Option<&Emission>, Option<bool>) {
+    match s {
+        ShapeFile::Sphere(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        ShapeFile::Triangle(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        ShapeFile::Plane(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        ShapeFile::Quad(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        ShapeFile::Mesh(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+    }
+}
+
 fn mesh_shape(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, material: u32) -> Shape {
     Shape {
         kind: ShapeKind::Mesh(Mesh { positions, indices }),
@@ -820,11 +1029,12 @@ fn build_mesh(
     at: &str,
     m: &MeshFile,
     lookup: &dyn Fn(String, &str) -> Result<u32>,
+    emitter_material: Option<u32>,
 ) -> Result<Vec<Shape>> {
     // Scene-file checks first: the material names.
     let default_material = match &m.material {
         Some(name) => Some(lookup(format!("{at}.material"), name)?),
-        None => None,
+        None => emitter_material,
     };
     let mut group_material = BTreeMap::new();
     for (group, name) in &m.groups {

@@ -10,8 +10,11 @@ pub use load::load_scene;
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::Shape;
-use crate::light::Light;
-use crate::spectrum::DenseSpectrum;
+use crate::integrator::IntegratorKind;
+use crate::light::sampler::LightSamplerKind;
+use crate::light::{Light, LightSampler, SceneBounds};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::Vec3;
 use std::path::PathBuf;
 
 /// Render settings a scene file may give; the CLI may override spp and seed.
@@ -23,6 +26,11 @@ pub struct RenderSettings {
     /// Ray offset ε for rays leaving surfaces (seed: 1e-4).
     pub epsilon: f32,
     pub seed: u64,
+    /// The scene's integrator (the CLI may override it).
+    pub integrator: IntegratorKind,
+    /// Path depth from which Russian roulette may end a path (path integrator).
+    pub rr_depth: u32,
+    pub light_sampler: LightSamplerKind,
 }
 
 impl Default for RenderSettings {
@@ -32,9 +40,15 @@ impl Default for RenderSettings {
             max_depth: 10,
             epsilon: 1e-4,
             seed: 0,
+            integrator: IntegratorKind::Whitted,
+            rr_depth: 5,
+            light_sampler: LightSamplerKind::Power,
         }
     }
 }
+
+/// `Scene::shape_light` for a shape that does not emit.
+pub const NO_LIGHT: u32 = u32::MAX;
 
 /// A validated scene. `shapes[i]` is Embree geometry i.
 #[derive(Clone, Debug)]
@@ -44,12 +58,111 @@ pub struct Scene {
     pub shapes: Vec<Shape>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
+    /// The file's lights in file order, then one area light per emitting shape, then
+    /// the environment (background and sky), when it emits.
     pub lights: Vec<Light>,
+    /// For each shape, the index of its area light in `lights`, or [`NO_LIGHT`].
+    pub shape_light: Vec<u32>,
+    /// The index of the environment light, if the background or sky emits.
+    pub environment: Option<u32>,
+    /// Lights a ray that leaves the scene can see (the environment first, then suns).
+    pub infinite_lights: Vec<u32>,
     /// Radiance seen along rays that leave the scene.
     pub background: DenseSpectrum,
     /// A rainbow sky, when the scene has one.
     pub sky: Option<std::sync::Arc<SceneSky>>,
     pub settings: RenderSettings,
+    /// The bounding sphere of the shapes.
+    pub bounds: SceneBounds,
+    /// Picks one light per shading point for the path integrator.
+    pub light_sampler: LightSampler,
+}
+
+/// What a scene is made of before its derived parts (the environment light, the list of
+/// lights at infinity, the bounding sphere, the light sampler) are computed.
+pub struct SceneParts {
+    pub source: PathBuf,
+    pub camera: Camera,
+    pub shapes: Vec<Shape>,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    /// Every light but the environment (area lights included).
+    pub lights: Vec<Light>,
+    /// For each shape, its area light in `lights` or [`NO_LIGHT`]; empty: none emits.
+    pub shape_light: Vec<u32>,
+    pub background: DenseSpectrum,
+    pub sky: Option<std::sync::Arc<SceneSky>>,
+    pub settings: RenderSettings,
+}
+
+impl Scene {
+    /// Completes `parts`: appends the environment light when the background or sky
+    /// emits, lists the lights at infinity (environment first, then suns), bounds the
+    /// shapes and builds the light sampler.
+    pub fn from_parts(p: SceneParts) -> Scene {
+        let mut lights = p.lights;
+        let environment = if p.sky.is_some() || p.background.max_value() > 0.0 {
+            lights.push(Light::Environment(crate::light::EnvironmentLight::new(
+                p.background.clone(),
+                p.sky.clone(),
+            )));
+            Some(lights.len() as u32 - 1)
+        } else {
+            None
+        };
+        let mut infinite_lights: Vec<u32> = environment.into_iter().collect();
+        infinite_lights.extend(
+            lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| matches!(l, Light::Sun(_)))
+                .map(|(i, _)| i as u32),
+        );
+        let bounds = load::scene_bounds(&p.shapes);
+        let light_sampler = LightSampler::new(p.settings.light_sampler, &lights, &bounds);
+        let shape_light = if p.shape_light.is_empty() {
+            vec![NO_LIGHT; p.shapes.len()]
+        } else {
+            p.shape_light
+        };
+        Scene {
+            source: p.source,
+            camera: p.camera,
+            shapes: p.shapes,
+            materials: p.materials,
+            material_names: p.material_names,
+            lights,
+            shape_light,
+            environment,
+            infinite_lights,
+            background: p.background,
+            sky: p.sky,
+            settings: p.settings,
+            bounds,
+            light_sampler,
+        }
+    }
+
+    /// Radiance arriving along a ray that leaves the scene in direction `dir`: the
+    /// environment (background or sky) plus every sun whose disk it points into.
+    #[inline]
+    pub fn escaped_radiance<const N: usize>(
+        &self,
+        dir: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        let mut l = SampledSpectrum::<N>::zero();
+        for &i in &self.infinite_lights {
+            l += self.lights[i as usize].le(dir, wl);
+        }
+        l
+    }
+
+    /// Rebuilds the light sampler (after the lights or the kind changed).
+    pub fn rebuild_light_sampler(&mut self) {
+        self.light_sampler =
+            LightSampler::new(self.settings.light_sampler, &self.lights, &self.bounds);
+    }
 }
 
 /// A sky model ready for rendering: tabulated over (θ, λ), tied to the scene's sun.

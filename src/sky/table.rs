@@ -63,6 +63,11 @@ impl SkyTable {
         }
     }
 
+    /// The θ nodes of the grid, degrees, increasing from 0 to 180.
+    pub fn theta_grid(&self) -> &[f64] {
+        &self.theta_deg
+    }
+
     /// Column index and weight for θ in degrees.
     #[inline]
     fn column(&self, theta_deg: f64) -> (usize, f32) {

@@ -70,6 +70,11 @@ impl DenseSpectrum {
         self.values.iter().copied().fold(f32::MIN, f32::max)
     }
 
+    /// Mean of the table over 360–830 nm.
+    pub fn mean(&self) -> f32 {
+        (self.values.iter().map(|&v| v as f64).sum::<f64>() / self.values.len() as f64) as f32
+    }
+
     pub fn min_value(&self) -> f32 {
         self.values.iter().copied().fold(f32::MAX, f32::min)
     }

@@ -6,6 +6,7 @@ pub mod cie;
 pub mod color;
 pub mod dense;
 pub mod ior;
+pub mod metals;
 pub mod rgb2spec;
 pub mod sampled;
 pub mod uplift;

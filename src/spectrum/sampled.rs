@@ -5,7 +5,7 @@
 //! `SampledWavelengths`). Each lane keeps its own pdf; a lane whose pdf is 0 has been
 //! terminated and contributes nothing to the film.
 use super::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
-use std::ops::{Add, AddAssign, Div, Mul, MulAssign};
+use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign};
 
 /// A value per wavelength lane (radiance, throughput, reflectance …).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,6 +105,12 @@ impl<const N: usize> MulAssign<f32> for SampledSpectrum<N> {
         for v in &mut self.0 {
             *v *= s;
         }
+    }
+}
+impl<const N: usize> DivAssign<f32> for SampledSpectrum<N> {
+    #[inline]
+    fn div_assign(&mut self, s: f32) {
+        *self = *self / s;
     }
 }
 impl<const N: usize> Div<f32> for SampledSpectrum<N> {

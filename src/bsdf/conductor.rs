@@ -1,0 +1,67 @@
+//! A smooth metal: a delta reflection weighted by the conductor Fresnel reflectance
+//! R(θ, λ) of its complex index n(λ) + i k(λ) ([`super::fresnel::fresnel_conductor`]),
+//! per lane (pbrt-v4 `ConductorBxDF`, smooth case; Mitsuba 3 `conductor`).
+//!
+//! The index comes from measurements tabulated in `spectra/metals/` (Johnson & Christy
+//! 1972 for Au, Ag, Cu; Rakić et al. 1998 for Al; see spectra/README.md) or from a
+//! user's table. A metal's reflectance depends on wavelength but its direction does
+//! not, so every lane is kept.
+use super::fresnel::fresnel_conductor;
+use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use glam::Vec3;
+
+/// A spectral complex refractive index n(λ) + i k(λ), relative to the outside (n = 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ComplexIor {
+    pub n: DenseSpectrum,
+    pub k: DenseSpectrum,
+}
+
+impl ComplexIor {
+    /// R(cos θ) per lane.
+    #[inline]
+    pub fn reflectance<const N: usize>(
+        &self,
+        cos: f32,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        let mut r = SampledSpectrum::<N>::zero();
+        for i in 0..N {
+            let l = wl.lambda[i];
+            r.0[i] = fresnel_conductor(cos, self.n.eval(l), self.k.eval(l));
+        }
+        r
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Conductor {
+    pub ior: ComplexIor,
+}
+
+const LOBE: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::REFLECTION);
+
+impl Conductor {
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>> {
+        if !ctx.lobes.allows(LOBE) {
+            return None;
+        }
+        let wi = reflect_local(wo);
+        let c = wi.z.abs();
+        Some(BsdfSample {
+            wi,
+            f: self.ior.reflectance(c, wl) / c,
+            pdf: 1.0,
+            flags: LOBE,
+            eta: 1.0,
+            ended_companions: false,
+        })
+    }
+}

@@ -1,0 +1,95 @@
+//! A rough metal: the Torrance–Sparrow microfacet BRDF with the Trowbridge–Reitz (GGX)
+//! distribution (Walter et al. 2007, eq. 20):
+//!
+//! f(ωo, ωi) = D(ωm) G(ωo, ωi) F(ωo·ωm) / (4 |cos θo| |cos θi|),  ωm = (ωo + ωi)/‖ωo + ωi‖,
+//!
+//! with the conductor Fresnel term per lane and directions sampled from the visible
+//! normals (Heitz 2018): pdf = D_ωo(ωm)/(4 |ωo·ωm|). Single scattering only, so energy
+//! is lost at high roughness (tests/bsdf.rs states how much).
+use super::conductor::ComplexIor;
+use super::microfacet::TrowbridgeReitz;
+use super::{reflect, same_hemisphere, BsdfContext, BsdfSample, LobeFlags};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct RoughConductor {
+    pub ior: ComplexIor,
+    pub distribution: TrowbridgeReitz,
+}
+
+const LOBE: LobeFlags = LobeFlags::GLOSSY.union(LobeFlags::REFLECTION);
+
+impl RoughConductor {
+    /// The half vector of a reflection pair, on the outward side; None when degenerate.
+    #[inline]
+    fn half(wo: Vec3, wi: Vec3) -> Option<Vec3> {
+        if !same_hemisphere(wo, wi) {
+            return None;
+        }
+        let h = wo + wi;
+        if h.length_squared() == 0.0 {
+            return None;
+        }
+        let h = h.normalize();
+        Some(if h.z < 0.0 { -h } else { h })
+    }
+
+    #[inline]
+    pub fn eval<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        let Some(wm) = Self::half(wo, wi) else {
+            return SampledSpectrum::zero();
+        };
+        let d = &self.distribution;
+        let k = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z.abs() * wi.z.abs());
+        self.ior.reflectance(wo.dot(wm).abs(), wl) * k
+    }
+
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f32 {
+        if !ctx.lobes.allows(LOBE) {
+            return 0.0;
+        }
+        let Some(wm) = Self::half(wo, wi) else {
+            return 0.0;
+        };
+        self.distribution.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+    }
+
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>> {
+        if !ctx.lobes.allows(LOBE) {
+            return None;
+        }
+        let d = &self.distribution;
+        let wm = d.sample_wm(wo, u);
+        let wi = reflect(wo, wm);
+        if !same_hemisphere(wo, wi) || wi.z == 0.0 {
+            return None;
+        }
+        let pdf = d.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs());
+        if !(pdf > 0.0) {
+            return None;
+        }
+        let k = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z.abs() * wi.z.abs());
+        Some(BsdfSample {
+            wi,
+            f: self.ior.reflectance(wo.dot(wm).abs(), wl) * k,
+            pdf,
+            flags: LOBE,
+            eta: 1.0,
+            ended_companions: false,
+        })
+    }
+}

@@ -1,0 +1,241 @@
+//! The environment: the scene's constant background and its `[sky]` model, as one light
+//! at infinity that every escaping ray sees (pbrt-v4 `UniformInfiniteLight` and
+//! `ImageInfiniteLight`; Mitsuba 3 `constant` and `envmap`). The sun's disk is a light
+//! of its own ([`super::SunLight`]).
+//!
+//! Without a sky, directions are sampled uniformly on the sphere. A sky depends only on
+//! the angle θ from the antisolar point (it is symmetric about the sun's axis), so it is
+//! importance-sampled in u = cos θ from its own (θ, λ) table: the table's θ nodes become
+//! bins in u, each weighted by the larger of its two ends' radiance averaged over
+//! 360–830 nm (the table interpolates linearly between nodes, so that bound never misses
+//! light), and φ is uniform. The density is then p(ω) = p_u(cos θ)/(2π).
+use super::{LightLeSample, LightLiSample, SceneBounds};
+use crate::math::warp::{uniform_sphere, UNIFORM_SPHERE_PDF};
+use crate::math::Frame;
+use crate::scene::SceneSky;
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+#[derive(Clone, Debug)]
+pub struct EnvironmentLight {
+    pub background: DenseSpectrum,
+    pub sky: Option<Arc<SceneSky>>,
+    /// Importance sampling of the sky in u = cos θ about the antisolar axis.
+    zones: Option<Zones>,
+    /// ∫ L dω, averaged over wavelength.
+    power_per_area: f32,
+}
+
+/// A piecewise-constant density over u ∈ [−1, 1] with bins of any width.
+#[derive(Clone, Debug)]
+struct Zones {
+    frame: Frame,
+    /// Bin edges in u, increasing; `edges.len() == density.len() + 1`.
+    edges: Vec<f32>,
+    /// Density in u per bin (integrates to 1).
+    density: Vec<f32>,
+    /// CDF at the edges.
+    cdf: Vec<f32>,
+}
+
+impl Zones {
+    fn sample(&self, u: Vec2) -> (Vec3, f32) {
+        let n = self.density.len();
+        let i = (self.cdf.partition_point(|&c| c <= u.x).max(1) - 1).min(n - 1);
+        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let t = if c1 > c0 {
+            ((u.x - c0) / (c1 - c0)).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let z = (self.edges[i] + t * (self.edges[i + 1] - self.edges[i])).clamp(-1.0, 1.0);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let w = self
+            .frame
+            .to_world(Vec3::new(r * phi.cos(), r * phi.sin(), z));
+        (w, self.density[i] / (2.0 * PI))
+    }
+
+    fn pdf(&self, w: Vec3) -> f32 {
+        let z = w.dot(self.frame.n).clamp(-1.0, 1.0);
+        let n = self.density.len();
+        let i = (self.edges.partition_point(|&e| e <= z).max(1) - 1).min(n - 1);
+        self.density[i] / (2.0 * PI)
+    }
+}
+
+impl EnvironmentLight {
+    pub fn new(background: DenseSpectrum, sky: Option<Arc<SceneSky>>) -> Self {
+        let Some(s) = &sky else {
+            let power_per_area = 4.0 * PI * background.mean();
+            return EnvironmentLight {
+                background,
+                sky,
+                zones: None,
+                power_per_area,
+            };
+        };
+        // Mean radiance over λ at each θ node.
+        let lambdas: Vec<f32> = (0..=94).map(|k| LAMBDA_MIN + 5.0 * k as f32).collect();
+        let bg = if s.replaces_background {
+            0.0
+        } else {
+            background.mean()
+        };
+        let grid = s.table.theta_grid();
+        let mean: Vec<f32> = grid
+            .iter()
+            .map(|&t| {
+                let sum: f32 = lambdas
+                    .iter()
+                    .map(|&l| s.table.eval(t, l) * s.factor.eval(l))
+                    .sum();
+                sum / lambdas.len() as f32 + bg
+            })
+            .collect();
+        debug_assert!(LAMBDA_MAX == lambdas[lambdas.len() - 1]);
+        // Bins in increasing u = cos θ, i.e. θ from 180° down to 0°.
+        let k = grid.len();
+        let mut edges = Vec::with_capacity(k);
+        let mut weight = Vec::with_capacity(k - 1);
+        let mut integral = 0.0f64;
+        for j in (0..k).rev() {
+            edges.push((grid[j].to_radians().cos() as f32).clamp(-1.0, 1.0));
+        }
+        edges[0] = -1.0;
+        edges[k - 1] = 1.0;
+        for b in 0..k - 1 {
+            // Bin b spans θ nodes k−1−b (lower u) and k−2−b.
+            let (hi, lo) = (k - 1 - b, k - 2 - b);
+            weight.push(mean[hi].max(mean[lo]));
+            integral += 0.5 * (mean[hi] + mean[lo]) as f64 * (edges[b + 1] - edges[b]) as f64;
+        }
+        let mass: f64 = weight
+            .iter()
+            .enumerate()
+            .map(|(b, &w)| w as f64 * (edges[b + 1] - edges[b]) as f64)
+            .sum();
+        let power_per_area = (2.0 * std::f64::consts::PI * integral) as f32;
+        if !(mass > 0.0) {
+            // An all-black sky and background: no light, nothing to sample.
+            return EnvironmentLight {
+                background,
+                sky,
+                zones: None,
+                power_per_area: 0.0,
+            };
+        }
+        let density: Vec<f32> = weight.iter().map(|&w| (w as f64 / mass) as f32).collect();
+        let mut cdf = vec![0.0f32; density.len() + 1];
+        let mut acc = 0.0f64;
+        for b in 0..density.len() {
+            acc += weight[b] as f64 * (edges[b + 1] - edges[b]) as f64 / mass;
+            cdf[b + 1] = acc as f32;
+        }
+        let last = cdf.len() - 1;
+        cdf[last] = 1.0;
+        let zones = Zones {
+            frame: Frame::from_z(-s.sun_dir),
+            edges,
+            density,
+            cdf,
+        };
+        EnvironmentLight {
+            background,
+            sky,
+            zones: Some(zones),
+            power_per_area,
+        }
+    }
+
+    /// Radiance arriving along a ray that leaves the scene in direction `dir`: the
+    /// background, or the sky model that contains it or adds to it.
+    #[inline]
+    pub fn le<const N: usize>(&self, dir: Vec3, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        match &self.sky {
+            None => wl.eval(&self.background),
+            Some(sky) => {
+                // θ once per ray; the table per lane.
+                let theta = crate::sky::antisolar_angle(dir, sky.sun_dir).to_degrees();
+                let mut s = SampledSpectrum::<N>::zero();
+                for i in 0..N {
+                    let lambda = wl.lambda[i];
+                    s.0[i] = sky.table.eval(theta, lambda) * sky.factor.eval(lambda);
+                }
+                if sky.replaces_background {
+                    s
+                } else {
+                    s + wl.eval(&self.background)
+                }
+            }
+        }
+    }
+
+    #[inline]
+    fn sample_dir(&self, u: Vec2) -> (Vec3, f32) {
+        match &self.zones {
+            Some(z) => z.sample(u),
+            None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
+        }
+    }
+
+    #[inline]
+    pub fn sample_li<const N: usize>(
+        &self,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+    ) -> Option<LightLiSample<N>> {
+        let (wi, pdf) = self.sample_dir(u);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        Some(LightLiSample {
+            l: self.le(wi, wl),
+            wi,
+            pdf,
+            dist: f32::INFINITY,
+            delta: false,
+        })
+    }
+
+    #[inline]
+    pub fn pdf_li(&self, wi: Vec3) -> f32 {
+        match &self.zones {
+            Some(z) => z.pdf(wi),
+            None => UNIFORM_SPHERE_PDF,
+        }
+    }
+
+    /// A ray coming in from a sampled direction through a point uniform on the disk
+    /// covering the scene's bounding sphere.
+    #[inline]
+    pub fn sample_le<const N: usize>(
+        &self,
+        u1: Vec2,
+        u2: Vec2,
+        wl: &SampledWavelengths<N>,
+        bounds: &SceneBounds,
+    ) -> Option<LightLeSample<N>> {
+        let (w, pdf_dir) = self.sample_dir(u1);
+        if !(pdf_dir > 0.0) {
+            return None;
+        }
+        let (origin, pdf_pos) = bounds.disk_point(w, u2);
+        Some(LightLeSample {
+            origin,
+            dir: -w,
+            l: self.le(w, wl),
+            pdf_pos,
+            pdf_dir,
+            normal: None,
+        })
+    }
+
+    /// Φ = π R² ∫ L dω (pbrt-v4's convention for lights at infinity).
+    pub fn phi(&self, bounds: &SceneBounds) -> f32 {
+        bounds.disk_area() * self.power_per_area
+    }
+}

@@ -1,0 +1,59 @@
+//! Samplers: where an integrator's random numbers come from.
+//!
+//! An integrator asks for numbers through one interface (pbrt-v4 `base/sampler.h`):
+//! [`Sampler::start_pixel_sample`] for a (pixel, sample index), then
+//! [`Sampler::get_pixel_2d`] for the position on the film, and [`Sampler::get_1d`] /
+//! [`Sampler::get_2d`] for each decision, in an order the integrator fixes (its
+//! documentation lists its dimensions). A sampler that places points by dimension (a
+//! low-discrepancy sequence) can then replace the independent one without changing the
+//! integrators, and every sampler's numbers depend only on (seed, pixel, sample index),
+//! never on the thread or the tile order.
+//!
+//! `Sampler` is a closed enum dispatched by `match`, chosen once per render.
+pub mod independent;
+
+pub use independent::IndependentSampler;
+
+use glam::Vec2;
+
+#[derive(Clone, Debug)]
+pub enum Sampler {
+    Independent(IndependentSampler),
+}
+
+impl Sampler {
+    /// The independent sampler for a render with `seed` on a film `width` pixels wide.
+    pub fn independent(seed: u64, width: u32) -> Sampler {
+        Sampler::Independent(IndependentSampler::new(seed, width))
+    }
+
+    /// Starts the numbers of sample `index` of pixel (x, y).
+    #[inline]
+    pub fn start_pixel_sample(&mut self, x: u32, y: u32, index: u32) {
+        match self {
+            Sampler::Independent(s) => s.start_pixel_sample(x, y, index),
+        }
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self) -> f32 {
+        match self {
+            Sampler::Independent(s) => s.get_1d(),
+        }
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self) -> Vec2 {
+        match self {
+            Sampler::Independent(s) => s.get_2d(),
+        }
+    }
+
+    /// The position within the pixel, [0, 1)².
+    #[inline]
+    pub fn get_pixel_2d(&mut self) -> Vec2 {
+        match self {
+            Sampler::Independent(s) => s.get_2d(),
+        }
+    }
+}
