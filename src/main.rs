@@ -37,6 +37,13 @@ enum Command {
     /// Rainbow skies: radiance profiles of the sky models (heron::sky).
     #[command(subcommand)]
     Sky(SkyCommand),
+    /// The scene's spectra (reflectances, emissions, indices) on heron's 1 nm grid as
+    /// JSON, for tests/python/test_mitsuba.py.
+    #[command(hide = true)]
+    Spectra {
+        /// Scene file (TOML).
+        scene: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]
@@ -371,6 +378,9 @@ fn main() {
         }
         Command::Color(args) => cmd_color(args),
         Command::Sky(c) => cmd_sky(c),
+        Command::Spectra { scene } => load_scene(&scene)
+            .map_err(Into::into)
+            .map(|s| println!("{}", heron::scene::export::spectra_json(&s))),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -1,5 +1,6 @@
 //! Scenes: the TOML file format, its validation, and the in-memory scene the renderer
 //! uses.
+pub mod export;
 pub mod features;
 pub mod file;
 pub mod load;

@@ -1,0 +1,67 @@
+//! The spectra a loaded scene uses, as JSON on heron's 1 nm grid (`heron spectra`, a
+//! hidden command): reflectances and emissions after RGB uplift, metals' n and k,
+//! dielectrics' indices, the background. tests/python/test_mitsuba.py gives these same
+//! spectra to Mitsuba 3, so that a comparison of the two renderers does not also
+//! compare their RGB uplifts.
+use super::Scene;
+use crate::bsdf::Material;
+use crate::light::Light;
+use crate::spectrum::{DenseSpectrum, LAMBDA_MIN};
+use serde_json::{json, Value};
+
+fn values(s: &DenseSpectrum) -> Value {
+    json!(s.values().to_vec())
+}
+
+fn ior_values(ior: &crate::spectrum::ior::Ior) -> Value {
+    values(&DenseSpectrum::from_fn(|l| ior.eval(l)))
+}
+
+/// The scene's spectra; `shapes[i]` is Embree geometry i.
+pub fn spectra_json(scene: &Scene) -> Value {
+    let lambda: Vec<f32> = (0..crate::spectrum::DENSE_LEN)
+        .map(|i| LAMBDA_MIN + i as f32)
+        .collect();
+    let mut materials = serde_json::Map::new();
+    for (name, m) in scene.material_names.iter().zip(&scene.materials) {
+        let v = match m {
+            Material::Lambertian(l) => json!({"type": "lambertian", "rho_d": values(&l.rho_d)}),
+            Material::Mirror(l) => json!({"type": "mirror", "rho_s": values(&l.rho_s)}),
+            Material::Dielectric(d) => json!({"type": "dielectric", "ior": ior_values(&d.ior),
+                "outside_ior": ior_values(&d.outside), "fresnel": d.fresnel, "alpha": 0.0}),
+            Material::RoughDielectric(d) => json!({"type": "dielectric",
+                "ior": ior_values(&d.interface.ior), "outside_ior": ior_values(&d.interface.outside),
+                "fresnel": true, "alpha": d.distribution.alpha}),
+            Material::Conductor(c) => json!({"type": "conductor", "n": values(&c.ior.n),
+                "k": values(&c.ior.k), "alpha": 0.0}),
+            Material::RoughConductor(c) => json!({"type": "conductor", "n": values(&c.ior.n),
+                "k": values(&c.ior.k), "alpha": c.distribution.alpha}),
+            Material::Glossy(g) => json!({"type": "glossy", "rho_d": values(&g.rho_d),
+                "rho_s": g.rho_s, "shininess": g.shininess}),
+        };
+        materials.insert(name.clone(), v);
+    }
+    let shapes: Vec<Value> = scene
+        .shapes
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let light = scene.shape_light[i];
+            let (emission, two_sided) = match scene.lights.get(light as usize) {
+                Some(Light::Area(a)) => (values(&a.emission), a.two_sided),
+                _ => (Value::Null, false),
+            };
+            json!({
+                "material": scene.material_names[s.material as usize],
+                "emission": emission,
+                "two_sided": two_sided,
+            })
+        })
+        .collect();
+    json!({
+        "lambda_nm": lambda,
+        "materials": materials,
+        "shapes": shapes,
+        "background": values(&scene.background),
+    })
+}

@@ -1,0 +1,153 @@
+"""heron scenes as Mitsuba 3 scene dictionaries, for the side-by-side tests and the
+benchmark (tests/python/test_mitsuba.py, scripts/bench_mitsuba.py).
+
+Geometry, camera and render settings are read from the heron TOML file; every spectrum
+(reflectances and emissions after heron's RGB uplift, metals' n and k) comes from
+`heron spectra SCENE` on heron's 1 nm grid and is given to Mitsuba as a `regular`
+spectrum, so that the comparison does not also compare the two renderers' RGB uplifts.
+
+What maps onto what:
+
+| heron | Mitsuba 3 |
+| --- | --- |
+| camera (eye, look_at, up, d) | `perspective`, fov_axis y, fov = 2 atan(1/(2d)) |
+| box pixel filter | `hdrfilm` with a `box` rfilter (radius 0.5: the pixel) |
+| `quad` | `rectangle` with to_world columns edge1/2, edge2/2, normal |
+| `sphere` | `sphere` |
+| `lambertian` (two-sided) | `twosided` `diffuse` |
+| `conductor` (smooth, rough) | `conductor`, `roughconductor` (ggx, visible normals) |
+| `dielectric` with a constant index | `dielectric` / `roughdielectric` |
+| `emission` on a shape (one-sided) | `area` emitter |
+| `background` | `constant` emitter |
+| `max_depth` (scattering events) | `path` max_depth = heron's + 1 (Mitsuba counts vertices) |
+
+Anything else (meshes, dispersive glass, point lights…) raises ValueError: the
+comparison covers what both renderers model the same way.
+"""
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+import subprocess
+import tomllib
+
+LAMBDA_MIN, LAMBDA_MAX = 360.0, 830.0
+
+
+def regular(values) -> dict:
+    return {
+        "type": "regular",
+        "wavelength_min": LAMBDA_MIN,
+        "wavelength_max": LAMBDA_MAX,
+        "values": ",".join(f"{v:.9g}" for v in values),
+    }
+
+
+def heron_spectra(heron_bin: pathlib.Path, scene: pathlib.Path) -> dict:
+    out = subprocess.run([str(heron_bin), "spectra", str(scene)], capture_output=True,
+                         text=True, check=True)
+    return json.loads(out.stdout)
+
+
+def _constant(values, what: str) -> float:
+    if max(values) - min(values) > 1e-6 * max(1.0, abs(max(values))):
+        raise ValueError(f"{what}: Mitsuba's dielectric has no dispersion")
+    return float(values[0])
+
+
+def _bsdf(m: dict, name: str) -> dict:
+    t = m["type"]
+    if t == "lambertian":
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": regular(m["rho_d"])}}
+    if t == "conductor":
+        d = {"eta": regular(m["n"]), "k": regular(m["k"])}
+        if m["alpha"] == 0.0:
+            return {"type": "conductor", **d}
+        return {"type": "roughconductor", "distribution": "ggx", "alpha": m["alpha"],
+                "sample_visible": True, **d}
+    if t == "dielectric":
+        d = {"int_ior": _constant(m["ior"], name), "ext_ior": _constant(m["outside_ior"], name)}
+        if not m["fresnel"]:
+            raise ValueError(f"{name}: Mitsuba has no Fresnel-free dielectric")
+        if m["alpha"] == 0.0:
+            return {"type": "dielectric", **d}
+        return {"type": "roughdielectric", "distribution": "ggx", "alpha": m["alpha"],
+                "sample_visible": True, **d}
+    raise ValueError(f"{name}: no Mitsuba counterpart for heron's {t}")
+
+
+def _look_at(mi, eye, target, up):
+    return mi.ScalarTransform4f().look_at(origin=eye, target=target, up=up)
+
+
+def _rectangle(mi, origin, e1, e2):
+    o, a, b = (list(map(float, v)) for v in (origin, e1, e2))
+    n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    ln = math.sqrt(sum(x * x for x in n))
+    n = [x / ln for x in n]
+    c = [o[i] + 0.5 * a[i] + 0.5 * b[i] for i in range(3)]
+    m = [[0.5 * a[i], 0.5 * b[i], n[i], c[i]] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
+    return mi.ScalarTransform4f(m)
+
+
+def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, height=None,
+                 spp: int = 16, max_depth=None) -> dict:
+    """The Mitsuba scene dictionary of heron scene `scene_path` (variant already set)."""
+    doc = tomllib.loads(scene_path.read_text())
+    cam = doc["camera"]
+    w, h = cam["resolution"]
+    w, h = width or w, height or h
+    d = float(cam.get("d", 1.0))
+    render = doc.get("render", {})
+    depth = max_depth if max_depth is not None else int(render.get("max_depth", 10))
+    if doc.get("lights"):
+        raise ValueError("point, directional, spot and sun lights are not converted")
+    scene = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": depth + 1},
+        "sensor": {
+            "type": "perspective",
+            "fov_axis": "y",
+            "fov": math.degrees(2.0 * math.atan(1.0 / (2.0 * d))),
+            "to_world": _look_at(mi, cam["eye"], cam["look_at"], cam.get("up", [0.0, 1.0, 0.0])),
+            "sampler": {"type": "independent", "sample_count": spp},
+            "film": {"type": "hdrfilm", "width": w, "height": h, "rfilter": {"type": "box"},
+                     "pixel_format": "xyz", "component_format": "float32"},
+        },
+    }
+    for name, m in spectra["materials"].items():
+        if name.startswith("("):
+            scene["bsdf-black"] = {"type": "diffuse", "reflectance": 0.0}
+            continue
+        scene[f"bsdf-{name}"] = _bsdf(m, name)
+    for i, (s, sp) in enumerate(zip(doc.get("shapes", []), spectra["shapes"])):
+        t = s["type"]
+        if t == "quad":
+            shape = {"type": "rectangle", "to_world": _rectangle(mi, s["origin"], s["edge1"], s["edge2"])}
+        elif t == "sphere":
+            shape = {"type": "sphere", "center": list(map(float, s["center"])),
+                     "radius": float(s["radius"])}
+        else:
+            raise ValueError(f"shapes[{i}]: {t} is not converted")
+        mat = sp["material"]
+        shape["bsdf"] = {"type": "ref", "id": "bsdf-black" if mat.startswith("(") else f"bsdf-{mat}"}
+        if sp["emission"] is not None:
+            if sp["two_sided"]:
+                raise ValueError(f"shapes[{i}]: Mitsuba's area emitter is one-sided")
+            shape["emitter"] = {"type": "area", "radiance": regular(sp["emission"])}
+        scene[f"shape-{i}"] = shape
+    if max(spectra["background"]) > 0.0:
+        scene["environment"] = {"type": "constant", "radiance": regular(spectra["background"])}
+    return scene
+
+
+def xyz_normalisation(mi, colour) -> float:
+    """Factor that turns Mitsuba's XYZ into heron's: Mitsuba divides by a fixed
+    ∫ȳ = 1/MI_CIE_Y_NORMALIZATION (106.7502594), heron by the sum of its 1 nm CIE 1931
+    table over 360–830 nm (106.857, colour-science's), so Mitsuba's values are 0.1%
+    higher for the same spectrum."""
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(
+        colour.SpectralShape(360, 830, 1))
+    y_integral = float(cmfs.values[:, 1].sum())
+    return 1.0 / (float(mi.MI_CIE_Y_NORMALIZATION) * y_integral)
