@@ -59,9 +59,7 @@ impl AreaLight {
     pub fn new(shape: u32, emission: DenseSpectrum, two_sided: bool, geometry: AreaShape) -> Self {
         let area = match &geometry {
             AreaShape::Sphere { radius, .. } => 4.0 * PI * radius * radius,
-            AreaShape::Triangles { triangles, .. } => {
-                triangles.iter().map(triangle_area).sum()
-            }
+            AreaShape::Triangles { triangles, .. } => triangles.iter().map(triangle_area).sum(),
         };
         AreaLight {
             shape,
