@@ -94,9 +94,17 @@ impl Glossy {
         } else {
             0.0
         };
-        let wb = match &self.base {
-            Some(b) if ctx.lobes.intersects(b.flags()) => 1.0,
-            _ => 0.0,
+        // The base is two delta lobes: it may be chosen when the mask allows either.
+        let base_allowed = ctx
+            .lobes
+            .allows(LobeFlags::SPECULAR | LobeFlags::REFLECTION)
+            || ctx
+                .lobes
+                .allows(LobeFlags::SPECULAR | LobeFlags::TRANSMISSION);
+        let wb = if self.base.is_some() && base_allowed {
+            1.0
+        } else {
+            0.0
         };
         (wd, ws, wb)
     }

@@ -76,17 +76,35 @@ impl Distribution1D {
     #[inline]
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
         let (i, p, t) = self.sample_discrete(u);
-        let n = self.func.len() as f32;
-        ((i as f32 + t) / n, p * n, i)
+        let n = self.func.len();
+        let nf = n as f32;
+        // (i + t)/n can round onto the next bin's edge in f32 (or to 1): step back to the
+        // last float that `pdf` assigns to bin i, so the density reported is bin i's.
+        let bin = |x: f32| bin_of(x, n);
+        let mut x = ((i as f32 + t) / nf).min(1.0 - f32::EPSILON / 2.0);
+        while x > 0.0 && bin(x) > i {
+            x = f32::from_bits(x.to_bits() - 1);
+        }
+        while bin(x) < i {
+            x = f32::from_bits(x.to_bits() + 1);
+        }
+        (x, p * nf, i)
     }
 
     /// Density of `sample_continuous` at x in [0, 1).
     #[inline]
     pub fn pdf(&self, x: f32) -> f32 {
         let n = self.func.len();
-        let i = ((x * n as f32) as usize).min(n - 1);
-        self.pmf(i) * n as f32
+        self.pmf(bin_of(x, n)) * n as f32
     }
+}
+
+/// The bin of x among n equal bins of [0, 1): ⌊x n⌋ computed exactly (in f64, where the
+/// product of an f32 and a bin count is exact), so that x = k/n rounded to f32 falls on
+/// the side of the edge it is on.
+#[inline]
+fn bin_of(x: f32, n: usize) -> usize {
+    ((x as f64 * n as f64) as usize).min(n - 1)
 }
 
 #[cfg(test)]

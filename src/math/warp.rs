@@ -83,12 +83,13 @@ pub fn uniform_triangle(u: Vec2) -> [f32; 3] {
 /// strategy: w = p_f² / (p_f² + p_g²).
 #[inline]
 pub fn power_heuristic(pf: f32, pg: f32) -> f32 {
-    let (f, g) = (pf * pf, pg * pg);
-    if f.is_infinite() {
+    if pf.is_infinite() {
         return 1.0;
     }
+    // Squared in f64: in f32 the squares overflow above 1.8e19 and vanish below 4e-23.
+    let (f, g) = ((pf as f64) * (pf as f64), (pg as f64) * (pg as f64));
     if f + g == 0.0 {
         return 0.0;
     }
-    f / (f + g)
+    (f / (f + g)) as f32
 }
