@@ -1,7 +1,9 @@
 //! The per-sample loop: camera ray, Embree hit, material, shadow rays, continuation, film
-//! weights, on the course's scenes, single-threaded, for 1, 4 and 8 wavelength lanes.
-//! Each iteration renders a 64×64 image at 1 spp on an already built Embree scene, so
-//! time / 4096 is the cost of one sample (criterion reports it as elements/s).
+//! weights, on the course's scenes (Whitted, their default), single-threaded, for 1, 4
+//! and 8 wavelength lanes; and the path integrator on the Cornell box of
+//! `scenes/cornell-box.toml`. Each iteration renders a 64×64 image at 1 spp on an
+//! already built Embree scene, so time / 4096 is the cost of one sample (criterion
+//! reports it as elements/s).
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use heron::render::{RenderOptions, Renderer};
 use heron::scene::load_scene;
@@ -11,7 +13,13 @@ fn shading(c: &mut Criterion) {
     let mut g = c.benchmark_group("sample");
     g.throughput(Throughput::Elements(64 * 64));
     g.sample_size(20);
-    for name in ["default", "default-glass", "default-glossy", "cornell"] {
+    for name in [
+        "default",
+        "default-glass",
+        "default-glossy",
+        "cornell",
+        "cornell-box",
+    ] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.toml"));
         let mut scene = load_scene(&path).expect("scene loads");
         scene.camera = heron::camera::Camera::new(
@@ -25,16 +33,18 @@ fn shading(c: &mut Criterion) {
         .unwrap();
         let renderer = Renderer::new(&scene).expect("embree scene");
         for lanes in [1usize, 4, 8] {
-            if lanes != 4 && name != "default" {
+            if lanes != 4 && name != "default" && name != "cornell-box" {
                 continue;
             }
             let mut o = RenderOptions::from_scene(&scene);
             o.spp = 1;
             o.threads = 1;
             o.lanes = lanes;
-            g.bench_function(format!("{name}/lanes{lanes}"), |b| {
-                b.iter(|| renderer.render(&o).unwrap())
-            });
+            let id = match o.integrator {
+                heron::integrator::IntegratorKind::Whitted => format!("{name}/lanes{lanes}"),
+                k => format!("{name}/{}/lanes{lanes}", k.name()),
+            };
+            g.bench_function(id, |b| b.iter(|| renderer.render(&o).unwrap()));
             if name == "default" && lanes == 4 {
                 // Camera rays one by one instead of Embree 8-wide packets.
                 o.packets = false;

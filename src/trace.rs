@@ -144,10 +144,7 @@ pub fn trace(
         let flags = material.flags();
         let frame = it.frame();
         let wo_local = frame.to_local(wo);
-        let wl = SampledWavelengths::<1> {
-            lambda: [lambda_nm],
-            pdf: [1.0],
-        };
+        let wl = SampledWavelengths::<1>::new([lambda_nm], [1.0]);
         let spec = |side: LobeFlags| {
             let ctx = BsdfContext::radiance::<1>().with_lobes(LobeFlags::SPECULAR | side);
             material

@@ -84,18 +84,12 @@ fn nsf11() -> Ior {
 
 /// One lane at 550 nm.
 fn wl1() -> SampledWavelengths<1> {
-    SampledWavelengths {
-        lambda: [550.0],
-        pdf: [1.0 / 470.0],
-    }
+    SampledWavelengths::new([550.0], [1.0 / 470.0])
 }
 
 /// Four lanes: a hero at 450 nm and its companions 117.5 nm apart.
 fn wl4() -> SampledWavelengths<4> {
-    SampledWavelengths {
-        lambda: [450.0, 567.5, 685.0, 802.5],
-        pdf: [1.0 / 470.0; 4],
-    }
+    SampledWavelengths::new([450.0, 567.5, 685.0, 802.5], [1.0 / 470.0; 4])
 }
 
 fn ctx<const N: usize>(mode: TransportMode) -> BsdfContext {
@@ -421,10 +415,7 @@ fn chi2_rough_dielectric_dispersive() {
             &sphere(),
         ));
         // The density is the hero's: the same as with the hero alone.
-        let hero = SampledWavelengths::<1> {
-            lambda: [wl4().lambda[0]],
-            pdf: [wl4().pdf[0]],
-        };
+        let hero = SampledWavelengths::<1>::new([wl4().lambda[0]], [wl4().pdf[0]]);
         let mut rng = Rng::new(17, inside as u64);
         for _ in 0..10_000 {
             let wi = uniform_sphere(Vec2::new(rng.uniform(), rng.uniform()));

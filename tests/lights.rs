@@ -41,10 +41,7 @@ const CHI2_TESTS: usize = SUN_TESTS + SPHERE_TESTS + MESH_TESTS + ENVIRONMENT_TE
 const P: Vec3 = Vec3::new(0.31, -0.17, 0.23);
 
 fn wl1() -> SampledWavelengths<1> {
-    SampledWavelengths {
-        lambda: [550.0],
-        pdf: [1.0 / 470.0],
-    }
+    SampledWavelengths::new([550.0], [1.0 / 470.0])
 }
 
 fn u2(r: &mut Rng) -> Vec2 {
@@ -432,10 +429,7 @@ fn sky_density_is_positive_wherever_the_sky_shines() {
         for k in 0..200_000 {
             let w = heron::math::warp::uniform_sphere(u2(&mut rng));
             let lambda = 360.0 + 470.0 * (k as f32 / 200_000.0);
-            let wl = SampledWavelengths::<1> {
-                lambda: [lambda],
-                pdf: [1.0 / 470.0],
-            };
+            let wl = SampledWavelengths::<1>::new([lambda], [1.0 / 470.0]);
             if light.le(w, &wl).0[0] > 0.0 {
                 assert!(light.pdf_li(P, w, None) > 0.0, "{w:?} at {lambda} nm");
             }
@@ -470,10 +464,7 @@ fn power_by_sampling(name: &str, light: &Light, n: usize, step: usize) -> (f64, 
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for _ in 0..n {
         let k = ((rng.uniform() * nodes as f32) as usize).min(nodes - 1);
-        let wl = SampledWavelengths::<1> {
-            lambda: [360.0 + (k * step) as f32],
-            pdf: [1.0 / 470.0],
-        };
+        let wl = SampledWavelengths::<1>::new([360.0 + (k * step) as f32], [1.0 / 470.0]);
         let (u1, uu) = (u2(&mut rng), u2(&mut rng));
         let Some(e) = light.sample_le(u1, uu, &wl, &b) else {
             continue;

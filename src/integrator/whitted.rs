@@ -137,7 +137,7 @@ fn direct_lighting<const N: usize>(
             continue;
         }
         if !occluded(ctx, x, ls.wi, ls.dist, counters) {
-            visit(ls.wi, ls.l / ls.pdf * cos);
+            visit(ls.wi, ls.l * (cos / ls.pdf));
         }
     }
 }

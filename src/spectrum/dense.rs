@@ -50,9 +50,22 @@ impl DenseSpectrum {
     /// Value at `lambda` nm by linear interpolation; clamped to the table's ends.
     #[inline]
     pub fn eval(&self, lambda: f32) -> f32 {
+        let (i, t) = Self::position(lambda);
+        self.eval_at(i, t)
+    }
+
+    /// The row i and fraction t in [0, 1] at which `lambda` nm falls (clamped to the
+    /// table's ends), so that the value there is values[i] + t (values[i+1] − values[i]).
+    #[inline]
+    pub fn position(lambda: f32) -> (usize, f32) {
         let x = (lambda - LAMBDA_MIN).clamp(0.0, (DENSE_LEN - 1) as f32);
         let i = (x as usize).min(DENSE_LEN - 2);
-        let t = x - i as f32;
+        (i, x - i as f32)
+    }
+
+    /// The value at a [`Self::position`].
+    #[inline]
+    pub fn eval_at(&self, i: usize, t: f32) -> f32 {
         let a = self.values[i];
         let b = self.values[i + 1];
         a + t * (b - a)

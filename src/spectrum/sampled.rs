@@ -177,13 +177,37 @@ impl WavelengthSampler {
 }
 
 /// The N wavelengths of one path (nm) and their pdfs (nm⁻¹).
+///
+/// Each lane's position in heron's 1 nm tables (`DenseSpectrum`) is computed once, here,
+/// so that every spectrum evaluated along the path costs two loads and a lerp per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampledWavelengths<const N: usize> {
     pub lambda: [f32; N],
     pub pdf: [f32; N],
+    /// Table row and fraction of each lane ([`DenseSpectrum::position`]).
+    index: [u32; N],
+    frac: [f32; N],
 }
 
 impl<const N: usize> SampledWavelengths<N> {
+    /// Wavelengths (nm) with their pdfs (nm⁻¹).
+    #[inline]
+    pub fn new(lambda: [f32; N], pdf: [f32; N]) -> Self {
+        let mut index = [0u32; N];
+        let mut frac = [0.0f32; N];
+        for i in 0..N {
+            let (k, t) = DenseSpectrum::position(lambda[i]);
+            index[i] = k as u32;
+            frac[i] = t;
+        }
+        SampledWavelengths {
+            lambda,
+            pdf,
+            index,
+            frac,
+        }
+    }
+
     /// Uniform hero over 360–830 nm; companions at offsets of 470/N nm, wrapped.
     #[inline]
     pub fn sample_uniform(u: f32) -> Self {
@@ -203,15 +227,16 @@ impl<const N: usize> SampledWavelengths<N> {
             }
             (lambda[i], pdf[i]) = sampler.sample(ui);
         }
-        SampledWavelengths { lambda, pdf }
+        Self::new(lambda, pdf)
     }
 
-    /// Evaluates a dense spectrum at every lane.
+    /// Evaluates a dense spectrum at every lane (the same values as
+    /// `DenseSpectrum::eval` at each λ).
     #[inline]
     pub fn eval(&self, s: &DenseSpectrum) -> SampledSpectrum<N> {
         let mut out = [0.0; N];
-        for (o, &l) in out.iter_mut().zip(&self.lambda) {
-            *o = s.eval(l);
+        for ((o, &k), &t) in out.iter_mut().zip(&self.index).zip(&self.frac) {
+            *o = s.eval_at(k as usize, t);
         }
         SampledSpectrum(out)
     }

@@ -1,0 +1,155 @@
+#!/usr/bin/env python3
+"""Equal-error render time: heron's path tracer against Mitsuba 3 on the same scene.
+
+    .venv/bin/python scripts/bench_mitsuba.py [--scene scenes/cornell-box.toml]
+        [--ref-spp 4096] [--spp 16,32,64,128,256] [--rounds 3] [--threads 2]
+        [--heron-args "--lanes 8"]...
+
+Each renderer is measured against its own high-sample reference (heron's made by heron,
+Mitsuba's by Mitsuba's LLVM variant: both Mitsuba variants compute the same estimator),
+so neither is charged for the other's small systematic differences. Runs are
+interleaved (for each round and spp: heron, Mitsuba scalar_spectral, Mitsuba
+llvm_ad_spectral, and any extra heron settings), because this machine's timings drift by
+±15% over minutes; the reported time is the median over the rounds.
+
+Time is the render alone: heron's own "in X s" (after loading the scene and building
+Embree's BVH), and the wall time of Mitsuba's mi.render (after mi.load_dict; the LLVM
+variant's kernels are compiled by a warm-up render first). Error is the relative RMSE
+of linear sRGB, sqrt(Σ(x − ref)²)/sqrt(Σ ref²), as `heron converge` defines it, with
+both images converted from XYZ by the same IEC 61966-2-1 matrix. RMSE·√t is constant
+for an unbiased estimator; the time heron needs to reach Mitsuba's error at 64 spp is
+(RMSE·√t of heron / RMSE of Mitsuba at 64 spp)², from heron's median RMSE·√t.
+
+Needs the pinned .venv (scripts/setup-python.sh) and a release build of heron.
+"""
+from __future__ import annotations
+
+import argparse
+import pathlib
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests" / "python"))
+from mitsuba_scene import heron_spectra, mitsuba_dict, xyz_normalisation  # noqa: E402
+
+XYZ_TO_SRGB = np.array([[3.2404542, -1.5371385, -0.4985314],
+                        [-0.9692660, 1.8760108, 0.0415560],
+                        [0.0556434, -0.2040259, 1.0572252]])
+
+
+def read_xyz(path):
+    import OpenEXR
+
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        ch = f.channels()
+        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "XYZ"], -1)
+
+
+def rel_rmse(xyz, ref_xyz):
+    a, r = xyz @ XYZ_TO_SRGB.T, ref_xyz @ XYZ_TO_SRGB.T
+    return float(np.sqrt(((a - r) ** 2).sum() / (r ** 2).sum()))
+
+
+class Heron:
+    def __init__(self, binary, scene, threads, extra, tmp):
+        self.binary, self.scene, self.threads, self.extra, self.tmp = binary, scene, threads, extra, tmp
+        self.name = "heron" + (f" {' '.join(extra)}" if extra else "")
+
+    def render(self, spp, seed):
+        out = self.tmp / "h.exr"
+        p = subprocess.run([str(self.binary), "render", str(self.scene), "-o", str(out),
+                            "--spp", str(spp), "--seed", str(seed), "--threads", str(self.threads),
+                            "--xyz", "--no-png", "--quiet", *self.extra],
+                           check=True, capture_output=True, text=True)
+        t = float(re.search(r" in ([0-9.]+) s:", p.stderr).group(1))
+        return read_xyz(out), t
+
+
+class Mitsuba:
+    def __init__(self, variant, scene_path, spectra, threads):
+        import colour
+        import drjit as dr
+        import mitsuba as mi
+
+        self.mi, self.dr, self.variant = mi, dr, variant
+        self.name = f"mitsuba {variant}"
+        mi.set_variant(variant)
+        dr.set_thread_count(threads)
+        self.scene = mi.load_dict(mitsuba_dict(mi, scene_path, spectra))
+        self.k = xyz_normalisation(mi, colour)
+        if variant.startswith("llvm"):
+            self.render(4, 0)  # compile the kernels
+
+    def render(self, spp, seed):
+        self.mi.set_variant(self.variant)
+        t0 = time.perf_counter()
+        img = np.array(self.mi.render(self.scene, spp=spp, seed=seed), dtype=np.float64)
+        return img * self.k, time.perf_counter() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scene", default="scenes/cornell-box.toml")
+    ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--spp", default="16,32,64,128,256")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--heron-args", action="append", default=[],
+                    help="extra heron settings measured as further rows, e.g. '--lanes 8'")
+    a = ap.parse_args()
+    scene = (REPO / a.scene).resolve()
+    binary = REPO / "target" / "release" / "heron"
+    spps = [int(s) for s in a.spp.split(",")]
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="heron-bench-"))
+    spectra = heron_spectra(binary, scene)
+    runners = [Heron(binary, scene, a.threads, [], tmp)]
+    runners += [Heron(binary, scene, a.threads, x.split(), tmp) for x in a.heron_args]
+    scalar = Mitsuba("scalar_spectral", scene, spectra, a.threads)
+    llvm = Mitsuba("llvm_ad_spectral", scene, spectra, a.threads)
+    runners += [scalar, llvm]
+
+    print(f"# {a.scene}, {a.threads} threads, references at {a.ref_spp} spp, {a.rounds} rounds",
+          flush=True)
+    t0 = time.perf_counter()
+    refs = {r.name: None for r in runners}
+    for r in runners:
+        if isinstance(r, Heron):
+            refs[r.name] = r.render(a.ref_spp, 100_000)[0]
+    mref = llvm.render(a.ref_spp, 100_000)[0]
+    refs[scalar.name] = refs[llvm.name] = mref
+    print(f"# references took {time.perf_counter() - t0:.0f} s", flush=True)
+
+    rows = {}
+    for rnd in range(a.rounds):
+        for spp in spps:
+            for r in runners:
+                img, t = r.render(spp, 1 + rnd)
+                rows.setdefault((r.name, spp), []).append((t, rel_rmse(img, refs[r.name])))
+    print("renderer,spp,time_s,rel_rmse,rmse_sqrt_time")
+    eff = {}
+    for (name, spp), v in rows.items():
+        t = statistics.median(x[0] for x in v)
+        e = statistics.median(x[1] for x in v)
+        eff.setdefault(name, []).append(e * t ** 0.5)
+        print(f"{name},{spp},{t:.3f},{e:.5f},{e * t ** 0.5:.5f}")
+    print()
+    for m in (scalar, llvm):
+        e64 = statistics.median(x[1] for x in rows[(m.name, 64)])
+        t64 = statistics.median(x[0] for x in rows[(m.name, 64)])
+        for r in runners:
+            if not isinstance(r, Heron):
+                continue
+            th = (statistics.median(eff[r.name]) / e64) ** 2
+            print(f"{r.name} reaches {m.name}'s 64-spp error ({e64:.4f}) in {th:.3f} s; "
+                  f"{m.name} takes {t64:.3f} s: ratio {th / t64:.3f}")
+
+
+if __name__ == "__main__":
+    main()
