@@ -475,3 +475,64 @@ fn render_tile<const N: usize>(
         nonfinite,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load::load_scene_from_str;
+    use std::path::Path;
+
+    /// A splatting integrator (standing in for light tracing): each sample splats the
+    /// constant spectrum 1 into a pixel chosen by its own random numbers and returns
+    /// nothing for its own pixel. Every pixel is then expected to receive 1 per sample on
+    /// average, i.e. Y ≈ 1 after the film divides by spp, and the image must be the same
+    /// bytes for any thread count, since splats are merged tile by tile in order.
+    #[test]
+    fn splats_are_deterministic_and_normalised_by_spp() {
+        let scene = load_scene_from_str(
+            "[camera]\neye = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nresolution = [40, 24]\n",
+            Path::new("splat.toml"),
+        )
+        .unwrap();
+        let device = embree::Device::new("").unwrap();
+        let accel = build_accel(&scene, &device).unwrap();
+        let ctx = Context {
+            scene: &scene,
+            accel: &accel,
+        };
+        let npix = (40 * 24) as f32;
+        let integrate = |n: Lanes| -> SampleFn {
+            assert_eq!(n, Lanes::Four);
+            SampleFn::Four(Box::new(move |_, _, _, wl, s, _, splats| {
+                let p = (s.get_1d() * npix) as u32;
+                // Radiance 1 at every lane: the film's Y of one splat is the sample's
+                // estimate of ∫ȳ / ∫ȳ = 1 (up to the lanes' λ noise).
+                splats.add(p, &SampledSpectrum::splat(1.0), wl);
+                SampledSpectrum::zero()
+            }))
+        };
+        let run = |threads: usize, pass: u32| {
+            let pool = embree::worker_pool(threads).unwrap();
+            let mut o = RenderOptions::from_scene(&scene);
+            o.spp = 64;
+            o.threads = threads;
+            render_passes(&ctx, &pool, &o, pass, &integrate).unwrap().0
+        };
+        let a = run(1, 16);
+        assert!(
+            a == run(2, 16) && a == run(3, 16),
+            "splats depend on the thread count"
+        );
+        let mean = a.xyz.iter().map(|c| c[1] as f64).sum::<f64>() / a.xyz.len() as f64;
+        assert!((mean - 1.0).abs() < 0.02, "mean splatted Y {mean}");
+        // Passes only regroup the same splats: the same image up to summation order.
+        let b = run(2, 64);
+        let worst = a
+            .xyz
+            .iter()
+            .zip(&b.xyz)
+            .map(|(x, y)| (x[1] - y[1]).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-5, "{worst}");
+    }
+}
