@@ -28,10 +28,10 @@ pub fn xyz_of_sample<const N: usize>(
             continue;
         }
         let w = l.0[i] * k / p;
-        let lambda = wl.lambda[i];
-        xyz[0] += w * obs.x.eval(lambda);
-        xyz[1] += w * obs.y.eval(lambda);
-        xyz[2] += w * obs.z.eval(lambda);
+        let (j, t) = wl.position(i);
+        xyz[0] += w * obs.x.eval_at(j, t);
+        xyz[1] += w * obs.y.eval_at(j, t);
+        xyz[2] += w * obs.z.eval_at(j, t);
     }
     xyz
 }

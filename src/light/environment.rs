@@ -78,8 +78,9 @@ impl EnvironmentLight {
                 power_per_area,
             };
         };
-        // Mean radiance over λ at each θ node.
-        let lambdas: Vec<f32> = (0..=94).map(|k| LAMBDA_MIN + 5.0 * k as f32).collect();
+        // Mean radiance over λ at each θ node, on the table's own 5 nm rows.
+        let rows = ((LAMBDA_MAX - LAMBDA_MIN) / 5.0).round() as usize;
+        let lambdas: Vec<f32> = (0..=rows).map(|k| LAMBDA_MIN + 5.0 * k as f32).collect();
         let bg = if s.replaces_background {
             0.0
         } else {
@@ -96,7 +97,6 @@ impl EnvironmentLight {
                 sum / lambdas.len() as f32 + bg
             })
             .collect();
-        debug_assert!(LAMBDA_MAX == lambdas[lambdas.len() - 1]);
         // Bins in increasing u = cos θ, i.e. θ from 180° down to 0°.
         let k = grid.len();
         let mut edges = Vec::with_capacity(k);

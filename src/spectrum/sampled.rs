@@ -230,6 +230,12 @@ impl<const N: usize> SampledWavelengths<N> {
         Self::new(lambda, pdf)
     }
 
+    /// Lane i's row and fraction in heron's 1 nm tables ([`DenseSpectrum::position`]).
+    #[inline]
+    pub fn position(&self, i: usize) -> (usize, f32) {
+        (self.index[i] as usize, self.frac[i])
+    }
+
     /// Evaluates a dense spectrum at every lane (the same values as
     /// `DenseSpectrum::eval` at each λ).
     #[inline]
