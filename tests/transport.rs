@@ -35,13 +35,17 @@ fn run(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64) -> Film {
     film
 }
 
+/// Mean and standard error of independent values.
+fn mean_se_of(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
 /// Mean and standard error of the film's Y over all pixels.
 fn mean_se(film: &Film) -> (f64, f64) {
-    let y: Vec<f64> = film.xyz.iter().map(|c| c[1] as f64).collect();
-    let n = y.len() as f64;
-    let m = y.iter().sum::<f64>() / n;
-    let var = y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
+    mean_se_of(&film.xyz.iter().map(|c| c[1] as f64).collect::<Vec<_>>())
 }
 
 /// The camera constant d for a view that the sphere of radius r at distance D fills:
@@ -212,10 +216,7 @@ angular_radius = 2.0
                         d.push(p.xyz[i][ch] as f64 - w.xyz[i][ch] as f64);
                     }
                 }
-                let n = d.len() as f64;
-                let m = d.iter().sum::<f64>() / n;
-                let var = d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0);
-                let se = (var / n).sqrt();
+                let (m, se) = mean_se_of(&d);
                 if se == 0.0 {
                     assert_eq!(m, 0.0);
                     continue;
