@@ -344,3 +344,53 @@ fn ending_secondary_wavelengths_is_unbiased() {
         );
     }
 }
+
+/// A dielectric may name the index of the medium outside it (glass in water): the
+/// interface then refracts with n_inside/n_outside, both functions of λ, and a sphere
+/// whose outside medium has its own index (index matching) neither bends nor reflects.
+#[test]
+fn the_outside_medium_index_sets_the_relative_index() {
+    let mut s = glass_scene(vec![drop()], ior::named("N-BK7").unwrap());
+    if let heron::bsdf::Material::Dielectric(d) = &mut s.materials[0] {
+        d.outside = ior::named("water").unwrap();
+    }
+    let r = Renderer::new(&s).unwrap();
+    let mut rng = Rng::new(4, 4);
+    let mut checked = 0;
+    for _ in 0..200 {
+        let lambda = 380.0 + 400.0 * rng.uniform();
+        let o = Vec3::new(-3.0, 0.2 + 0.4 * rng.uniform(), 0.3 * rng.uniform() - 0.15);
+        let target = Vec3::new(0.0, 0.3, 0.0) + 0.3 * Vec3::new(rng.uniform(), rng.uniform(), 0.0);
+        let rep = run(&s, &r, o, target - o, lambda, &[]);
+        let (glass, water) = (
+            ior::named("N-BK7").unwrap().eval(lambda),
+            ior::named("water").unwrap().eval(lambda),
+        );
+        for e in rep.events.iter().filter(|e| e.kind == EventKind::Refract) {
+            let (ni, nt) = (e.n_i.unwrap(), e.n_t.unwrap());
+            assert!(
+                (ni == water && nt == glass) || (ni == glass && nt == water),
+                "indices {ni}, {nt}; water {water}, glass {glass}"
+            );
+            let nrm = v(e.normal.unwrap());
+            let sin_i = v(e.incoming).cross(nrm).length();
+            let sin_t = v(e.outgoing.unwrap()).cross(nrm).length();
+            assert!((ni * sin_i - nt * sin_t).abs() < 1e-5);
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked}");
+
+    // Index-matched: the ray goes straight through, with no Fresnel reflection.
+    let mut m = glass_scene(vec![drop()], Ior::Constant(1.5));
+    if let heron::bsdf::Material::Dielectric(d) = &mut m.materials[0] {
+        d.outside = Ior::Constant(1.5);
+    }
+    let r = Renderer::new(&m).unwrap();
+    let dir = Vec3::new(1.0, 0.1, 0.05).normalize();
+    let rep = run(&m, &r, Vec3::new(-3.0, 0.3, 0.0), dir, 550.0, &[]);
+    for e in rep.events.iter().filter(|e| e.kind == EventKind::Refract) {
+        assert!((v(e.outgoing.unwrap()) - dir).length() < 1e-5);
+        assert!(e.fresnel_r.unwrap() < 1e-12);
+    }
+}
