@@ -1,6 +1,29 @@
 //! The lecture's pinhole camera: eye, look-at point, up vector and camera constant d
 //! (the distance from the eye to an image plane of height 1).
+//!
+//! As a sensor (for paths that start at the lights): the importance a pinhole camera
+//! gives a direction ω at angle θ from its axis is We(ω) = 1/(A cos⁴θ), where A is the
+//! area of the image plane moved to distance 1 (aspect/d²); it makes ∫ We cos θ dω over
+//! the image equal 1 (pbrt-v4 `PerspectiveCamera::We`, Veach 1997 §8.2). Camera rays
+//! through uniformly chosen film points have the direction density 1/(A cos³θ); the
+//! eye is a point (position density 1, a delta). A light path connects to the camera
+//! through [`Camera::sample_wi`], which also says which pixel it lands in.
 use glam::Vec3;
+
+/// A connection from a point in the scene to the camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraWiSample {
+    /// Importance We of the direction from the eye to the point.
+    pub we: f32,
+    /// Unit direction from the point toward the eye.
+    pub wi: Vec3,
+    /// Distance to the eye.
+    pub dist: f32,
+    /// Density of this connection in solid angle at the point: dist²/cos θ.
+    pub pdf: f32,
+    /// Film position in pixels, (0, 0) at the top-left corner.
+    pub raster: (f32, f32),
+}
 
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -67,5 +90,148 @@ impl Camera {
         let u = (x / self.width as f32 - 0.5) * aspect;
         let w = 0.5 - y / self.height as f32;
         (u * self.b1 + w * self.b2 + self.d * self.v).normalize()
+    }
+
+    /// The unit viewing direction (the camera's axis).
+    pub fn forward(&self) -> Vec3 {
+        self.v
+    }
+
+    /// Area of the image plane at distance 1 from the eye.
+    #[inline]
+    fn film_area(&self) -> f32 {
+        let aspect = self.width as f32 / self.height as f32;
+        aspect / (self.d * self.d)
+    }
+
+    /// Film position (pixels) that the unit direction `w` from the eye passes through,
+    /// or None when it is outside the image (or behind the camera). Inverse of
+    /// [`Camera::direction`].
+    #[inline]
+    pub fn raster(&self, w: Vec3) -> Option<(f32, f32)> {
+        let c = w.dot(self.v);
+        if !(c > 0.0) {
+            return None;
+        }
+        let aspect = self.width as f32 / self.height as f32;
+        let u = self.d * w.dot(self.b1) / c;
+        let v = self.d * w.dot(self.b2) / c;
+        let x = (u / aspect + 0.5) * self.width as f32;
+        let y = (0.5 - v) * self.height as f32;
+        let inside =
+            (0.0..self.width as f32).contains(&x) && (0.0..self.height as f32).contains(&y);
+        inside.then_some((x, y))
+    }
+
+    /// Importance We(w) of the unit direction `w` leaving the eye (zero outside the
+    /// image).
+    #[inline]
+    pub fn we(&self, w: Vec3) -> f32 {
+        if self.raster(w).is_none() {
+            return 0.0;
+        }
+        let c = w.dot(self.v);
+        1.0 / (self.film_area() * c * c * c * c)
+    }
+
+    /// (position density, direction density) of the camera ray leaving in unit
+    /// direction `w`, when film points are chosen uniformly: (1, 1/(A cos³θ)); the
+    /// direction density is zero outside the image.
+    #[inline]
+    pub fn pdf_we(&self, w: Vec3) -> (f32, f32) {
+        if self.raster(w).is_none() {
+            return (1.0, 0.0);
+        }
+        let c = w.dot(self.v);
+        (1.0, 1.0 / (self.film_area() * c * c * c))
+    }
+
+    /// The connection from point `p` to the eye: We, the direction, its solid-angle
+    /// density dist²/cos θ (pbrt-v4 `PerspectiveCamera::SampleWi` with a pinhole) and
+    /// the pixel; None when `p` is not in view.
+    #[inline]
+    pub fn sample_wi(&self, p: Vec3) -> Option<CameraWiSample> {
+        let to_eye = self.eye - p;
+        let d2 = to_eye.length_squared();
+        let dist = d2.sqrt();
+        if !(dist > 0.0) {
+            return None;
+        }
+        let wi = to_eye / dist;
+        let w = -wi;
+        let raster = self.raster(w)?;
+        let c = w.dot(self.v);
+        Some(CameraWiSample {
+            we: 1.0 / (self.film_area() * c * c * c * c),
+            wi,
+            dist,
+            pdf: d2 / c,
+            raster,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cam() -> Camera {
+        Camera::new(
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(0.0, 0.5, -1.0),
+            Vec3::Y,
+            1.3,
+            64,
+            40,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn raster_inverts_direction() {
+        let c = cam();
+        for &(x, y) in &[(0.5f32, 0.5f32), (10.25, 30.75), (63.5, 39.5), (32.0, 20.0)] {
+            let (rx, ry) = c.raster(c.direction(x, y)).unwrap();
+            assert!(
+                (rx - x).abs() < 1e-3 && (ry - y).abs() < 1e-3,
+                "({x}, {y}) -> ({rx}, {ry})"
+            );
+        }
+        assert!(c.raster(-c.forward()).is_none());
+    }
+
+    /// ∫ We cos θ dω over the image is 1, and so is ∫ pdf_dir dω: integrated over the
+    /// film in pixel space, where dω = cos³θ dA/d² (dA the film area element at
+    /// distance d).
+    #[test]
+    fn importance_and_direction_density_integrate_to_one() {
+        let c = cam();
+        let aspect = c.width as f64 / c.height as f64;
+        let pixel_area = aspect / c.width as f64 / c.height as f64; // at distance d
+        let (mut a, mut b) = (0.0f64, 0.0f64);
+        let k = 4;
+        for y in 0..c.height * k {
+            for x in 0..c.width * k {
+                let w = c.direction((x as f32 + 0.5) / k as f32, (y as f32 + 0.5) / k as f32);
+                let cos = w.dot(c.forward()) as f64;
+                let domega = cos.powi(3) * pixel_area / (k * k) as f64 / (c.d as f64).powi(2);
+                a += c.we(w) as f64 * cos * domega;
+                b += c.pdf_we(w).1 as f64 * domega;
+            }
+        }
+        assert!((a - 1.0).abs() < 1e-4 && (b - 1.0).abs() < 1e-4, "{a} {b}");
+    }
+
+    #[test]
+    fn sample_wi_points_at_the_eye_with_dist_squared_over_cos() {
+        let c = cam();
+        let p = c.eye + 5.0 * c.direction(20.0, 10.0);
+        let s = c.sample_wi(p).unwrap();
+        assert!((s.dist - 5.0).abs() < 1e-4);
+        assert!((s.wi + c.direction(20.0, 10.0)).length() < 1e-5);
+        let cos = c.direction(20.0, 10.0).dot(c.forward());
+        assert!((s.pdf - 25.0 / cos).abs() < 1e-2);
+        assert!((s.raster.0 - 20.0).abs() < 1e-3 && (s.raster.1 - 10.0).abs() < 1e-3);
+        assert!(c.sample_wi(c.eye - c.forward()).is_none());
     }
 }

@@ -208,8 +208,8 @@ struct ConvergeArgs {
     /// How hero wavelengths are drawn in the measured runs: uniform or visible.
     #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
     wavelengths: String,
-    /// whitted or path; default: the scene's.
-    #[arg(long, value_parser = ["whitted", "path"])]
+    /// whitted, path, lighttrace or bdpt; default: the scene's.
+    #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
     integrator: Option<String>,
 }
 
@@ -310,9 +310,10 @@ struct RenderArgs {
     /// How hero wavelengths are drawn: uniform or visible (pdf ∝ 1/cosh²(0.0072(λ − 538))).
     #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
     wavelengths: String,
-    /// whitted (the seed's tracer) or path (path tracing with MIS); default: the scene's
-    /// [render] integrator, else whitted.
-    #[arg(long, value_parser = ["whitted", "path"])]
+    /// whitted (the seed's tracer), path (path tracing with MIS), lighttrace (paths from
+    /// the lights, splatted) or bdpt (bidirectional); default: the scene's [render]
+    /// integrator, else whitted.
+    #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
     integrator: Option<String>,
     /// Maximum number of scattering events per path (overrides the scene's
     /// render.max_depth).

@@ -185,18 +185,33 @@ fn render_with(
     let kind = opts.integrator;
     let integrate = move |n: Lanes| -> SampleFn {
         match n {
-            Lanes::One => SampleFn::One(Box::new(move |c, r, h, wl, s, k, _| {
-                integrator::radiance::<1>(kind, c, r, h, wl, s, k)
+            Lanes::One => SampleFn::One(Box::new(move |c, r, h, wl, s, k, sp| {
+                integrator::radiance::<1>(kind, c, r, h, wl, s, k, sp)
             })),
-            Lanes::Four => SampleFn::Four(Box::new(move |c, r, h, wl, s, k, _| {
-                integrator::radiance::<4>(kind, c, r, h, wl, s, k)
+            Lanes::Four => SampleFn::Four(Box::new(move |c, r, h, wl, s, k, sp| {
+                integrator::radiance::<4>(kind, c, r, h, wl, s, k, sp)
             })),
-            Lanes::Eight => SampleFn::Eight(Box::new(move |c, r, h, wl, s, k, _| {
-                integrator::radiance::<8>(kind, c, r, h, wl, s, k)
+            Lanes::Eight => SampleFn::Eight(Box::new(move |c, r, h, wl, s, k, sp| {
+                integrator::radiance::<8>(kind, c, r, h, wl, s, k, sp)
             })),
         }
     };
-    render_passes(&ctx, pool, opts, opts.spp, &integrate)
+    // A splatting integrator keeps its splats per tile for one pass: passes of about a
+    // million pixel samples bound that memory (tens of MB).
+    let pass = if kind.splats() {
+        let npix = (scene.camera.width * scene.camera.height).max(1);
+        ((1u32 << 20) / npix).max(1)
+    } else {
+        opts.spp
+    };
+    let mut opts = opts.clone();
+    opts.packets &= kind.uses_camera_rays();
+    render_passes(&ctx, pool, &opts, pass, &integrate)
+}
+
+/// Whether the render's integrator splats (so that splat buffers are needed).
+fn kind_splats(opts: &RenderOptions) -> bool {
+    opts.integrator.splats()
 }
 
 /// The lane counts a render can use, chosen once per render.
@@ -279,6 +294,7 @@ pub(crate) fn render_passes(
     let mut sum_bins = vec![0.0f64; npix * nb];
     let mut good = vec![0u32; npix];
     let mut splat = vec![[0.0f64; 3]; npix];
+    let mut splat_bins = vec![0.0f64; if kind_splats(opts) { npix * nb } else { 0 }];
     let mut any_splat = false;
     let mut stats = RenderStats {
         samples: cam.width as u64 * cam.height as u64 * opts.spp as u64,
@@ -325,6 +341,9 @@ pub(crate) fn render_passes(
                     *a += b as f64;
                 }
             }
+            for &(p, k, v) in &t.splats.spectral {
+                splat_bins[p as usize * nb + k as usize] += v as f64;
+            }
             stats.counters.rays += t.counters.rays;
             stats.counters.shadow_rays += t.counters.shadow_rays;
             stats.nonfinite += t.nonfinite + t.splats.nonfinite;
@@ -353,7 +372,14 @@ pub(crate) fn render_passes(
         .collect();
     let spectral = bins.map(|b| {
         let data = (0..npix * nb)
-            .map(|j| (sum_bins[j] * inv(good[j / nb])) as f32)
+            .map(|j| {
+                let v = sum_bins[j] * inv(good[j / nb]);
+                if any_splat {
+                    (v + splat_bins[j] * inv_spp) as f32
+                } else {
+                    v as f32
+                }
+            })
             .collect();
         (b, data)
     });
@@ -400,7 +426,12 @@ fn render_tile<const N: usize>(
     let mut counters = TraceCounters::default();
     let mut nonfinite = 0u64;
     let mut good = vec![0u32; (w * h) as usize];
-    let mut splats = Splats::new(cam.width * cam.height);
+    let mut splats = Splats::with_bins(
+        cam.width * cam.height,
+        (opts.spectral_bins > 0).then_some(SpectralBins {
+            count: opts.spectral_bins,
+        }),
+    );
     let base = Sampler::independent(opts.seed, cam.width);
     let mut samplers: [Sampler; PACKET] = std::array::from_fn(|_| base.clone());
     let mut rays = [RayQuery {

@@ -77,22 +77,34 @@ pub fn add_to_bins<const N: usize>(
 /// tracing, bidirectional connections to the camera): kept in the order they are made,
 /// per tile and pass, and added to the film in tile order by `render.rs`, so splatting
 /// keeps the image independent of the thread count. A splat is an estimate of the
-/// image's value per pixel sample: the film adds Σ splats / spp.
+/// image's value per pixel sample: the film adds Σ splats / spp. With spectral output,
+/// each splat also keeps its lanes' bin contributions.
 #[derive(Clone, Debug, Default)]
 pub struct Splats {
     /// (pixel index, row-major from the top-left; CIE XYZ).
     pub list: Vec<(u32, [f32; 3])>,
+    /// (pixel index, bin, value) for spectral output.
+    pub spectral: Vec<(u32, u16, f32)>,
     /// Splats left out because they were NaN or infinite.
     pub nonfinite: u64,
     pixels: u32,
+    bins: Option<SpectralBins>,
 }
 
 impl Splats {
     pub fn new(pixels: u32) -> Self {
         Splats {
-            list: Vec::new(),
-            nonfinite: 0,
             pixels,
+            ..Default::default()
+        }
+    }
+
+    /// Splats that also keep spectral bins.
+    pub fn with_bins(pixels: u32, bins: Option<SpectralBins>) -> Self {
+        Splats {
+            pixels,
+            bins,
+            ..Default::default()
         }
     }
 
@@ -111,8 +123,18 @@ impl Splats {
             self.nonfinite += 1;
             return;
         }
-        if !l.is_zero() {
-            self.list.push((pixel, xyz_of_sample(l, wl)));
+        if l.is_zero() {
+            return;
+        }
+        self.list.push((pixel, xyz_of_sample(l, wl)));
+        if let Some(b) = &self.bins {
+            let w = 1.0 / (N as f32 * b.width());
+            for i in 0..N {
+                if wl.pdf[i] > 0.0 && l.0[i] != 0.0 {
+                    let k = b.index(wl.lambda[i]) as u16;
+                    self.spectral.push((pixel, k, l.0[i] * w / wl.pdf[i]));
+                }
+            }
         }
     }
 }

@@ -3,16 +3,21 @@
 //! - `whitted`: the seed lecture's recursive tracer written as the lecture's loop: the
 //!   shader overwrites the ray and increments the depth;
 //! - `path`: a spectral unidirectional path tracer with next-event estimation and
-//!   multiple importance sampling.
+//!   multiple importance sampling;
+//! - `lighttrace`: paths from the lights, connected to the camera and splatted;
+//! - `bdpt`: bidirectional path tracing with every connection strategy and MIS.
 //!
 //! Both see materials and lights only through their methods (`bsdf`, `light`), and draw
 //! every random number through the [`Sampler`] interface. `render.rs` owns tiles,
 //! packets, passes and the film, and calls [`radiance`] once per pixel sample (pbrt-v4's
 //! `RayIntegrator::EvaluatePixelSample`).
+pub mod bdpt;
+pub mod lighttrace;
 pub mod path;
 pub mod whitted;
 
 use crate::accel::embree::{self, Hit, RayQuery};
+use crate::film::Splats;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -27,15 +32,32 @@ pub enum IntegratorKind {
     Whitted,
     /// Unidirectional path tracing with next-event estimation and MIS.
     Path,
+    /// Paths from the lights, every diffuse or glossy vertex connected to the camera.
+    LightTrace,
+    /// Bidirectional path tracing, every strategy, power-heuristic MIS.
+    Bdpt,
 }
 
 impl IntegratorKind {
-    pub const NAMES: &'static [&'static str] = &["whitted", "path"];
+    pub const NAMES: &'static [&'static str] = &["whitted", "path", "lighttrace", "bdpt"];
+
+    /// Whether the integrator adds to other pixels than the one it samples.
+    pub fn splats(self) -> bool {
+        matches!(self, IntegratorKind::LightTrace | IntegratorKind::Bdpt)
+    }
+
+    /// Whether it starts from the camera ray of the pixel sample (light tracing does
+    /// not, so the renderer traces no camera packets for it).
+    pub fn uses_camera_rays(self) -> bool {
+        !matches!(self, IntegratorKind::LightTrace)
+    }
 
     pub fn parse(name: &str) -> Result<IntegratorKind, String> {
         match name {
             "whitted" => Ok(IntegratorKind::Whitted),
             "path" => Ok(IntegratorKind::Path),
+            "lighttrace" => Ok(IntegratorKind::LightTrace),
+            "bdpt" => Ok(IntegratorKind::Bdpt),
             other => Err(format!(
                 "expected one of {}, got {other:?}",
                 Self::NAMES.join(", ")
@@ -47,6 +69,8 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Whitted => "whitted",
             IntegratorKind::Path => "path",
+            IntegratorKind::LightTrace => "lighttrace",
+            IntegratorKind::Bdpt => "bdpt",
         }
     }
 }
@@ -68,8 +92,10 @@ pub struct TraceCounters {
 }
 
 /// Radiance arriving along the camera ray `ray` at the wavelengths `wl`, by the
-/// integrator `kind`. `first_hit` is the camera ray's closest hit when it was already
-/// traced (in an Embree packet); `None` traces it here.
+/// integrator `kind`; contributions to other pixels go to `splats`. `first_hit` is the
+/// camera ray's closest hit when it was already traced (in an Embree packet); `None`
+/// traces it here.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn radiance<const N: usize>(
     kind: IntegratorKind,
@@ -79,10 +105,13 @@ pub fn radiance<const N: usize>(
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
+    splats: &mut Splats,
 ) -> SampledSpectrum<N> {
     match kind {
         IntegratorKind::Whitted => whitted::radiance(ctx, ray, first_hit, wl, sampler, counters),
         IntegratorKind::Path => path::radiance(ctx, ray, first_hit, wl, sampler, counters),
+        IntegratorKind::LightTrace => lighttrace::radiance(ctx, wl, sampler, counters, splats),
+        IntegratorKind::Bdpt => bdpt::radiance(ctx, ray, first_hit, wl, sampler, counters, splats),
     }
 }
 

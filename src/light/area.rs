@@ -162,6 +162,7 @@ impl AreaLight {
             pdf,
             dist: d,
             delta: false,
+            n,
         })
     }
 
@@ -224,6 +225,21 @@ impl AreaLight {
             pdf_dir,
             normal: Some(n),
         })
+    }
+
+    /// Direction density of `sample_le` for a ray leaving the point with outward normal
+    /// `n` in direction `dir`: cos θ/π on the emitting side (half each side when
+    /// two-sided).
+    #[inline]
+    pub fn pdf_dir(&self, n: Vec3, dir: Vec3) -> f32 {
+        let c = n.dot(dir);
+        if self.two_sided {
+            0.5 * c.abs() / PI
+        } else if c > 0.0 {
+            c / PI
+        } else {
+            0.0
+        }
     }
 
     /// Φ = π A L (twice that when two-sided).

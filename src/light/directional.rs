@@ -21,6 +21,7 @@ impl DirectionalLight {
             pdf: 1.0,
             dist: f32::INFINITY,
             delta: true,
+            n: Vec3::ZERO,
         }
     }
 
@@ -40,7 +41,7 @@ impl DirectionalLight {
             l: wl.eval(&self.radiance),
             pdf_pos,
             pdf_dir: 1.0,
-            normal: None,
+            normal: Some(self.direction),
         }
     }
 

@@ -198,6 +198,7 @@ impl EnvironmentLight {
             pdf,
             dist: f32::INFINITY,
             delta: false,
+            n: Vec3::ZERO,
         })
     }
 
@@ -230,7 +231,7 @@ impl EnvironmentLight {
             l: self.le(w, wl),
             pdf_pos,
             pdf_dir,
-            normal: None,
+            normal: Some(-w),
         })
     }
 

@@ -26,7 +26,7 @@ pub use environment::EnvironmentLight;
 pub use point::PointLight;
 pub use sampler::LightSampler;
 pub use spot::SpotLight;
-pub use sun::SunLight;
+pub use sun::{Portal, SunLight};
 
 use crate::math::warp::concentric_disk;
 use crate::math::Frame;
@@ -46,6 +46,8 @@ pub struct LightLiSample<const N: usize> {
     /// Distance to the sampled point (infinite for lights at infinity).
     pub dist: f32,
     pub delta: bool,
+    /// The light's outward normal at the sampled point (area lights; zero otherwise).
+    pub n: Vec3,
 }
 
 /// A ray leaving a light.
@@ -60,7 +62,9 @@ pub struct LightLeSample<const N: usize> {
     pub pdf_pos: f32,
     /// Density of the direction (per solid angle; 1 for a delta direction).
     pub pdf_dir: f32,
-    /// The emitting surface's normal, for area lights.
+    /// The normal of the surface the origin was drawn on (an area light, a portal, the
+    /// disk of a light at infinity), so that the flux of the ray is
+    /// L |cos| / (pdf_pos pdf_dir); None for point and spot lights.
     pub normal: Option<Vec3>,
 }
 
@@ -177,6 +181,34 @@ impl Light {
             Light::Sun(l) => Some(l.sample_le(u1, u2, wl, bounds)),
             Light::Area(l) => l.sample_le(u1, u2, wl),
             Light::Environment(l) => l.sample_le(u1, u2, wl, bounds),
+        }
+    }
+
+    /// (position density, direction density) with which `sample_le` emits a ray from
+    /// `origin` in unit direction `dir`, the origin on a surface of outward normal `n`
+    /// (area lights). Positions of lights at infinity are densities per unit area across
+    /// the rays ([`Light::pdf_le_position`]); delta positions have density 1, delta
+    /// directions density 0 (pbrt-v4 `Light::PDF_Le`).
+    pub fn pdf_le(&self, origin: Vec3, dir: Vec3, n: Vec3, bounds: &SceneBounds) -> (f32, f32) {
+        let _ = origin;
+        match self {
+            Light::Point(_) => (1.0, crate::math::warp::UNIFORM_SPHERE_PDF),
+            Light::Spot(s) => (1.0, s.pdf_dir(dir)),
+            Light::Directional(_) => (1.0 / bounds.disk_area(), 0.0),
+            Light::Sun(s) => (s.pdf_le_position(dir, bounds), s.pdf_li(-dir)),
+            Light::Area(a) => (1.0 / a.area, a.pdf_dir(n, dir)),
+            Light::Environment(e) => (1.0 / bounds.disk_area(), e.pdf_li(-dir)),
+        }
+    }
+
+    /// For lights at infinity: the density of where `sample_le` starts a ray that leaves
+    /// in direction `dir`, per unit area perpendicular to it (the bounding disk, or the
+    /// sun's portal). 0 for other lights.
+    pub fn pdf_le_position(&self, dir: Vec3, bounds: &SceneBounds) -> f32 {
+        match self {
+            Light::Sun(s) => s.pdf_le_position(dir, bounds),
+            Light::Directional(_) | Light::Environment(_) => 1.0 / bounds.disk_area(),
+            _ => 0.0,
         }
     }
 

@@ -32,6 +32,7 @@ impl PointLight {
             pdf: 1.0,
             dist: d,
             delta: true,
+            n: Vec3::ZERO,
         })
     }
 

@@ -61,6 +61,7 @@ impl SpotLight {
             pdf: 1.0,
             dist: d,
             delta: true,
+            n: Vec3::ZERO,
         })
     }
 
@@ -85,6 +86,16 @@ impl SpotLight {
             pdf_dir: uniform_cone_pdf(omc),
             normal: None,
         })
+    }
+
+    /// Direction density of `sample_le`: uniform over the cone of half-angle θ_end.
+    #[inline]
+    pub fn pdf_dir(&self, dir: Vec3) -> f32 {
+        if dir.dot(self.direction) >= self.cos_falloff_end {
+            uniform_cone_pdf(1.0 - self.cos_falloff_end)
+        } else {
+            0.0
+        }
     }
 
     /// Φ = I · 2π ((1 − cos θ_start) + (cos θ_start − cos θ_end)/2) (pbrt-v4

@@ -30,6 +30,43 @@ pub struct SunLight {
     pub radiance: DenseSpectrum,
     /// The frame whose z axis points at the sun.
     frame: Frame,
+    /// Where sunlight enters the scene, if only through one opening (a window, a slit):
+    /// light paths then start on it instead of on the scene's bounding disk.
+    pub portal: Option<Portal>,
+}
+
+/// A parallelogram origin + s·edge1 + t·edge2 (s, t ∈ [0, 1]) through which all of a
+/// light at infinity that reaches the scene passes. Light paths that start on it carry
+/// the same flux as those started on the bounding disk, without the ones the scene's
+/// geometry would block anyway; so a portal is exact only when everything else of the
+/// scene is shadowed from the light (the wall around Newton's slit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Portal {
+    pub origin: Vec3,
+    pub edge1: Vec3,
+    pub edge2: Vec3,
+    /// Unit normal, edge1 × edge2.
+    pub normal: Vec3,
+    pub area: f32,
+}
+
+impl Portal {
+    pub fn new(origin: Vec3, edge1: Vec3, edge2: Vec3) -> Portal {
+        let c = edge1.cross(edge2);
+        Portal {
+            origin,
+            edge1,
+            edge2,
+            normal: c.normalize(),
+            area: c.length(),
+        }
+    }
+
+    /// A point uniform on the portal.
+    #[inline]
+    pub fn point(&self, u: Vec2) -> Vec3 {
+        self.origin + u.x * self.edge1 + u.y * self.edge2
+    }
 }
 
 impl SunLight {
@@ -47,6 +84,7 @@ impl SunLight {
             one_minus_cos: omc as f32,
             sin2: a.sin().powi(2) as f32,
             frame: Frame::from_z(-direction),
+            portal: None,
         }
     }
 
@@ -91,6 +129,7 @@ impl SunLight {
             pdf: 1.0 / self.solid_angle(),
             dist: f32::INFINITY,
             delta: false,
+            n: Vec3::ZERO,
         }
     }
 
@@ -104,7 +143,8 @@ impl SunLight {
     }
 
     /// A ray from the disk's direction through a point uniform on the disk covering the
-    /// scene's bounding sphere.
+    /// scene's bounding sphere, or on the portal when there is one (its normal then
+    /// carries the cosine between the ray and the portal).
     #[inline]
     pub fn sample_le<const N: usize>(
         &self,
@@ -114,20 +154,48 @@ impl SunLight {
         bounds: &SceneBounds,
     ) -> LightLeSample<N> {
         let w = self.sample_direction(u1);
-        let (origin, pdf_pos) = bounds.disk_point(w, u2);
+        let (origin, pdf_pos, normal) = match &self.portal {
+            Some(p) => (p.point(u2), 1.0 / p.area, p.normal),
+            None => {
+                let (o, pdf) = bounds.disk_point(w, u2);
+                (o, pdf, -w)
+            }
+        };
         LightLeSample {
             origin,
             dir: -w,
             l: wl.eval(&self.radiance),
             pdf_pos,
             pdf_dir: 1.0 / self.solid_angle(),
-            normal: None,
+            normal: Some(normal),
         }
     }
 
-    /// Φ = π R² E over the scene's bounding disk.
+    /// Density, per unit area perpendicular to a ray leaving in direction `dir`, of the
+    /// ray's position as `sample_le` draws it: 1/(π R²) on the bounding disk, or
+    /// 1/(A |cos|) on a portal (its area projected onto that plane).
+    #[inline]
+    pub fn pdf_le_position(&self, dir: Vec3, bounds: &SceneBounds) -> f32 {
+        match &self.portal {
+            Some(p) => {
+                let c = p.normal.dot(dir).abs();
+                if c > 0.0 {
+                    1.0 / (p.area * c)
+                } else {
+                    0.0
+                }
+            }
+            None => 1.0 / bounds.disk_area(),
+        }
+    }
+
+    /// Φ = π R² E over the scene's bounding disk, or E A |cos| through a portal.
     pub fn phi(&self, bounds: &SceneBounds) -> f32 {
-        bounds.disk_area() * self.irradiance.mean()
+        let area = match &self.portal {
+            Some(p) => p.area * p.normal.dot(self.direction).abs(),
+            None => bounds.disk_area(),
+        };
+        area * self.irradiance.mean()
     }
 }
 

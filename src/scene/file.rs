@@ -373,6 +373,19 @@ pub struct SunLightFile {
     /// Angular radius in degrees, in (0, 90); default 0.2666.
     #[serde(default)]
     pub angular_radius: Option<PositiveNumber>,
+    /// The opening through which all sunlight that reaches the scene passes (a window, a
+    /// slit); light tracing and BDPT start the sun's paths on it.
+    #[serde(default)]
+    pub portal: Option<PortalFile>,
+}
+
+/// A parallelogram origin + s·edge1 + t·edge2, s, t ∈ [0, 1].
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PortalFile {
+    pub origin: Point3,
+    pub edge1: Direction3,
+    pub edge2: Direction3,
 }
 
 #[derive(Debug, serde::Deserialize)]

@@ -567,11 +567,19 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                         "lights[{i}].angular_radius: expected degrees in (0, 90), got {deg}"
                     )));
                 }
-                Ok(Light::Sun(SunLight::new(
-                    s.direction.unit(),
-                    s.irradiance.spectrum(),
-                    deg.to_radians(),
-                )))
+                let mut sun = SunLight::new(s.direction.unit(), s.irradiance.spectrum(), deg.to_radians());
+                if let Some(p) = &s.portal {
+                    let (o, e1, e2) = (p.origin.0, p.edge1.0, p.edge2.0);
+                    if is_degenerate(o, o + e1, o + e2) {
+                        return Err(err(format!(
+                            "lights[{i}].portal: expected edge1 and edge2 spanning a non-zero area, got {} and {}",
+                            fmt_points(&[e1]),
+                            fmt_points(&[e2])
+                        )));
+                    }
+                    sun.portal = Some(crate::light::Portal::new(o, e1, e2));
+                }
+                Ok(Light::Sun(sun))
             }
             LightFile::Spot(s) => {
                 let angle = s.cone_angle.map_or(30.0, |a| a.0);

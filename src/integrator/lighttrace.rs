@@ -1,0 +1,142 @@
+//! Light tracing (particle tracing with next-event estimation to the camera; Arvo &
+//! Kirk 1990, Dutré et al. 1993; pbrt-v4's `LightPathIntegrator`): paths start at the
+//! lights and every vertex on a diffuse or glossy surface is connected to the camera
+//! and splatted into the pixel it lands in. It is BDPT's t = 1 strategies alone, so it
+//! finds the caustics a camera path cannot (a diffuse screen lit through a prism by a
+//! small sun), and cannot see lights at infinity (the sky, the sun's disk) directly.
+//!
+//! A path: a light chosen by the scene's light sampler, an emitted ray from
+//! `Light::sample_le` (its flux L |cos| / (p_light pdf_pos pdf_dir)), then the
+//! materials' importance-mode sampling (no η² at refractions: importance is not
+//! radiance, Veach 1997 §5.2). A connection adds β f(ωo, ω_camera) |cos| We / pdf_camera
+//! to the pixel the point projects to; the film divides splats by spp, and since every
+//! pixel sample traces one light path, a pixel's value is the mean of the importance
+//! arriving at it (pbrt-v4 §13.4.3 derives the normalisation).
+//!
+//! Emitting surfaces seen directly by the camera are splatted from the light's own
+//! vertex. Dispersion: the lanes were drawn with the pixel sample and travel with the
+//! light path; a dispersive refraction ends the companions as in the path tracer.
+//!
+//! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
+//! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
+use super::{occluded, query, Context, TraceCounters};
+use crate::bsdf::{BsdfContext, TransportMode};
+use crate::film::Splats;
+use crate::geometry::{Interaction, Ray};
+use crate::light::Light;
+use crate::sampler::Sampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// The pixel index of a film position.
+#[inline]
+pub(crate) fn pixel_of(cam: &crate::camera::Camera, raster: (f32, f32)) -> u32 {
+    let x = (raster.0 as u32).min(cam.width - 1);
+    let y = (raster.1 as u32).min(cam.height - 1);
+    y * cam.width + x
+}
+
+/// Traces one light path and splats its connections to the camera; returns nothing for
+/// the pixel sample's own pixel.
+pub fn radiance<const N: usize>(
+    ctx: &Context,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    splats: &mut Splats,
+) -> SampledSpectrum<N> {
+    let scene = ctx.scene;
+    let cam = &scene.camera;
+    let settings = &scene.settings;
+    let eps = settings.epsilon;
+    let u_light = sampler.get_1d();
+    let u_pos = sampler.get_2d();
+    let u_dir = sampler.get_2d();
+    let zero = SampledSpectrum::<N>::zero();
+    let Some((li, pmf)) = scene.light_sampler.sample(u_light) else {
+        return zero;
+    };
+    let light = &scene.lights[li];
+    let Some(le) = light.sample_le(u_pos, u_dir, wl, &scene.bounds) else {
+        return zero;
+    };
+    if !(le.pdf_pos > 0.0) || !(le.pdf_dir > 0.0) || le.l.is_zero() {
+        return zero;
+    }
+    let cos_l = le.normal.map_or(1.0, |n| n.dot(le.dir).abs());
+
+    // An emitting surface seen by the camera: the light's own vertex.
+    if let (Light::Area(a), Some(n)) = (light, le.normal) {
+        if let Some(cs) = cam.sample_wi(le.origin) {
+            let emitted = a.l(n, cs.wi, wl);
+            if !emitted.is_zero() && !occluded(ctx, le.origin, cs.wi, cs.dist, counters) {
+                let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
+                splats.add(pixel_of(cam, cs.raster), &(emitted * k), wl);
+            }
+        }
+    }
+
+    let mut beta = le.l * (cos_l / (pmf * le.pdf_pos * le.pdf_dir));
+    let t_min = if matches!(light, Light::Area(_)) {
+        eps
+    } else {
+        0.0
+    };
+    let mut ray = Ray::new(le.origin, le.dir, t_min, f32::INFINITY);
+    let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(TransportMode::Importance);
+    let mut depth = 0u32;
+    loop {
+        counters.rays += 1;
+        let Some(hit) = ctx.accel.intersect1(&query(&ray)) else {
+            break;
+        };
+        let shape = &scene.shapes[hit.geom_id as usize];
+        let material = &scene.materials[shape.material as usize];
+        let it = Interaction::new(&ray, &hit, shape, material, depth, wl.lambda[0]);
+        // The path has scattered `depth` times before this vertex; scattering here
+        // toward the camera is one more.
+        if depth == settings.max_depth {
+            break;
+        }
+        depth += 1;
+        let u_lobe = sampler.get_1d();
+        let u_bsdf = sampler.get_2d();
+        let u_rr = sampler.get_1d();
+        let frame = it.frame();
+        let wo = frame.to_local(-ray.dir);
+        let flags = material.flags();
+        if flags.has_non_specular() {
+            if let Some(cs) = cam.sample_wi(it.position) {
+                let wi = frame.to_local(cs.wi);
+                let f = material.eval(wo, wi, wl, &bsdf_ctx);
+                if !f.is_zero() && !occluded(ctx, it.position, cs.wi, cs.dist, counters) {
+                    let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
+                    splats.add(pixel_of(cam, cs.raster), &c, wl);
+                }
+            }
+        }
+        if depth == settings.max_depth {
+            break;
+        }
+        let Some(bs) = material.sample(wo, u_lobe, u_bsdf, wl, &bsdf_ctx) else {
+            break;
+        };
+        beta *= bs.weight();
+        if bs.ended_companions {
+            bsdf_ctx.companions_alive = false;
+        }
+        if beta.is_zero() {
+            break;
+        }
+        ray = Ray::new(it.position, frame.to_world(bs.wi), eps, f32::INFINITY);
+        // Russian roulette on the importance throughput.
+        let rr = beta.max_value();
+        if rr < 1.0 && depth >= settings.rr_depth {
+            let q = (1.0 - rr).max(0.0);
+            if u_rr < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+    }
+    zero
+}
