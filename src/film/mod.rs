@@ -21,19 +21,15 @@ pub fn xyz_of_sample<const N: usize>(
 ) -> [f32; 3] {
     let obs = cie1931();
     let k = 1.0 / (N as f32 * obs.y_integral);
-    let mut xyz = [0.0f32; 3];
+    let mut xyz = glam::Vec4::ZERO;
     for i in 0..N {
         let p = wl.pdf[i];
-        if p == 0.0 {
-            continue;
-        }
-        let w = l.0[i] * k / p;
+        // A select rather than a branch: an ended lane (pdf 0) adds nothing.
+        let w = if p > 0.0 { l.0[i] * k / p } else { 0.0 };
         let (j, t) = wl.position(i);
-        xyz[0] += w * obs.x.eval_at(j, t);
-        xyz[1] += w * obs.y.eval_at(j, t);
-        xyz[2] += w * obs.z.eval_at(j, t);
+        xyz += w * obs.xyz_at(j, t);
     }
-    xyz
+    [xyz.x, xyz.y, xyz.z]
 }
 
 /// Equal-width wavelength bins over 360–830 nm for spectral output.

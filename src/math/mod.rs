@@ -1,6 +1,7 @@
 //! Math: glam re-exports, shading frames, warps with their densities, piecewise-constant
 //! distributions and per-sample random numbers.
 pub mod distribution;
+pub mod fastmath;
 pub mod frame;
 pub mod rng;
 pub mod warp;

@@ -26,6 +26,18 @@ pub struct Observer {
     pub y: DenseSpectrum,
     pub z: DenseSpectrum,
     pub y_integral: f32,
+    /// (x̄, ȳ, z̄, 0) per 1 nm row, interleaved so that the film's weights of one lane are
+    /// one 16-byte load and one lerp instead of three table walks.
+    xyz: Box<[glam::Vec4; DENSE_LEN]>,
+}
+
+impl Observer {
+    /// (x̄, ȳ, z̄, 0) at a [`DenseSpectrum::position`].
+    #[inline]
+    pub fn xyz_at(&self, i: usize, t: f32) -> glam::Vec4 {
+        let a = self.xyz[i];
+        a + t * (self.xyz[i + 1] - a)
+    }
 }
 
 /// Parses an embedded table with a header line and columns `wavelength_nm, v1, v2, …`.
@@ -56,11 +68,17 @@ fn observer_from_table(csv: &str) -> Observer {
     let rows = parse_table(csv, 3);
     let y = dense_column(&rows, 1);
     let y_integral = y.values().iter().map(|&v| v as f64).sum::<f64>() as f32;
+    let (x, z) = (dense_column(&rows, 0), dense_column(&rows, 2));
+    let mut xyz = Box::new([glam::Vec4::ZERO; DENSE_LEN]);
+    for (i, v) in xyz.iter_mut().enumerate() {
+        *v = glam::Vec4::new(x.values()[i], y.values()[i], z.values()[i], 0.0);
+    }
     Observer {
-        x: dense_column(&rows, 0),
+        x,
         y,
-        z: dense_column(&rows, 2),
+        z,
         y_integral,
+        xyz,
     }
 }
 

@@ -59,8 +59,9 @@ impl DenseSpectrum {
     #[inline]
     pub fn position(lambda: f32) -> (usize, f32) {
         let x = (lambda - LAMBDA_MIN).clamp(0.0, (DENSE_LEN - 1) as f32);
-        let i = (x as usize).min(DENSE_LEN - 2);
-        (i, x - i as f32)
+        // Through i32, which converts four lanes at once (usize does not vectorise).
+        let i = (x as i32).min(DENSE_LEN as i32 - 2);
+        (i as usize, x - i as f32)
     }
 
     /// The value at a [`Self::position`].
