@@ -1,6 +1,7 @@
 //! `heron converge`: run time against error. Renders a reference at many samples per
-//! pixel, then the same scene at each (lanes, spp) setting with another seed, and
-//! reports the wall time, the time per sample and the error against the reference.
+//! pixel (8 lanes, independent numbers, another seed), then the same scene at each
+//! (lanes, spp) setting, and reports the wall time, the time per sample and the error
+//! against the reference.
 //!
 //! Error: relative RMSE of linear sRGB over all pixels and channels,
 //! sqrt(Σ (x − x_ref)²) / sqrt(Σ x_ref²). The reference's own noise is part of the
@@ -53,6 +54,7 @@ pub fn converge(
     o.spp = ref_spp;
     o.lanes = 8;
     o.seed = base.seed.wrapping_add(1);
+    o.sampler = crate::sampler::SamplerKind::Independent;
     let (reference, ref_stats) = renderer.render(&o)?;
     let mut rows = Vec::new();
     for &l in lanes {

@@ -206,11 +206,15 @@ struct ConvergeArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// How hero wavelengths are drawn in the measured runs: uniform or visible.
-    #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
+    #[arg(long, default_value = "visible", value_parser = ["uniform", "visible"])]
     wavelengths: String,
     /// whitted, path, lighttrace or bdpt; default: the scene's.
     #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
     integrator: Option<String>,
+    /// sobol or independent for the measured runs [default: sobol]; the reference always
+    /// uses independent numbers.
+    #[arg(long, value_parser = ["sobol", "independent"])]
+    sampler: Option<String>,
 }
 
 fn wavelength_sampler(name: &str) -> heron::spectrum::WavelengthSampler {
@@ -292,7 +296,7 @@ struct RenderArgs {
     #[arg(long)]
     seed: Option<u64>,
     /// Wavelengths carried per path: 1, 4 or 8.
-    #[arg(long, default_value_t = 4, value_parser = parse_lanes)]
+    #[arg(long, default_value_t = 8, value_parser = parse_lanes)]
     lanes: usize,
     /// Trace camera rays one by one instead of in 8-wide Embree packets.
     #[arg(long)]
@@ -308,13 +312,17 @@ struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=470))]
     spectral_bins: Option<u16>,
     /// How hero wavelengths are drawn: uniform or visible (pdf ∝ 1/cosh²(0.0072(λ − 538))).
-    #[arg(long, default_value = "uniform", value_parser = ["uniform", "visible"])]
+    #[arg(long, default_value = "visible", value_parser = ["uniform", "visible"])]
     wavelengths: String,
     /// whitted (the seed's tracer), path (path tracing with MIS), lighttrace (paths from
     /// the lights, splatted) or bdpt (bidirectional); default: the scene's [render]
     /// integrator, else whitted.
     #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
     integrator: Option<String>,
+    /// Where random numbers come from: sobol (Owen-scrambled Sobol' points along a Morton
+    /// curve) or independent [default: sobol].
+    #[arg(long, value_parser = ["sobol", "independent"])]
+    sampler: Option<String>,
     /// Maximum number of scattering events per path (overrides the scene's
     /// render.max_depth).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -422,6 +430,10 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         opts.integrator = heron::integrator::IntegratorKind::parse(i)
             .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?;
     }
+    if let Some(s) = &args.sampler {
+        opts.sampler =
+            heron::sampler::SamplerKind::parse(s).map_err(|e| anyhow::anyhow!("--sampler: {e}"))?;
+    }
     if let Some(s) = args.spp {
         opts.spp = s;
     }
@@ -462,12 +474,13 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         p.commit()?;
     }
     eprintln!(
-        "{}: {}x{} at {} spp, {} lanes, {} in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
+        "{}: {}x{} at {} spp, {} lanes, {}, {} in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
         display(&exr_path),
         film.width,
         film.height,
         opts.spp,
         opts.lanes,
+        opts.sampler.name(),
         opts.integrator.name(),
         stats.wall.as_secs_f64(),
         stats.total_rays(),
@@ -493,6 +506,10 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
     if let Some(i) = &a.integrator {
         base.integrator = heron::integrator::IntegratorKind::parse(i)
             .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?;
+    }
+    if let Some(s) = &a.sampler {
+        base.sampler =
+            heron::sampler::SamplerKind::parse(s).map_err(|e| anyhow::anyhow!("--sampler: {e}"))?;
     }
     let (ref_wall, rows) =
         heron::converge::converge(&scene, &base, a.reference_spp, &a.lanes, &a.spp)?;

@@ -12,7 +12,7 @@ use crate::accel::embree::{self, Hit, RayQuery};
 use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{self, Context, IntegratorKind, TraceCounters};
-use crate::sampler::Sampler;
+use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampler};
 use crate::{HeronError, Result};
@@ -40,6 +40,8 @@ pub struct RenderOptions {
     pub spectral_bins: usize,
     /// The integrator (default: the scene's `[render] integrator`).
     pub integrator: IntegratorKind,
+    /// Where the random numbers come from.
+    pub sampler: SamplerKind,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
 }
@@ -50,11 +52,14 @@ impl RenderOptions {
             spp: scene.settings.spp,
             seed: scene.settings.seed,
             threads: 0,
-            lanes: 4,
+            // The defaults with the lowest RMSE·√t over the course scenes, the Cornell box
+            // and a rainbow (scripts/bench_defaults.py, BENCHMARKS.md "Defaults").
+            lanes: 8,
             packets: true,
-            wavelengths: WavelengthSampler::Uniform,
+            wavelengths: WavelengthSampler::Visible,
             spectral_bins: 0,
             integrator: scene.settings.integrator,
+            sampler: SamplerKind::Sobol,
             progress: None,
         }
     }
@@ -432,7 +437,7 @@ fn render_tile<const N: usize>(
             count: opts.spectral_bins,
         }),
     );
-    let base = Sampler::independent(opts.seed, cam.width);
+    let base = Sampler::new(opts.sampler, opts.seed, cam.width, cam.height, opts.spp);
     let mut samplers: [Sampler; PACKET] = std::array::from_fn(|_| base.clone());
     let mut rays = [RayQuery {
         origin: cam.eye,
@@ -546,6 +551,7 @@ mod tests {
             let pool = embree::worker_pool(threads).unwrap();
             let mut o = RenderOptions::from_scene(&scene);
             o.spp = 64;
+            o.lanes = 4;
             o.threads = threads;
             render_passes(&ctx, &pool, &o, pass, &integrate).unwrap().0
         };
