@@ -15,6 +15,14 @@
 //! The header's `rtcore_config.h` is read to check the compile-time options that change
 //! struct layouts or symbol names (`RTC_MAX_INSTANCE_LEVEL_COUNT`, `RTC_MIN_WIDTH`,
 //! `EMBREE_API_NAMESPACE`); sys.rs is written for Debian's defaults.
+//!
+//! **Embree 4 without headers.** `HERON_EMBREE4_LIB=DIR` links the first
+//! `libembree4*.so.4` in DIR by its file name (the `embreex` wheel on PyPI ships Embree
+//! 4.4 as `embreex.libs/libembree4-<hash>.so.4`, whose SONAME carries the hash) and puts
+//! DIR on the binaries' run path, so they run without `LD_LIBRARY_PATH`. heron's FFI
+//! needs no header, so there is no `rtcore_config.h` to check here: the Embree test
+//! asserts the library's version and runs the same queries against Embree 3.
+//! `scripts/test.sh` builds and tests heron this way as well.
 use std::env;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -35,6 +43,12 @@ fn main() {
     println!("cargo::rerun-if-env-changed=HERON_EMBREE_DIR");
     println!("cargo::rerun-if-env-changed=HERON_EMBREE_VERSION");
     println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
+    println!("cargo::rerun-if-env-changed=HERON_EMBREE4_LIB");
+
+    if let Some(dir) = env::var_os("HERON_EMBREE4_LIB").map(PathBuf::from) {
+        link_embree4_library(&dir);
+        return;
+    }
 
     let preferred: &[u32] = match env::var("HERON_EMBREE_VERSION").as_deref() {
         Ok("4") => &[4, 3],
@@ -61,6 +75,36 @@ fn main() {
     if found.major == 4 {
         println!("cargo::rustc-cfg=heron_embree4");
     }
+}
+
+/// Links a header-less Embree 4 shared library found in `dir` (see the module comment).
+fn link_embree4_library(dir: &Path) {
+    let entries = std::fs::read_dir(dir).unwrap_or_else(|e| {
+        fail(&format!(
+            "heron: HERON_EMBREE4_LIB={}: cannot read the directory: {e}",
+            dir.display()
+        ))
+    });
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.starts_with("libembree4") && n.ends_with(".so.4"))
+        .collect();
+    names.sort();
+    let Some(name) = names.first() else {
+        fail(&format!(
+            "heron: HERON_EMBREE4_LIB={}: expected a libembree4*.so.4 there (e.g. the \
+             embreex wheel's embreex.libs folder)",
+            dir.display()
+        ));
+    };
+    let dir = dir
+        .canonicalize()
+        .unwrap_or_else(|e| fail(&format!("heron: HERON_EMBREE4_LIB={}: {e}", dir.display())));
+    println!("cargo::rerun-if-changed={}", dir.join(name).display());
+    println!("cargo::rustc-link-search=native={}", dir.display());
+    println!("cargo::rustc-link-lib=dylib:+verbatim={name}");
+    println!("cargo::rustc-link-arg=-Wl,-rpath,{}", dir.display());
+    println!("cargo::rustc-cfg=heron_embree4");
 }
 
 /// Prints one line and stops the build.

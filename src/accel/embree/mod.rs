@@ -25,6 +25,10 @@ mod scene;
 mod sys;
 
 pub use device::Device;
+
+/// The Embree major version heron's bindings were compiled for (build.rs sets
+/// `cfg(heron_embree4)` for 4); the library's own version must agree.
+pub const BINDINGS_MAJOR: u32 = if cfg!(heron_embree4) { 4 } else { 3 };
 pub use scene::{Scene, SceneBuilder};
 
 use glam::Vec3;
