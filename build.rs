@@ -75,6 +75,16 @@ fn main() {
     if found.major == 4 {
         println!("cargo::rustc-cfg=heron_embree4");
     }
+    let mut args: Vec<String> = Vec::new();
+    if found.major == 4 {
+        args.push("-DHERON_EMBREE4".into());
+    }
+    for dir in &found.lib_dirs {
+        args.push(format!("-L{}", dir.display()));
+        args.push(format!("-Wl,-rpath,{}", dir.display()));
+    }
+    args.push(format!("-lembree{}", found.major));
+    gcc_args(&args);
 }
 
 /// Links a header-less Embree 4 shared library found in `dir` (see the module comment).
@@ -105,6 +115,19 @@ fn link_embree4_library(dir: &Path) {
     println!("cargo::rustc-link-lib=dylib:+verbatim={name}");
     println!("cargo::rustc-link-arg=-Wl,-rpath,{}", dir.display());
     println!("cargo::rustc-cfg=heron_embree4");
+    gcc_args(&[
+        "-DHERON_EMBREE4".into(),
+        format!("-L{}", dir.display()),
+        format!("-l:{name}"),
+        format!("-Wl,-rpath,{}", dir.display()),
+    ]);
+}
+
+/// The gcc arguments that link the same Embree heron links, for the raw-Embree program
+/// `heron bench traversal --raw` builds (src/bench/raw.rs), tab-separated in
+/// `HERON_EMBREE_GCC_ARGS`.
+fn gcc_args(args: &[String]) {
+    println!("cargo::rustc-env=HERON_EMBREE_GCC_ARGS={}", args.join("\t"));
 }
 
 /// Prints one line and stops the build.

@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 # Debian's libllvm15 it picks LLVM 15, which aborts in Dr.Jit's kernels ("LLVM ERROR: Cannot
 # select ... fminimum"). To pin it explicitly:
 # DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
-APT_PACKAGES=(libembree-dev embree-tools pkg-config python3-venv python3-pip libllvm19)
+APT_PACKAGES=(libembree-dev embree-tools pkg-config gcc python3-venv python3-pip libllvm19)
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi

@@ -172,15 +172,19 @@ struct TraversalArgs {
     /// Image size W,H (Embree viewer: --size W H).
     #[arg(long, value_parser = parse_size, default_value = "1024,1024")]
     size: (u32, u32),
-    /// Rays per Embree call: 1 (rtcIntersect1) or 8 (rtcIntersect8).
-    #[arg(long, default_value_t = 8, value_parser = parse_packet)]
-    packet: usize,
-    /// Frames to time (after one warm-up frame).
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
-    frames: u32,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
-    threads: Option<u16>,
+    /// How rays go to Embree, comma-separated: 1 (rtcIntersect1), 4, 8, 16 (packets) or
+    /// stream (rtcIntersect1M, Embree 3 only).
+    #[arg(long, default_value = "1,4,8,16,stream", value_delimiter = ',', value_parser = heron::bench::Width::parse)]
+    widths: Vec<heron::bench::Width>,
+    /// Timed passes per ray set and width (after one warm-up pass); the table reports
+    /// medians.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    rounds: u32,
+    /// Also build (with gcc) and time a C program that traces the same rays through
+    /// Embree's C API, interleaved with heron's passes; adds the raw-Embree column and
+    /// heron's throughput as a fraction of it.
+    #[arg(long)]
+    raw: bool,
 }
 
 #[derive(clap::Args)]
@@ -269,14 +273,6 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
         return Err(bad());
     }
     Ok((w, h))
-}
-
-fn parse_packet(s: &str) -> std::result::Result<usize, String> {
-    match s {
-        "1" => Ok(1),
-        "8" => Ok(8),
-        _ => Err(format!("expected 1 or 8, got {s}")),
-    }
 }
 
 #[derive(clap::Args)]
@@ -558,38 +554,47 @@ fn cmd_bench_traversal(a: TraversalArgs) -> Result<()> {
         fov_deg: a.fov,
         width: a.size.0,
         height: a.size.1,
-        packet: a.packet,
-        frames: a.frames,
-        threads: a.threads.map_or(0, usize::from),
+        widths: a.widths,
+        rounds: a.rounds,
+        raw: a.raw,
     };
     let r = heron::bench::run_traversal(&mesh, &opts)?;
-    let threads = a
-        .threads
-        .map_or_else(rayon::current_num_threads, usize::from);
+    let (ma, mi, pa) = r.embree_version;
     println!(
-        "mesh {} ({} triangles), {}x{}, packet {}, {} frames, {} threads, BVH build {:.1} ms",
+        "# mesh {} ({} triangles), {}x{}, Embree {ma}.{mi}.{pa}, BVH build {:.1} ms, one thread, median of {} rounds",
         a.mesh.display(),
         r.triangles,
         opts.width,
         opts.height,
-        opts.packet,
-        opts.frames,
-        threads,
-        r.build.as_secs_f64() * 1e3
+        r.build.as_secs_f64() * 1e3,
+        opts.rounds
     );
-    println!(
-        "primary:   {:8.2} Mrays/s  ({} rays, {:.1}% hit, {:.2} frames/s)",
-        r.primary_mrays(),
-        r.primary_rays,
-        100.0 * r.primary_hits as f64 / r.primary_rays.max(1) as f64,
-        opts.frames as f64 / r.primary_time.as_secs_f64().max(1e-12)
-    );
-    println!(
-        "secondary: {:8.2} Mrays/s  ({} incoherent rays, {:.1}% hit)",
-        r.secondary_mrays(),
-        r.secondary_rays,
-        100.0 * r.secondary_hits as f64 / r.secondary_rays.max(1) as f64
-    );
+    println!("rays,width,count,hit_percent,heron_mrays,raw_embree_mrays,heron_over_raw");
+    for row in &r.rows {
+        let cell = |v: f64, ok: bool| {
+            if ok {
+                format!("{v:.3}")
+            } else {
+                "-".to_string()
+            }
+        };
+        let has_raw = !row.raw_ns.is_empty();
+        let has_heron = !row.heron_ns.is_empty();
+        println!(
+            "{},{},{},{},{},{},{}",
+            heron::bench::SETS[row.set],
+            row.width.name(),
+            row.rays,
+            if has_heron {
+                format!("{:.1}", 100.0 * row.hits as f64 / row.rays.max(1) as f64)
+            } else {
+                "-".to_string()
+            },
+            cell(row.heron_mrays(), has_heron),
+            cell(row.raw_mrays(), has_raw),
+            cell(row.ratio(), has_raw),
+        );
+    }
     Ok(())
 }
 

@@ -9,6 +9,7 @@ use std::sync::Arc;
 use glam::{DVec3, Vec3};
 use heron::accel::embree::{
     flush_denormals_enabled, worker_pool, Device, EmbreeError, Hit, RayCoherence, RayQuery, Scene,
+    StreamScratch,
 };
 
 // ---------------------------------------------------------------------------------------
@@ -662,6 +663,75 @@ fn packets_agree_with_single_rays() {
         }
     }
     assert!(active_lanes > 10_000);
+}
+
+fn assert_same_hit(single: Option<Hit>, other: Option<Hit>, what: &str, ray: &RayQuery) {
+    match (single, other) {
+        (None, None) => {}
+        (Some(a), Some(b)) => {
+            assert_eq!((a.geom_id, a.prim_id), (b.geom_id, b.prim_id), "{what}");
+            assert!(
+                (a.t - b.t).abs() <= 1e-5 * a.t.max(1.0),
+                "{what}: {a:?} vs {b:?}"
+            );
+            assert!(
+                a.ng.abs_diff_eq(b.ng, 1e-4 * a.ng.length().max(1.0)),
+                "{what}"
+            );
+            assert!(
+                (a.u - b.u).abs() < 1e-5 && (a.v - b.v).abs() < 1e-5,
+                "{what}"
+            );
+        }
+        (a, b) => panic!("{what}: ray {ray:?}: single {a:?}, other {b:?}"),
+    }
+}
+
+/// The 4- and 16-wide packets (both coherence hints) and Embree 3's stream API find the
+/// single-ray hits, with inactive and invalid lanes left out; on Embree 4 the stream
+/// reports that it is unavailable.
+#[test]
+fn packets_of_4_and_16_and_streams_agree_with_single_rays() {
+    let dev = device();
+    let scene = mixed_scene(&dev);
+    let mut rng = Pcg32::new(9, 1);
+    let mut scratch = StreamScratch::default();
+    for n in 0..500 {
+        let mut rays: [RayQuery; 16] = std::array::from_fn(|_| random_query(&mut rng));
+        if n % 7 == 0 {
+            rays[5].origin.x = f32::NAN;
+        }
+        let active = match n % 5 {
+            0 => 0xffff,
+            1 => 0,
+            _ => (rng.next_u32() & 0xffff) as u16,
+        };
+        let coherence = if n % 2 == 0 {
+            RayCoherence::Coherent
+        } else {
+            RayCoherence::Incoherent
+        };
+        let h16 = scene.intersect16_with(&rays, active, coherence);
+        let lo: [RayQuery; 4] = std::array::from_fn(|i| rays[i]);
+        let h4 = scene.intersect4_with(&lo, (active & 0xf) as u8, coherence);
+        let mut stream = [None; 16];
+        let has_stream = scene.intersect_stream(&rays, coherence, &mut scratch, &mut stream);
+        assert_eq!(has_stream, heron::accel::embree::BINDINGS_MAJOR == 3);
+        for i in 0..16 {
+            let single = scene.intersect1(&rays[i]);
+            if has_stream {
+                assert_same_hit(single, stream[i], "stream", &rays[i]);
+            }
+            if active & (1 << i) == 0 {
+                assert_eq!(h16[i], None, "inactive lane {i} reported a hit");
+                continue;
+            }
+            assert_same_hit(single, h16[i], "16-wide", &rays[i]);
+            if i < 4 {
+                assert_same_hit(single, h4[i], "4-wide", &rays[i]);
+            }
+        }
+    }
 }
 
 #[test]

@@ -29,7 +29,7 @@ pub use device::Device;
 /// The Embree major version heron's bindings were compiled for (build.rs sets
 /// `cfg(heron_embree4)` for 4); the library's own version must agree.
 pub const BINDINGS_MAJOR: u32 = if cfg!(heron_embree4) { 4 } else { 3 };
-pub use scene::{Scene, SceneBuilder};
+pub use scene::{Scene, SceneBuilder, StreamScratch};
 
 use glam::Vec3;
 
@@ -108,7 +108,7 @@ pub fn worker_pool(threads: usize) -> Result<rayon::ThreadPool, EmbreeError> {
 
 /// Sets FTZ and DAZ on the calling thread; see [`worker_pool`]. No-op on targets other
 /// than x86_64.
-fn set_flush_denormals() {
+pub fn set_flush_denormals() {
     #[cfg(target_arch = "x86_64")]
     {
         #[allow(deprecated)]

@@ -403,6 +403,99 @@ fn to_rtc_ray(r: &RayQuery) -> sys::RTCRay {
     }
 }
 
+/// The record buffer of [`Scene::intersect_stream`], reused between calls.
+#[derive(Default)]
+pub struct StreamScratch(Vec<sys::RTCRayHit>);
+
+/// Generates, for one packet width, the SoA packet builder and the closest-hit query
+/// `rtcIntersectW(3)`: lanes whose bit in `active` is 0 (or whose ray is invalid) are
+/// inactive and get None.
+macro_rules! packet_query {
+    ($(#[$doc:meta])* $name:ident, $each:ident, $build:ident, $w:literal, $mask:ty,
+     $valid:ident, $ray:ident, $hit:ident, $rayhit:ident, $sysfn:ident) => {
+        /// Fills the SoA packet `p` and the valid mask in place (a packet is up to 768
+        /// bytes; returning it by value cost a memcpy per query); false if no lane is
+        /// active. Every lane is copied and only the mask depends on the lane's validity,
+        /// so the copy has no branches (Embree reads no field of an inactive lane).
+        #[inline]
+        fn $build(
+            rays: &[RayQuery; $w],
+            active: $mask,
+            valid: &mut sys::$valid,
+            p: &mut sys::$ray,
+        ) -> bool {
+            let mut any = false;
+            for (i, r) in rays.iter().enumerate() {
+                let on = active & (1 << i) != 0 && valid_ray(r);
+                any |= on;
+                valid.0[i] = -(on as i32);
+                p.org_x[i] = r.origin.x;
+                p.org_y[i] = r.origin.y;
+                p.org_z[i] = r.origin.z;
+                p.tnear[i] = r.tnear;
+                p.dir_x[i] = r.dir.x;
+                p.dir_y[i] = r.dir.y;
+                p.dir_z[i] = r.dir.z;
+                p.tfar[i] = r.tfar;
+                p.mask[i] = u32::MAX;
+            }
+            any
+        }
+
+        /// Calls `f(lane, hit)` for every active lane that hits, in lane order; the
+        /// cheapest form of the packet query, since no `Option` is built for a miss.
+        #[inline]
+        pub fn $each(
+            &self,
+            rays: &[RayQuery; $w],
+            active: $mask,
+            coherence: RayCoherence,
+            mut f: impl FnMut(usize, Hit),
+        ) {
+            let mut valid = sys::$valid::default();
+            let mut rh = sys::$rayhit {
+                ray: sys::$ray::default(),
+                hit: sys::$hit::invalid(),
+            };
+            if !Self::$build(rays, active, &mut valid, &mut rh.ray) {
+                return;
+            }
+            // SAFETY: committed, unmodified scene; `valid` and `rh` are aligned to the
+            // packet width, valid and exclusive for the call.
+            unsafe {
+                sys::$sysfn(&valid, self.raw, &mut rh, coherence == RayCoherence::Coherent)
+            };
+            for i in 0..$w {
+                if valid.0[i] != 0 && rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID {
+                    f(
+                        i,
+                        Hit {
+                            t: rh.ray.tfar[i],
+                            geom_id: rh.hit.geomID[i],
+                            prim_id: rh.hit.primID[i],
+                            ng: Vec3::new(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]),
+                            u: rh.hit.u[i],
+                            v: rh.hit.v[i],
+                        },
+                    );
+                }
+            }
+        }
+
+        $(#[$doc])*
+        pub fn $name(
+            &self,
+            rays: &[RayQuery; $w],
+            active: $mask,
+            coherence: RayCoherence,
+        ) -> [Option<Hit>; $w] {
+            let mut out = [None; $w];
+            self.$each(rays, active, coherence, |i, h| out[i] = Some(h));
+            out
+        }
+    };
+}
+
 impl Scene {
     /// Closest hit along `ray` within `[tnear, tfar]` (`rtcIntersect1(3)`, incoherent
     /// context), or None. Invalid rays (see [`RayQuery`]) give None.
@@ -455,54 +548,69 @@ impl Scene {
         r.tfar == f32::NEG_INFINITY
     }
 
-    /// Builds the SoA packet and the valid mask; returns None if no lane is active.
-    fn packet(rays: &[RayQuery; 8], active: u8) -> Option<(sys::ValidMask8, sys::RTCRay8)> {
-        let mut valid = sys::ValidMask8::default();
-        let mut p = sys::RTCRay8::default();
-        for (i, r) in rays.iter().enumerate() {
-            if active & (1 << i) == 0 || !valid_ray(r) {
-                // Inactive lanes keep a zero ray; Embree does not read them.
-                continue;
-            }
-            valid.0[i] = -1;
-            p.org_x[i] = r.origin.x;
-            p.org_y[i] = r.origin.y;
-            p.org_z[i] = r.origin.z;
-            p.tnear[i] = r.tnear;
-            p.dir_x[i] = r.dir.x;
-            p.dir_y[i] = r.dir.y;
-            p.dir_z[i] = r.dir.z;
-            p.tfar[i] = r.tfar;
-            p.mask[i] = u32::MAX;
-        }
-        (valid.0 != [0; 8]).then_some((valid, p))
-    }
-
     /// Coherent 8-wide packet; lanes whose bit in `active` is 0 are ignored and get None.
     ///
     /// `rtcIntersect8(3)` with the valid mask (-1 active, 0 inactive) and a COHERENT
     /// context. Lane `i` is bit `1 << i`; invalid rays are treated as inactive.
     pub fn intersect8(&self, rays: &[RayQuery; 8], active: u8) -> [Option<Hit>; 8] {
-        let Some((valid, ray)) = Self::packet(rays, active) else {
-            return [None; 8];
-        };
-        let mut rh = sys::RTCRayHit8 {
-            ray,
-            hit: sys::RTCHit8::invalid(),
-        };
-        // SAFETY: committed, unmodified scene; `valid` and `rh` are aligned (32 bytes),
-        // valid and exclusive for the call.
-        unsafe { sys::intersect8(&valid, self.raw, &mut rh, true) };
-        std::array::from_fn(|i| {
-            (valid.0[i] != 0 && rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID).then(|| Hit {
-                t: rh.ray.tfar[i],
-                geom_id: rh.hit.geomID[i],
-                prim_id: rh.hit.primID[i],
-                ng: Vec3::new(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]),
-                u: rh.hit.u[i],
-                v: rh.hit.v[i],
-            })
-        })
+        self.intersect8_with(rays, active, RayCoherence::Coherent)
+    }
+
+    packet_query!(
+        /// [`Scene::intersect8`] with an explicit coherence hint.
+        intersect8_with, intersect8_each, packet8, 8, u8, ValidMask8, RTCRay8, RTCHit8, RTCRayHit8, intersect8
+    );
+    packet_query!(
+        /// 4-wide packet (`rtcIntersect4(3)`), as [`Scene::intersect8_with`].
+        intersect4_with, intersect4_each, packet4, 4, u8, ValidMask4, RTCRay4, RTCHit4, RTCRayHit4, intersect4
+    );
+    packet_query!(
+        /// 16-wide packet (`rtcIntersect16(3)`), as [`Scene::intersect8_with`].
+        intersect16_with, intersect16_each, packet16, 16, u16, ValidMask16, RTCRay16, RTCHit16, RTCRayHit16, intersect16
+    );
+
+    /// Closest hits of a stream of single rays with Embree 3's stream API
+    /// (`rtcIntersect1M(3)`), into `hits` (same length as `rays`). `scratch` holds the
+    /// records between calls so that a caller tracing many streams allocates once.
+    /// Returns false, touching nothing, on Embree 4, which has no stream API.
+    pub fn intersect_stream(
+        &self,
+        rays: &[RayQuery],
+        coherence: RayCoherence,
+        scratch: &mut StreamScratch,
+        hits: &mut [Option<Hit>],
+    ) -> bool {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        let records = &mut scratch.0;
+        records.clear();
+        records.extend(rays.iter().map(|r| {
+            let mut ray = to_rtc_ray(r);
+            if !valid_ray(r) {
+                // An empty segment: Embree reports no hit for it.
+                ray.tnear = 0.0;
+                ray.tfar = -1.0;
+            }
+            sys::RTCRayHit {
+                ray,
+                hit: sys::RTCHit::invalid(),
+            }
+        }));
+        // SAFETY: committed, unmodified scene; the records are valid, aligned and
+        // exclusive for the call.
+        if !unsafe { sys::intersect1m(self.raw, records, coherence == RayCoherence::Coherent) } {
+            return false;
+        }
+        for (h, rh) in hits.iter_mut().zip(records.iter()) {
+            *h = (rh.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID).then(|| Hit {
+                t: rh.ray.tfar,
+                geom_id: rh.hit.geomID,
+                prim_id: rh.hit.primID,
+                ng: Vec3::new(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z),
+                u: rh.hit.u,
+                v: rh.hit.v,
+            });
+        }
+        true
     }
 
     /// Returns a bit mask of the active lanes that are occluded.
@@ -510,9 +618,11 @@ impl Scene {
     /// `rtcOccluded8(3)` with a COHERENT context; occluded lanes come back with
     /// `tfar = -inf`.
     pub fn occluded8(&self, rays: &[RayQuery; 8], active: u8) -> u8 {
-        let Some((valid, mut ray)) = Self::packet(rays, active) else {
+        let mut valid = sys::ValidMask8::default();
+        let mut ray = sys::RTCRay8::default();
+        if !Self::packet8(rays, active, &mut valid, &mut ray) {
             return 0;
-        };
+        }
         // SAFETY: as in intersect8.
         unsafe { sys::occluded8(&valid, self.raw, &mut ray, true) };
         (0..8)

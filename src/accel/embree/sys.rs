@@ -194,74 +194,81 @@ pub struct RTCRayHit {
     pub hit: RTCHit,
 }
 
-/// `struct RTC_ALIGN(32) RTCRay8` (rtcore_ray.h), structure of arrays.
-#[repr(C, align(32))]
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RTCRay8 {
-    pub org_x: [f32; 8],
-    pub org_y: [f32; 8],
-    pub org_z: [f32; 8],
-    pub tnear: [f32; 8],
-    pub dir_x: [f32; 8],
-    pub dir_y: [f32; 8],
-    pub dir_z: [f32; 8],
-    pub time: [f32; 8],
-    pub tfar: [f32; 8],
-    pub mask: [u32; 8],
-    pub id: [u32; 8],
-    pub flags: [u32; 8],
-}
-
-/// `struct RTC_ALIGN(32) RTCHit8` (rtcore_ray.h), structure of arrays; see [`RTCHit`]
-/// for the Embree 4 trailing field.
-#[repr(C, align(32))]
-#[derive(Clone, Copy, Debug)]
-pub struct RTCHit8 {
-    pub Ng_x: [f32; 8],
-    pub Ng_y: [f32; 8],
-    pub Ng_z: [f32; 8],
-    pub u: [f32; 8],
-    pub v: [f32; 8],
-    pub primID: [u32; 8],
-    pub geomID: [u32; 8],
-    pub instID: [[u32; 8]; 1],
-    #[cfg(heron_embree4)]
-    pub instPrimID: [[u32; 8]; 1],
-}
-
-impl RTCHit8 {
-    /// All lanes as `rtcIntersect8(3)` requires them: geometry and instance IDs invalid.
-    pub const fn invalid() -> RTCHit8 {
-        RTCHit8 {
-            Ng_x: [0.0; 8],
-            Ng_y: [0.0; 8],
-            Ng_z: [0.0; 8],
-            u: [0.0; 8],
-            v: [0.0; 8],
-            primID: [RTC_INVALID_GEOMETRY_ID; 8],
-            geomID: [RTC_INVALID_GEOMETRY_ID; 8],
-            instID: [[RTC_INVALID_GEOMETRY_ID; 8]],
-            #[cfg(heron_embree4)]
-            instPrimID: [[RTC_INVALID_GEOMETRY_ID; 8]],
+/// Declares the packet types of one width W (rtcore_ray.h): `struct RTC_ALIGN(A)
+/// RTCRayW` and `RTCHitW` (structures of arrays; see [`RTCHit`] for the Embree 4
+/// trailing field), `RTCRayHitW` (aligned through its members, as `rtcIntersectW(3)`
+/// requires of the packet) and the `valid` argument: one `int` per lane, `-1` active and
+/// `0` inactive. The man pages only state the packet's alignment; the mask is read with
+/// W-wide loads, so it gets the packet's alignment too.
+macro_rules! packet_types {
+    ($w:literal, $align:literal, $ray:ident, $hit:ident, $rayhit:ident, $valid:ident) => {
+        #[repr(C, align($align))]
+        #[derive(Clone, Copy, Debug, Default)]
+        pub struct $ray {
+            pub org_x: [f32; $w],
+            pub org_y: [f32; $w],
+            pub org_z: [f32; $w],
+            pub tnear: [f32; $w],
+            pub dir_x: [f32; $w],
+            pub dir_y: [f32; $w],
+            pub dir_z: [f32; $w],
+            pub time: [f32; $w],
+            pub tfar: [f32; $w],
+            pub mask: [u32; $w],
+            pub id: [u32; $w],
+            pub flags: [u32; $w],
         }
-    }
+
+        #[repr(C, align($align))]
+        #[derive(Clone, Copy, Debug)]
+        pub struct $hit {
+            pub Ng_x: [f32; $w],
+            pub Ng_y: [f32; $w],
+            pub Ng_z: [f32; $w],
+            pub u: [f32; $w],
+            pub v: [f32; $w],
+            pub primID: [u32; $w],
+            pub geomID: [u32; $w],
+            pub instID: [[u32; $w]; 1],
+            #[cfg(heron_embree4)]
+            pub instPrimID: [[u32; $w]; 1],
+        }
+
+        impl $hit {
+            /// All lanes as `rtcIntersectW(3)` requires them: geometry and instance IDs
+            /// invalid.
+            pub const fn invalid() -> $hit {
+                $hit {
+                    Ng_x: [0.0; $w],
+                    Ng_y: [0.0; $w],
+                    Ng_z: [0.0; $w],
+                    u: [0.0; $w],
+                    v: [0.0; $w],
+                    primID: [RTC_INVALID_GEOMETRY_ID; $w],
+                    geomID: [RTC_INVALID_GEOMETRY_ID; $w],
+                    instID: [[RTC_INVALID_GEOMETRY_ID; $w]],
+                    #[cfg(heron_embree4)]
+                    instPrimID: [[RTC_INVALID_GEOMETRY_ID; $w]],
+                }
+            }
+        }
+
+        #[repr(C)]
+        #[derive(Clone, Copy, Debug)]
+        pub struct $rayhit {
+            pub ray: $ray,
+            pub hit: $hit,
+        }
+
+        #[repr(C, align($align))]
+        #[derive(Clone, Copy, Debug, Default)]
+        pub struct $valid(pub [i32; $w]);
+    };
 }
 
-/// `struct RTCRayHit8` (rtcore_ray.h): 32-byte aligned through its members, as
-/// `rtcIntersect8(3)` requires of the packet.
-#[repr(C)]
-#[derive(Clone, Copy, Debug)]
-pub struct RTCRayHit8 {
-    pub ray: RTCRay8,
-    pub hit: RTCHit8,
-}
-
-/// The `valid` argument of `rtcIntersect8`/`rtcOccluded8`: one `int` per lane, `-1`
-/// active and `0` inactive. The man page only states the packet's alignment; the mask is
-/// read with 8-wide loads, so it gets the packet's 32 bytes too.
-#[repr(C, align(32))]
-#[derive(Clone, Copy, Debug, Default)]
-pub struct ValidMask8(pub [i32; 8]);
+packet_types!(4, 16, RTCRay4, RTCHit4, RTCRayHit4, ValidMask4);
+packet_types!(8, 32, RTCRay8, RTCHit8, RTCRayHit8, ValidMask8);
+packet_types!(16, 64, RTCRay16, RTCHit16, RTCRayHit16, ValidMask16);
 
 // ---------------------------------------------------------------------------------------
 // Layout checks. The expected numbers were printed by a throw-away C program compiled
@@ -315,12 +322,20 @@ const _: () = {
     assert!(offset_of!(RTCBounds, upper_x) == 16);
     assert!(size_of::<ValidMask8>() == 32 && align_of::<ValidMask8>() == 32);
 
+    // The other widths follow the same pattern: W lanes per field, aligned to 4W bytes.
+    assert!(size_of::<RTCRay4>() == 192 && align_of::<RTCRay4>() == 16);
+    assert!(offset_of!(RTCRayHit4, hit) == 192);
+    assert!(size_of::<RTCRay16>() == 768 && align_of::<RTCRay16>() == 64);
+    assert!(offset_of!(RTCRayHit16, hit) == 768);
+    assert!(offset_of!(RTCHit16, instID) == 448);
+
     #[cfg(not(heron_embree4))]
     {
         assert!(size_of::<RTCHit>() == 32);
         assert!(size_of::<RTCRayHit>() == 80);
         assert!(size_of::<RTCHit8>() == 256);
         assert!(size_of::<RTCRayHit8>() == 640);
+        assert!(size_of::<RTCHit4>() == 128 && size_of::<RTCHit16>() == 512);
         assert!(size_of::<RTCIntersectContext>() == 24);
         assert!(align_of::<RTCIntersectContext>() == 8);
         assert!(offset_of!(RTCIntersectContext, filter) == 8);
@@ -332,6 +347,7 @@ const _: () = {
         assert!(size_of::<RTCRayHit>() == 96);
         assert!(size_of::<RTCHit8>() == 288);
         assert!(size_of::<RTCRayHit8>() == 672);
+        assert!(size_of::<RTCHit4>() == 144 && size_of::<RTCHit16>() == 576);
     }
 };
 
@@ -451,6 +467,78 @@ mod embree3_queries {
             context: *mut RTCIntersectContext,
             ray: *mut RTCRay8,
         );
+        /// `rtcIntersect4(3)`: packet 16-byte aligned.
+        pub fn rtcIntersect4(
+            valid: *const i32,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            rayhit: *mut RTCRayHit4,
+        );
+        /// `rtcIntersect16(3)`: packet 64-byte aligned.
+        pub fn rtcIntersect16(
+            valid: *const i32,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            rayhit: *mut RTCRayHit16,
+        );
+        /// `rtcIntersect1M(3)`: a stream of M single-ray records `byteStride` apart.
+        pub fn rtcIntersect1M(
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            rayhit: *mut RTCRayHit,
+            M: u32,
+            byteStride: usize,
+        );
+    }
+
+    /// Closest hits of a 4-ray packet.
+    ///
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn intersect4(
+        valid: &ValidMask4,
+        scene: RTCScene,
+        rayhit: &mut RTCRayHit4,
+        coherent: bool,
+    ) {
+        let mut ctx = context(coherent);
+        // SAFETY: as in `intersect1`; the packet and the mask are align(16).
+        unsafe { rtcIntersect4(valid.0.as_ptr(), scene, &mut ctx, rayhit) }
+    }
+
+    /// Closest hits of a 16-ray packet.
+    ///
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn intersect16(
+        valid: &ValidMask16,
+        scene: RTCScene,
+        rayhit: &mut RTCRayHit16,
+        coherent: bool,
+    ) {
+        let mut ctx = context(coherent);
+        // SAFETY: as in `intersect1`; the packet and the mask are align(64).
+        unsafe { rtcIntersect16(valid.0.as_ptr(), scene, &mut ctx, rayhit) }
+    }
+
+    /// Closest hits of a stream of single rays (Embree 3's stream API); returns true.
+    ///
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn intersect1m(scene: RTCScene, rayhits: &mut [RTCRayHit], coherent: bool) -> bool {
+        let mut ctx = context(coherent);
+        // SAFETY: as in `intersect1`; the records are contiguous, each align(16), and M
+        // fits in u32 (the callers pass chunks of at most a few thousand).
+        unsafe {
+            rtcIntersect1M(
+                scene,
+                &mut ctx,
+                rayhits.as_mut_ptr(),
+                rayhits.len() as u32,
+                std::mem::size_of::<RTCRayHit>(),
+            )
+        };
+        true
     }
 
     fn context(coherent: bool) -> RTCIntersectContext {
@@ -536,6 +624,55 @@ mod embree4_queries {
             ray: *mut RTCRay8,
             args: *mut c_void,
         );
+        pub fn rtcIntersect4(
+            valid: *const i32,
+            scene: RTCScene,
+            rayhit: *mut RTCRayHit4,
+            args: *mut c_void,
+        );
+        pub fn rtcIntersect16(
+            valid: *const i32,
+            scene: RTCScene,
+            rayhit: *mut RTCRayHit16,
+            args: *mut c_void,
+        );
+    }
+
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn intersect4(
+        valid: &ValidMask4,
+        scene: RTCScene,
+        rayhit: &mut RTCRayHit4,
+        _coherent: bool,
+    ) {
+        // SAFETY: as in `intersect1`; the packet and the mask are align(16).
+        unsafe { rtcIntersect4(valid.0.as_ptr(), scene, rayhit, std::ptr::null_mut()) }
+    }
+
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn intersect16(
+        valid: &ValidMask16,
+        scene: RTCScene,
+        rayhit: &mut RTCRayHit16,
+        _coherent: bool,
+    ) {
+        // SAFETY: as in `intersect1`; the packet and the mask are align(64).
+        unsafe { rtcIntersect16(valid.0.as_ptr(), scene, rayhit, std::ptr::null_mut()) }
+    }
+
+    /// Embree 4 removed the stream API (`rtcIntersect1M` and friends): returns false and
+    /// leaves the records untouched.
+    ///
+    /// # Safety
+    /// Always safe; `unsafe` only to match the Embree 3 signature.
+    pub unsafe fn intersect1m(
+        _scene: RTCScene,
+        _rayhits: &mut [RTCRayHit],
+        _coherent: bool,
+    ) -> bool {
+        false
     }
 
     /// # Safety
