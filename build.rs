@@ -44,6 +44,7 @@ fn main() {
     println!("cargo::rerun-if-env-changed=HERON_EMBREE_VERSION");
     println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
     println!("cargo::rerun-if-env-changed=HERON_EMBREE4_LIB");
+    strip_features();
 
     if let Some(dir) = env::var_os("HERON_EMBREE4_LIB").map(PathBuf::from) {
         link_embree4_library(&dir);
@@ -237,5 +238,25 @@ fn check_config(config_h: &Path, major: u32) {
              Embree built with its C API",
             config_h.display()
         ));
+    }
+}
+
+/// `HERON_STRIP=shadows,specular,emitters,escape` (any subset): a build whose kernels
+/// lack those features' code, to measure the specialised kernels against
+/// (`src/scene/features.rs`, `scripts/bench_kernels.py`). Not for rendering.
+fn strip_features() {
+    const NAMES: [&str; 4] = ["shadows", "specular", "emitters", "escape"];
+    for n in NAMES {
+        println!("cargo::rustc-check-cfg=cfg(heron_strip_{n})");
+    }
+    println!("cargo::rerun-if-env-changed=HERON_STRIP");
+    let Ok(list) = env::var("HERON_STRIP") else {
+        return;
+    };
+    for n in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        if !NAMES.contains(&n) {
+            panic!("HERON_STRIP: expected a comma-separated subset of {NAMES:?}, got {n:?}");
+        }
+        println!("cargo::rustc-cfg=heron_strip_{n}");
     }
 }

@@ -319,6 +319,11 @@ struct RenderArgs {
     /// curve) or independent [default: sobol].
     #[arg(long, value_parser = ["sobol", "independent"])]
     sampler: Option<String>,
+    /// auto: the kernel compiled for what the scene uses (no shadow rays, specular
+    /// paths, area lights or escaping radiance where it has none); general: the kernel
+    /// with all of them. Both give the same image.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "general"])]
+    kernel: String,
     /// Maximum number of scattering events per path (overrides the scene's
     /// render.max_depth).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -441,6 +446,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     opts.packets = !args.no_packets;
     opts.spectral_bins = args.spectral_bins.map_or(0, usize::from);
     opts.wavelengths = wavelength_sampler(&args.wavelengths);
+    opts.kernel = heron::scene::features::KernelChoice::parse(&args.kernel)
+        .map_err(|e| anyhow::anyhow!("--kernel: {e}"))?;
     let bar = progress_bar(args.quiet);
     if let Some(bar) = &bar {
         let b = bar.clone();
@@ -470,7 +477,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         p.commit()?;
     }
     eprintln!(
-        "{}: {}x{} at {} spp, {} lanes, {}, {} in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
+        "{}: {}x{} at {} spp, {} lanes, {}, {} (kernel {}) in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
         display(&exr_path),
         film.width,
         film.height,
@@ -478,6 +485,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         opts.lanes,
         opts.sampler.name(),
         opts.integrator.name(),
+        heron::scene::features::flag_names(stats.kernel),
         stats.wall.as_secs_f64(),
         stats.total_rays(),
         stats.counters.rays,

@@ -8,13 +8,14 @@
 //! Splats (contributions an integrator makes to other pixels than its own) are kept in
 //! a list per tile, in the order they were made, and added to the film tile by tile in
 //! tile order, pass by pass. So the image is bit-identical whatever the thread count.
-use crate::accel::embree::{self, Hit, RayQuery};
+use crate::accel::embree::{self, RayQuery};
 use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{self, Context, IntegratorKind, TraceCounters};
 use crate::sampler::{Sampler, SamplerKind};
-use crate::scene::Scene;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampler};
+use crate::scene::features::{KernelChoice, KernelFlags};
+use crate::scene::{Features, Scene};
+use crate::spectrum::{SampledWavelengths, WavelengthSampler};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -42,6 +43,8 @@ pub struct RenderOptions {
     pub integrator: IntegratorKind,
     /// Where the random numbers come from.
     pub sampler: SamplerKind,
+    /// The kernel specialised to the scene's features, or the general one.
+    pub kernel: KernelChoice,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
 }
@@ -60,6 +63,7 @@ impl RenderOptions {
             spectral_bins: 0,
             integrator: scene.settings.integrator,
             sampler: SamplerKind::Sobol,
+            kernel: KernelChoice::Auto,
             progress: None,
         }
     }
@@ -73,6 +77,8 @@ pub struct RenderStats {
     /// counted here.
     pub nonfinite: u64,
     pub samples: u64,
+    /// The kernel that ran ([`crate::scene::features::flag_names`] names it).
+    pub kernel: KernelFlags,
 }
 
 impl RenderStats {
@@ -188,17 +194,15 @@ fn render_with(
 ) -> Result<(Film, RenderStats)> {
     let ctx = Context { scene, accel };
     let kind = opts.integrator;
+    // The kernel is decided here, once per render, from what the scene uses.
+    let k = Features::of(scene)
+        .choose(kind, opts.kernel)
+        .map_err(HeronError::Invalid)?;
     let integrate = move |n: Lanes| -> SampleFn {
         match n {
-            Lanes::One => SampleFn::One(Box::new(move |c, r, h, wl, s, k, sp| {
-                integrator::radiance::<1>(kind, c, r, h, wl, s, k, sp)
-            })),
-            Lanes::Four => SampleFn::Four(Box::new(move |c, r, h, wl, s, k, sp| {
-                integrator::radiance::<4>(kind, c, r, h, wl, s, k, sp)
-            })),
-            Lanes::Eight => SampleFn::Eight(Box::new(move |c, r, h, wl, s, k, sp| {
-                integrator::radiance::<8>(kind, c, r, h, wl, s, k, sp)
-            })),
+            Lanes::One => SampleFn::One(integrator::kernel::<1>(kind, k)),
+            Lanes::Four => SampleFn::Four(integrator::kernel::<4>(kind, k)),
+            Lanes::Eight => SampleFn::Eight(integrator::kernel::<8>(kind, k)),
         }
     };
     // A splatting integrator keeps its splats per tile for one pass: passes of about a
@@ -211,7 +215,9 @@ fn render_with(
     };
     let mut opts = opts.clone();
     opts.packets &= kind.uses_camera_rays();
-    render_passes(&ctx, pool, &opts, pass, &integrate)
+    let (film, mut stats) = render_passes(&ctx, pool, &opts, pass, &integrate)?;
+    stats.kernel = k;
+    Ok((film, stats))
 }
 
 /// Whether the render's integrator splats (so that splat buffers are needed).
@@ -227,23 +233,9 @@ pub(crate) enum Lanes {
     Eight,
 }
 
-/// What one pixel sample computes: (context, camera ray, its first hit if traced,
-/// wavelengths, sampler, counters, splats) -> radiance along the camera ray. Chosen once
-/// per render, so the per-sample call is one indirect call on top of the integrator's
-/// `match`.
-pub(crate) type SampleFnN<const N: usize> = Box<
-    dyn Fn(
-            &Context,
-            Ray,
-            Option<Option<Hit>>,
-            &SampledWavelengths<N>,
-            &mut Sampler,
-            &mut TraceCounters,
-            &mut Splats,
-        ) -> SampledSpectrum<N>
-        + Send
-        + Sync,
->;
+/// The per-sample function of a render, one per lane count (see
+/// [`integrator::kernel`]): one indirect call per pixel sample.
+pub(crate) type SampleFnN<const N: usize> = integrator::RadianceFn<N>;
 
 pub(crate) enum SampleFn {
     One(SampleFnN<1>),
@@ -536,16 +528,24 @@ mod tests {
             scene: &scene,
             accel: &accel,
         };
-        let npix = (40 * 24) as f32;
+        fn splat_one(
+            _: &Context,
+            _: Ray,
+            _: Option<Option<crate::accel::embree::Hit>>,
+            wl: &SampledWavelengths<4>,
+            s: &mut Sampler,
+            _: &mut TraceCounters,
+            splats: &mut Splats,
+        ) -> crate::spectrum::SampledSpectrum<4> {
+            let p = (s.get_1d() * (40 * 24) as f32) as u32;
+            // Radiance 1 at every lane: the film's Y of one splat is the sample's
+            // estimate of ∫ȳ / ∫ȳ = 1 (up to the lanes' λ noise).
+            splats.add(p, &crate::spectrum::SampledSpectrum::splat(1.0), wl);
+            crate::spectrum::SampledSpectrum::zero()
+        }
         let integrate = |n: Lanes| -> SampleFn {
             assert_eq!(n, Lanes::Four);
-            SampleFn::Four(Box::new(move |_, _, _, wl, s, _, splats| {
-                let p = (s.get_1d() * npix) as u32;
-                // Radiance 1 at every lane: the film's Y of one splat is the sample's
-                // estimate of ∫ȳ / ∫ȳ = 1 (up to the lanes' λ noise).
-                splats.add(p, &SampledSpectrum::splat(1.0), wl);
-                SampledSpectrum::zero()
-            }))
+            SampleFn::Four(splat_one)
         };
         let run = |threads: usize, pass: u32| {
             let pool = embree::worker_pool(threads).unwrap();

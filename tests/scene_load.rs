@@ -4,7 +4,9 @@
 use glam::Vec3;
 use heron::bsdf::Material;
 use heron::geometry::{Shape, ShapeKind};
+use heron::integrator::IntegratorKind;
 use heron::light::Light;
+use heron::scene::features::{flag_names, KernelChoice, ALL, EMITTERS, SHADOWS};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{load_scene, Features, Scene};
 use heron::spectrum::uplift::{named, rgb_to_illuminant, rgb_to_reflectance};
@@ -148,8 +150,11 @@ fn default_scene_has_the_lecture_numbers() {
         Features::of(&s),
         Features {
             shadows: true,
+            nee: true,
             specular: false,
-            glossy: false
+            glossy: false,
+            emitters: false,
+            escape: true,
         }
     );
 }
@@ -179,8 +184,11 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
         Features::of(&s),
         Features {
             shadows: true,
+            nee: true,
             specular: true,
-            glossy: false
+            glossy: false,
+            emitters: false,
+            escape: true,
         }
     );
 
@@ -206,8 +214,11 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
         Features::of(&s),
         Features {
             shadows: true,
+            nee: true,
             specular: true,
-            glossy: true
+            glossy: true,
+            emitters: false,
+            escape: true,
         }
     );
 }
@@ -822,13 +833,15 @@ fn malformed_documents_are_errors() {
 #[test]
 fn features_follow_the_materials_in_use() {
     let dir = Dir::new();
-    let scene = |materials: &str, shapes: &str, lights: &str| {
+    let scene_top = |top: &str, materials: &str, shapes: &str, lights: &str| {
         let p = dir.write(
             "scene.toml",
-            &format!("{CAMERA}\n{materials}\n{shapes}\n{lights}"),
+            &format!("{top}\n{CAMERA}\n{materials}\n{shapes}\n{lights}"),
         );
         Features::of(&load_scene(&p).unwrap())
     };
+    let scene =
+        |materials: &str, shapes: &str, lights: &str| scene_top("", materials, shapes, lights);
     let sphere = |m: &str| {
         format!(
             "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"{m}\"\n"
@@ -848,6 +861,7 @@ fn features_follow_the_materials_in_use() {
         scene(mats, &sphere("d"), light),
         Features {
             shadows: true,
+            nee: true,
             ..none
         }
     );
@@ -863,6 +877,7 @@ fn features_follow_the_materials_in_use() {
         scene(mats, &sphere("g"), light),
         Features {
             shadows: true,
+            nee: true,
             glossy: true,
             ..none
         }
@@ -871,12 +886,50 @@ fn features_follow_the_materials_in_use() {
         scene(mats, &sphere("gg"), light),
         Features {
             shadows: true,
+            nee: true,
             specular: true,
-            glossy: true
+            glossy: true,
+            ..none
         }
     );
     // Defined but unused materials do not count.
     assert_eq!(scene(mats, "", light), none);
+    // A background (or sky, or sun) is what an escaping ray can find.
+    assert_eq!(
+        scene_top("background = 0.2", mats, &sphere("d"), light),
+        Features {
+            shadows: true,
+            nee: true,
+            escape: true,
+            ..none
+        }
+    );
+    // An emitting shape is an area light: it lights the sphere and is seen.
+    let lamp = "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 3, 0]\nradius = 0.5\n\
+                material = \"d\"\nemission = 2\n";
+    let f = scene(mats, &format!("{}{lamp}", sphere("d")), "");
+    assert_eq!(
+        f,
+        Features {
+            shadows: true,
+            nee: true,
+            emitters: true,
+            ..none
+        }
+    );
+    assert_eq!(f.kernel(IntegratorKind::Whitted), SHADOWS | EMITTERS);
+    assert_eq!(
+        flag_names(f.kernel(IntegratorKind::Whitted)),
+        "shadows+emitters"
+    );
+    assert_eq!(
+        f.choose(IntegratorKind::Whitted, KernelChoice::General),
+        Ok(ALL)
+    );
+    assert_eq!(
+        f.choose(IntegratorKind::Whitted, KernelChoice::Auto),
+        Ok(SHADOWS | EMITTERS)
+    );
 }
 
 // ------------------------------------------------------------------------------------

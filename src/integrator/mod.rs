@@ -9,8 +9,8 @@
 //!
 //! Both see materials and lights only through their methods (`bsdf`, `light`), and draw
 //! every random number through the [`Sampler`] interface. `render.rs` owns tiles,
-//! packets, passes and the film, and calls [`radiance`] once per pixel sample (pbrt-v4's
-//! `RayIntegrator::EvaluatePixelSample`).
+//! packets, passes and the film, and calls the [`kernel`] chosen for the render once per
+//! pixel sample.
 pub mod bdpt;
 pub mod lighttrace;
 pub mod path;
@@ -20,6 +20,7 @@ use crate::accel::embree::{self, Hit, RayQuery};
 use crate::film::Splats;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
+use crate::scene::features::{KernelFlags, ALL, SPECULAR};
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -91,14 +92,58 @@ pub struct TraceCounters {
     pub shadow_rays: u64,
 }
 
-/// Radiance arriving along the camera ray `ray` at the wavelengths `wl`, by the
-/// integrator `kind`; contributions to other pixels go to `splats`. `first_hit` is the
+/// What one pixel sample computes: radiance along the camera ray `ray` at the
+/// wavelengths `wl`; contributions to other pixels go to `splats`. `first_hit` is the
 /// camera ray's closest hit when it was already traced (in an Embree packet); `None`
-/// traces it here.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn radiance<const N: usize>(
-    kind: IntegratorKind,
+/// traces it here. One function per (integrator, lanes, kernel), chosen once per render
+/// by [`kernel`] (pbrt-v4's `RayIntegrator::EvaluatePixelSample`).
+pub type RadianceFn<const N: usize> = fn(
+    &Context,
+    Ray,
+    Option<Option<Hit>>,
+    &SampledWavelengths<N>,
+    &mut Sampler,
+    &mut TraceCounters,
+    &mut Splats,
+) -> SampledSpectrum<N>;
+
+fn whitted_k<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    ray: Ray,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    _: &mut Splats,
+) -> SampledSpectrum<N> {
+    whitted::radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
+}
+
+fn path_k<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    ray: Ray,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    _: &mut Splats,
+) -> SampledSpectrum<N> {
+    path::radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
+}
+
+fn lighttrace_any<const N: usize>(
+    ctx: &Context,
+    _: Ray,
+    _: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    splats: &mut Splats,
+) -> SampledSpectrum<N> {
+    lighttrace::radiance(ctx, wl, sampler, counters, splats)
+}
+
+fn bdpt_any<const N: usize>(
     ctx: &Context,
     ray: Ray,
     first_hit: Option<Option<Hit>>,
@@ -107,11 +152,31 @@ pub fn radiance<const N: usize>(
     counters: &mut TraceCounters,
     splats: &mut Splats,
 ) -> SampledSpectrum<N> {
+    bdpt::radiance(ctx, ray, first_hit, wl, sampler, counters, splats)
+}
+
+/// Every kernel of one integrator, indexed by its flags (`ALL` is 15). The path tracer
+/// has no `SPECULAR` flag, so its entries with that bit are the ones without it.
+macro_rules! kernels {
+    ($f:ident, $n:ident, $drop:expr; $($k:literal)*) => {
+        [$($f::<$n, { $k & !$drop }> as RadianceFn<$n>),*]
+    };
+}
+
+/// The radiance function of integrator `kind` with `N` lanes, specialised to the kernel
+/// flags `k` (from [`crate::scene::Features::choose`]). Light tracing and BDPT have one
+/// kernel.
+pub fn kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> RadianceFn<N> {
+    let k = (k & ALL) as usize;
     match kind {
-        IntegratorKind::Whitted => whitted::radiance(ctx, ray, first_hit, wl, sampler, counters),
-        IntegratorKind::Path => path::radiance(ctx, ray, first_hit, wl, sampler, counters),
-        IntegratorKind::LightTrace => lighttrace::radiance(ctx, wl, sampler, counters, splats),
-        IntegratorKind::Bdpt => bdpt::radiance(ctx, ray, first_hit, wl, sampler, counters, splats),
+        IntegratorKind::Whitted => {
+            kernels!(whitted_k, N, 0; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15)[k]
+        }
+        IntegratorKind::Path => {
+            kernels!(path_k, N, SPECULAR; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15)[k]
+        }
+        IntegratorKind::LightTrace => lighttrace_any::<N>,
+        IntegratorKind::Bdpt => bdpt_any::<N>,
     }
 }
 

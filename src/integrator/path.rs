@@ -26,11 +26,17 @@ use crate::geometry::{Interaction, Ray};
 use crate::light::{Light, SurfacePoint};
 use crate::math::warp::power_heuristic;
 use crate::sampler::Sampler;
+use crate::scene::features::{on, KernelFlags, EMITTERS, ESCAPE, SHADOWS};
 use crate::scene::NO_LIGHT;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Radiance arriving along the camera ray `ray` at the wavelengths `wl`.
-pub fn radiance<const N: usize>(
+///
+/// `K` is the kernel ([`KernelFlags`]): without `SHADOWS` there is no next-event
+/// estimation (the scene has no light to sample, or no surface to light), without
+/// `EMITTERS` no emission lookup at hits, without `ESCAPE` nothing along escaping rays.
+/// The random numbers read per bounce are the same in every kernel.
+pub fn radiance<const N: usize, const K: KernelFlags>(
     ctx: &Context,
     mut ray: Ray,
     first_hit: Option<Option<Hit>>,
@@ -60,6 +66,9 @@ pub fn radiance<const N: usize>(
             }
         };
         let Some(hit) = hit else {
+            if !on(K, ESCAPE) {
+                break;
+            }
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.dir, wl);
@@ -82,7 +91,11 @@ pub fn radiance<const N: usize>(
         let wo = -ray.dir;
 
         // Emission of an area light the path has reached.
-        let emitter = scene.shape_light[hit.geom_id as usize];
+        let emitter = if on(K, EMITTERS) {
+            scene.shape_light[hit.geom_id as usize]
+        } else {
+            NO_LIGHT
+        };
         if emitter != NO_LIGHT {
             let light = &scene.lights[emitter as usize];
             if let Light::Area(a) = light {
@@ -118,7 +131,7 @@ pub fn radiance<const N: usize>(
         let flags = material.flags();
 
         // Next-event estimation.
-        if flags.has_non_specular() {
+        if on(K, SHADOWS) && flags.has_non_specular() {
             if let Some((li, pmf)) = scene.light_sampler.sample(u_light) {
                 let light = &scene.lights[li];
                 if let Some(ls) = light.sample_li(it.position, u_light_point, wl) {

@@ -20,6 +20,7 @@ use crate::bsdf::{BsdfContext, LobeFlags};
 use crate::geometry::{Interaction, Ray};
 use crate::light::Light;
 use crate::sampler::Sampler;
+use crate::scene::features::{on, KernelFlags, EMITTERS, ESCAPE, SHADOWS, SPECULAR};
 use crate::scene::NO_LIGHT;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -34,7 +35,11 @@ const DELTA: LobeFlags = LobeFlags::SPECULAR
 /// Random numbers, in order: per non-delta light at a diffuse or glossy hit, a 2D point
 /// on the light; per continuation through a surface with both a reflecting and a
 /// transmitting delta lobe, one number for the choice between them.
-pub fn radiance<const N: usize>(
+///
+/// `K` is the kernel ([`KernelFlags`]): code for a feature whose flag is off is not
+/// compiled into this instance (shadow rays, specular continuation, area-light
+/// emission, radiance along escaping rays).
+pub fn radiance<const N: usize, const K: KernelFlags>(
     ctx: &Context,
     mut ray: Ray,
     first_hit: Option<Option<Hit>>,
@@ -58,30 +63,34 @@ pub fn radiance<const N: usize>(
             }
         };
         let Some(hit) = hit else {
-            l += beta * scene.escaped_radiance(ray.dir, wl);
+            if on(K, ESCAPE) {
+                l += beta * scene.escaped_radiance(ray.dir, wl);
+            }
             break;
         };
         let shape = &scene.shapes[hit.geom_id as usize];
         let material = &scene.materials[shape.material as usize];
         let mut it = Interaction::new(&ray, &hit, shape, material, depth, wl.lambda[0]);
         let wo = -ray.dir;
-        let emitter = scene.shape_light[hit.geom_id as usize];
-        if emitter != NO_LIGHT {
-            if let Light::Area(a) = &scene.lights[emitter as usize] {
-                l += beta * a.l(it.n_outward, wo, wl);
+        if on(K, EMITTERS) {
+            let emitter = scene.shape_light[hit.geom_id as usize];
+            if emitter != NO_LIGHT {
+                if let Light::Area(a) = &scene.lights[emitter as usize] {
+                    l += beta * a.l(it.n_outward, wo, wl);
+                }
             }
         }
         let flags = material.flags();
         let frame = it.frame();
         let wo_local = frame.to_local(wo);
-        if flags.has_non_specular() {
+        if on(K, SHADOWS) && flags.has_non_specular() {
             let mut lr = SampledSpectrum::<N>::zero();
             direct_lighting(ctx, &it, wl, sampler, counters, |wi, li_cos| {
                 lr += material.eval(wo_local, frame.to_local(wi), wl, &bsdf_ctx) * li_cos;
             });
             l += beta * lr;
         }
-        if !flags.is_specular() {
+        if !on(K, SPECULAR) || !flags.is_specular() {
             break;
         }
         // Delta lobes choose among themselves with one number, drawn only when there is

@@ -1,10 +1,22 @@
-//! Which parts of the transport a scene needs, so the renderer can pick a kernel that
-//! skips the rest.
+//! Which parts of the transport a scene needs, and the kernel that skips the rest.
 //!
 //! Only materials that some shape uses count: a material defined in the file but bound
 //! to no shape never meets a ray.
-use super::Scene;
+//!
+//! [`Features::kernel`] turns the features into [`KernelFlags`], which the renderer
+//! uses, once per render, to pick an integrator monomorphised over them (a `const K:
+//! u32` generic next to the lane count N): code behind a flag that is off is not in that
+//! kernel at all, so a scene without shadow rays, specular paths, area lights or
+//! anything to see beyond the scene pays for none of their tests. `--kernel general`
+//! runs the kernel with every flag on, which must give the same image byte for byte.
+//!
+//! For measuring what a kernel costs against a build without a feature's code, the
+//! build script turns `HERON_STRIP=shadows,specular,emitters,escape` (any subset) into
+//! cfgs that switch those flags off in every kernel; such a build refuses scenes that
+//! need what it lacks (`scripts/bench_kernels.py`).
+use super::{Scene, NO_LIGHT};
 use crate::bsdf::Material;
+use crate::integrator::IntegratorKind;
 use crate::light::Light;
 
 /// The parts of the transport a scene uses. Each field is conservative: when it is true
@@ -27,6 +39,100 @@ pub struct Features {
     /// Some shape uses the seed's modified Phong model. When false, the renderer can
     /// skip the glossy lobe ((s + 2)/(2π) (ωo·ωr)^s) in its shading.
     pub glossy: bool,
+    /// Next-event estimation in the path tracer: some shape has a non-specular material
+    /// and some light emits, the environment included (the path tracer samples it; the
+    /// seed's tracer, whose shadow rays `shadows` is about, does not).
+    pub nee: bool,
+    /// Some shape emits (an area light): paths must look up and add emission at hits.
+    pub emitters: bool,
+    /// A ray that leaves the scene can find radiance: a background, sky or sun (the
+    /// scene's lights at infinity). When false, an escaping path simply ends.
+    pub escape: bool,
+}
+
+/// A set of [`Features`] a kernel is compiled for, as bits (a `const` generic).
+pub type KernelFlags = u32;
+
+/// Shadow rays / next-event estimation at diffuse and glossy hits.
+pub const SHADOWS: KernelFlags = 1 << 0;
+/// Specular continuation in the Whitted tracer.
+pub const SPECULAR: KernelFlags = 1 << 1;
+/// Emission of area lights found at hits.
+pub const EMITTERS: KernelFlags = 1 << 2;
+/// Radiance of the lights at infinity along escaping rays.
+pub const ESCAPE: KernelFlags = 1 << 3;
+/// The general kernel: every flag on.
+pub const ALL: KernelFlags = SHADOWS | SPECULAR | EMITTERS | ESCAPE;
+
+/// The flags this build was made without (`HERON_STRIP`, see the module docs).
+pub const STRIPPED: KernelFlags = (if cfg!(heron_strip_shadows) {
+    SHADOWS
+} else {
+    0
+}) | (if cfg!(heron_strip_specular) {
+    SPECULAR
+} else {
+    0
+}) | (if cfg!(heron_strip_emitters) {
+    EMITTERS
+} else {
+    0
+}) | (if cfg!(heron_strip_escape) { ESCAPE } else { 0 });
+
+/// The flags of `k` this build was made without (usually none, hence a function:
+/// clippy rejects a mask that is a constant zero).
+#[inline]
+fn stripped_of(k: KernelFlags) -> KernelFlags {
+    k & STRIPPED
+}
+
+/// Whether kernel `k` has `flag`'s code. With `k` a const generic this folds to a
+/// constant, so a kernel without the flag has no trace of the code behind it.
+#[inline(always)]
+pub const fn on(k: KernelFlags, flag: KernelFlags) -> bool {
+    k & flag & !STRIPPED != 0
+}
+
+/// The flags' names joined by '+' ("none" for none), for messages and the render summary.
+pub fn flag_names(k: KernelFlags) -> String {
+    let names: Vec<&str> = [
+        (SHADOWS, "shadows"),
+        (SPECULAR, "specular"),
+        (EMITTERS, "emitters"),
+        (ESCAPE, "escape"),
+    ]
+    .iter()
+    .filter(|(f, _)| k & f != 0)
+    .map(|&(_, n)| n)
+    .collect();
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join("+")
+    }
+}
+
+/// Which kernel a render runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum KernelChoice {
+    /// The kernel specialised to the scene's features.
+    #[default]
+    Auto,
+    /// The kernel with every feature compiled in.
+    General,
+    /// Exactly these flags, whatever the scene needs (not offered by the CLI): for tests
+    /// that show a missing flag changes the image, and for benchmarks.
+    Forced(KernelFlags),
+}
+
+impl KernelChoice {
+    pub fn parse(name: &str) -> Result<KernelChoice, String> {
+        match name {
+            "auto" => Ok(KernelChoice::Auto),
+            "general" => Ok(KernelChoice::General),
+            other => Err(format!("expected auto or general, got {other:?}")),
+        }
+    }
 }
 
 impl Features {
@@ -38,20 +144,70 @@ impl Features {
                 .iter()
                 .filter_map(|s| scene.materials.get(s.material as usize))
         };
-        let lit = scene.lights.iter().any(|l| match l {
+        let emits = |l: &Light| match l {
             Light::Point(p) => p.intensity.max_value() > 0.0,
             Light::Spot(p) => p.intensity.max_value() > 0.0,
             Light::Directional(d) => d.radiance.max_value() > 0.0,
             Light::Sun(s) => s.irradiance.max_value() > 0.0,
             Light::Area(a) => a.emission.max_value() > 0.0,
-            // The seed's tracer does not sample the environment.
-            Light::Environment(_) => false,
-        });
+            // Exists only when the background or sky emits.
+            Light::Environment(_) => true,
+        };
+        // The seed's tracer does not sample the environment.
+        let lit = scene
+            .lights
+            .iter()
+            .any(|l| !matches!(l, Light::Environment(_)) && emits(l));
         let non_specular = used().any(|m| m.flags().has_non_specular());
         Features {
             shadows: lit && non_specular,
+            nee: non_specular && scene.lights.iter().any(emits),
             specular: used().any(|m| m.flags().is_specular()),
             glossy: used().any(|m| matches!(m, Material::Glossy(_))),
+            emitters: scene.shape_light.iter().any(|&l| l != NO_LIGHT),
+            escape: !scene.infinite_lights.is_empty(),
         }
+    }
+
+    /// The kernel flags `kind` needs for these features. The Whitted tracer is
+    /// specialised on all four; the path tracer on shadows (its next-event estimation),
+    /// emitters and escape; light tracing and BDPT always run their general kernel.
+    pub fn kernel(&self, kind: IntegratorKind) -> KernelFlags {
+        let bit = |on: bool, f: KernelFlags| if on { f } else { 0 };
+        match kind {
+            IntegratorKind::Whitted => {
+                bit(self.shadows, SHADOWS)
+                    | bit(self.specular, SPECULAR)
+                    | bit(self.emitters, EMITTERS)
+                    | bit(self.escape, ESCAPE)
+            }
+            IntegratorKind::Path => {
+                bit(self.nee, SHADOWS) | bit(self.emitters, EMITTERS) | bit(self.escape, ESCAPE)
+            }
+            IntegratorKind::LightTrace | IntegratorKind::Bdpt => ALL,
+        }
+    }
+
+    /// The kernel a render with `kind` runs: the specialised one for `Auto`, every flag
+    /// for `General`. Errors if the scene needs a flag this build was made without.
+    pub fn choose(
+        &self,
+        kind: IntegratorKind,
+        choice: KernelChoice,
+    ) -> Result<KernelFlags, String> {
+        let need = self.kernel(kind);
+        let specialised = !matches!(kind, IntegratorKind::LightTrace | IntegratorKind::Bdpt);
+        let missing = stripped_of(need);
+        if specialised && missing != 0 {
+            return Err(format!(
+                "this heron was built without {} (HERON_STRIP), which the scene needs",
+                flag_names(missing)
+            ));
+        }
+        Ok(match choice {
+            KernelChoice::Auto => need,
+            KernelChoice::General => ALL,
+            KernelChoice::Forced(k) => k & ALL,
+        } & !STRIPPED)
     }
 }

@@ -1,0 +1,117 @@
+//! Kernels specialised to a scene's features (`scene/features.rs`): for every scene in
+//! `scenes/`, under its own integrator and under `whitted` and `path`, the kernel the
+//! renderer picks gives the same image, bit for bit, as the general kernel with every
+//! feature compiled in; a kernel missing a feature the scene uses does not; and the
+//! course's scenes get the kernels their contents imply.
+use heron::camera::Camera;
+use heron::integrator::IntegratorKind;
+use heron::render::{render, RenderOptions};
+use heron::scene::features::{
+    flag_names, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, SHADOWS, SPECULAR,
+};
+use heron::scene::{load_scene, Features, Scene};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+fn scene(name: &str) -> Scene {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    let mut s = load_scene(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+    // Small enough to render every scene twice per integrator in a second or two, large
+    // enough that every feature is hit (each scene's camera sees its lights' effects).
+    let c = &s.camera;
+    s.camera = Camera::new(c.eye, c.look_at, c.up, c.d, 40, 30).unwrap();
+    s
+}
+
+fn image(s: &Scene, kind: IntegratorKind, kernel: KernelChoice) -> (Vec<u32>, KernelFlags) {
+    let mut o = RenderOptions::from_scene(s);
+    o.integrator = kind;
+    o.kernel = kernel;
+    o.spp = 3;
+    o.lanes = 4;
+    o.threads = 2;
+    let (film, stats) = render(s, &o).unwrap();
+    let bits = film.xyz.iter().flatten().map(|v| v.to_bits()).collect();
+    (bits, stats.kernel)
+}
+
+#[test]
+fn specialised_kernels_give_the_general_kernels_image() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 10, "{names:?}");
+    let mut kernels = BTreeSet::new();
+    for name in &names {
+        let s = scene(name);
+        let own = s.settings.integrator;
+        let mut kinds = vec![own, IntegratorKind::Whitted, IntegratorKind::Path];
+        kinds.dedup();
+        for kind in kinds {
+            let (auto, k) = image(&s, kind, KernelChoice::Auto);
+            let (general, g) = image(&s, kind, KernelChoice::General);
+            assert_eq!(g, ALL);
+            assert_eq!(k, Features::of(&s).kernel(kind), "{name}");
+            assert!(
+                auto == general,
+                "{name}, {}: kernel {} differs from the general kernel",
+                kind.name(),
+                flag_names(k)
+            );
+            kernels.insert((kind.name(), k));
+        }
+    }
+    // Not vacuous: the scenes exercise several specialised kernels of both integrators.
+    let specialised = |n: &str| kernels.iter().filter(|(k, f)| *k == n && *f != ALL).count();
+    assert!(specialised("whitted") >= 4, "{kernels:?}");
+    assert!(specialised("path") >= 3, "{kernels:?}");
+}
+
+#[test]
+fn a_kernel_without_a_feature_the_scene_uses_changes_the_image() {
+    // Each flag matters somewhere: dropping it from the scene's own kernel changes the
+    // image (so the flags switch real code, and the identity test above can fail).
+    let cases: [(&str, IntegratorKind, KernelFlags); 5] = [
+        ("default.toml", IntegratorKind::Whitted, SHADOWS),
+        ("default.toml", IntegratorKind::Whitted, ESCAPE),
+        ("default-mirror.toml", IntegratorKind::Whitted, SPECULAR),
+        ("cornell-box.toml", IntegratorKind::Path, EMITTERS),
+        ("cornell-box.toml", IntegratorKind::Path, SHADOWS),
+    ];
+    for (name, kind, flag) in cases {
+        let s = scene(name);
+        let need = Features::of(&s).kernel(kind);
+        assert!(need & flag != 0, "{name} should need {}", flag_names(flag));
+        let (full, _) = image(&s, kind, KernelChoice::Auto);
+        let (without, k) = image(&s, kind, KernelChoice::Forced(need & !flag));
+        assert_eq!(k, need & !flag);
+        assert!(
+            full != without,
+            "{name}: dropping {} changed nothing",
+            flag_names(flag)
+        );
+    }
+}
+
+#[test]
+fn course_scenes_get_the_kernels_their_contents_imply() {
+    let w = |name: &str| Features::of(&scene(name)).kernel(IntegratorKind::Whitted);
+    // A point light over Lambertian shapes under a blue background.
+    assert_eq!(w("default.toml"), SHADOWS | ESCAPE);
+    assert_eq!(w("default-mirror.toml"), SHADOWS | SPECULAR | ESCAPE);
+    assert_eq!(w("default-glass.toml"), SHADOWS | SPECULAR | ESCAPE);
+    // Mitsuba's Cornell box: an area light, diffuse walls, nothing outside the box.
+    let c = scene("cornell-box.toml");
+    assert_eq!(
+        Features::of(&c).kernel(IntegratorKind::Path),
+        SHADOWS | EMITTERS
+    );
+    // Light tracing and BDPT have one kernel.
+    assert_eq!(Features::of(&c).kernel(IntegratorKind::Bdpt), ALL);
+}
