@@ -1,6 +1,7 @@
 //! The spectra a loaded scene uses, as JSON on heron's 1 nm grid (`heron spectra`, a
 //! hidden command): reflectances and emissions after RGB uplift, metals' n and k,
-//! dielectrics' indices, the background. tests/python/test_mitsuba.py gives these same
+//! dielectrics' indices, the background, point lights' intensities, and the triangles
+//! of mesh shapes. tests/python/test_mitsuba.py gives these same
 //! spectra to Mitsuba 3, so that a comparison of the two renderers does not also
 //! compare their RGB uplifts.
 use super::Scene;
@@ -51,17 +52,39 @@ pub fn spectra_json(scene: &Scene) -> Value {
                 Some(Light::Area(a)) => (values(&a.emission), a.two_sided),
                 _ => (Value::Null, false),
             };
+            // Triangle meshes (planes, triangles, quads and OBJ meshes after loading)
+            // with their vertices, so another renderer can be given the same geometry.
+            let mesh = match &s.kind {
+                crate::geometry::ShapeKind::Mesh(m) => json!({
+                    "positions": m.positions.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "indices": m.indices,
+                }),
+                crate::geometry::ShapeKind::Sphere { .. } => Value::Null,
+            };
             json!({
                 "material": scene.material_names[s.material as usize],
                 "emission": emission,
                 "two_sided": two_sided,
+                "mesh": mesh,
             })
+        })
+        .collect();
+    let point_lights: Vec<Value> = scene
+        .lights
+        .iter()
+        .filter_map(|l| match l {
+            Light::Point(p) => Some(json!({
+                "position": [p.position.x, p.position.y, p.position.z],
+                "intensity": values(&p.intensity),
+            })),
+            _ => None,
         })
         .collect();
     json!({
         "lambda_nm": lambda,
         "materials": materials,
         "shapes": shapes,
+        "point_lights": point_lights,
         "background": values(&scene.background),
     })
 }

@@ -13,16 +13,18 @@ What maps onto what:
 | camera (eye, look_at, up, d) | `perspective`, fov_axis y, fov = 2 atan(1/(2d)) |
 | box pixel filter | `hdrfilm` with a `box` rfilter (radius 0.5: the pixel) |
 | `quad` | `rectangle` with to_world columns edge1/2, edge2/2, normal |
+| `plane`, `triangle` | `ply` of heron's own triangles (a plane is heron's 2000 × 2000 quad), face normals |
 | `sphere` | `sphere` |
 | `lambertian` (two-sided) | `twosided` `diffuse` |
 | `conductor` (smooth, rough) | `conductor`, `roughconductor` (ggx, visible normals) |
 | `dielectric` with a constant index | `dielectric` / `roughdielectric` |
 | `emission` on a shape (one-sided) | `area` emitter |
 | `background` | `constant` emitter |
+| `point` light | `point` emitter with heron's intensity spectrum |
 | `max_depth` (scattering events) | `path` max_depth = heron's + 1 (Mitsuba counts vertices) |
 
-Anything else (meshes, dispersive glass, point lights…) raises ValueError: the
-comparison covers what both renderers model the same way.
+Anything else (OBJ meshes, dispersive glass, directional, spot and sun lights…) raises
+ValueError: the comparison covers what both renderers model the same way.
 """
 from __future__ import annotations
 
@@ -91,9 +93,25 @@ def _rectangle(mi, origin, e1, e2):
     return mi.ScalarTransform4f(m)
 
 
+def _write_ply(path: pathlib.Path, mesh: dict) -> None:
+    """A binary PLY of heron's triangles (positions as heron loaded them)."""
+    import struct
+
+    pos, idx = mesh["positions"], mesh["indices"]
+    head = ("ply\nformat binary_little_endian 1.0\n"
+            f"element vertex {len(pos)}\nproperty float x\nproperty float y\nproperty float z\n"
+            f"element face {len(idx)}\nproperty list uchar int vertex_indices\nend_header\n")
+    body = b"".join(struct.pack("<3f", *p) for p in pos)
+    body += b"".join(struct.pack("<B3i", 3, *t) for t in idx)
+    path.write_bytes(head.encode() + body)
+
+
 def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, height=None,
-                 spp: int = 16, max_depth=None) -> dict:
-    """The Mitsuba scene dictionary of heron scene `scene_path` (variant already set)."""
+                 spp: int = 16, max_depth=None, integrator=None, mesh_dir=None) -> dict:
+    """The Mitsuba scene dictionary of heron scene `scene_path` (variant already set).
+
+    `integrator` replaces the default `path` integrator's dictionary; `mesh_dir` is where
+    PLY files of planes and triangles are written (needed only when there are some)."""
     doc = tomllib.loads(scene_path.read_text())
     cam = doc["camera"]
     w, h = cam["resolution"]
@@ -101,11 +119,12 @@ def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, hei
     d = float(cam.get("d", 1.0))
     render = doc.get("render", {})
     depth = max_depth if max_depth is not None else int(render.get("max_depth", 10))
-    if doc.get("lights"):
-        raise ValueError("point, directional, spot and sun lights are not converted")
+    lights = doc.get("lights", [])
+    if any(lt.get("type") != "point" for lt in lights):
+        raise ValueError("directional, spot and sun lights are not converted")
     scene = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": depth + 1},
+        "integrator": integrator or {"type": "path", "max_depth": depth + 1},
         "sensor": {
             "type": "perspective",
             "fov_axis": "y",
@@ -128,6 +147,12 @@ def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, hei
         elif t == "sphere":
             shape = {"type": "sphere", "center": list(map(float, s["center"])),
                      "radius": float(s["radius"])}
+        elif t in ("plane", "triangle") and sp.get("mesh"):
+            if mesh_dir is None:
+                raise ValueError(f"shapes[{i}]: {t} needs mesh_dir for its PLY file")
+            ply = pathlib.Path(mesh_dir) / f"shape-{i}.ply"
+            _write_ply(ply, sp["mesh"])
+            shape = {"type": "ply", "filename": str(ply), "face_normals": True}
         else:
             raise ValueError(f"shapes[{i}]: {t} is not converted")
         mat = sp["material"]
@@ -137,6 +162,9 @@ def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, hei
                 raise ValueError(f"shapes[{i}]: Mitsuba's area emitter is one-sided")
             shape["emitter"] = {"type": "area", "radiance": regular(sp["emission"])}
         scene[f"shape-{i}"] = shape
+    for i, pl in enumerate(spectra.get("point_lights", [])):
+        scene[f"point-{i}"] = {"type": "point", "position": list(map(float, pl["position"])),
+                               "intensity": regular(pl["intensity"])}
     if max(spectra["background"]) > 0.0:
         scene["environment"] = {"type": "constant", "radiance": regular(spectra["background"])}
     return scene
