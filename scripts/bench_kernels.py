@@ -80,7 +80,7 @@ def main():
                 for name, exe, k in order:
                     times[name].append(render(exe, scene, integ, spp, k, out))
             med = {k: statistics.median(v) for k, v in times.items()}
-            print(f"{scene},{integ},{strip},{spp},{med['auto']:.3f},{med['general']:.3f},"
+            print(f"{scene},{integ},{strip.replace(',', '+')},{spp},{med['auto']:.3f},{med['general']:.3f},"
                   f"{med['stripped']:.3f},{med['auto'] / med['stripped']:.3f},"
                   f"{med['general'] / med['auto']:.3f}", flush=True)
 

@@ -82,17 +82,18 @@ class Heron:
 
 
 class Mitsuba:
-    def __init__(self, variant, scene_path, spectra, threads, integrator=None, mesh_dir=None):
+    def __init__(self, variant, scene_path, spectra, threads, integrator=None, mesh_dir=None,
+                 sampler="independent"):
         import colour
         import drjit as dr
         import mitsuba as mi
 
         self.mi, self.dr, self.variant = mi, dr, variant
-        self.name = f"mitsuba {variant}"
+        self.name = f"mitsuba {variant}" + ("" if sampler == "independent" else f" {sampler}")
         mi.set_variant(variant)
         dr.set_thread_count(threads)
         self.scene = mi.load_dict(mitsuba_dict(mi, scene_path, spectra, integrator=integrator,
-                                               mesh_dir=mesh_dir))
+                                               mesh_dir=mesh_dir, sampler=sampler))
         self.k = xyz_normalisation(mi, colour)
         if variant.startswith("llvm"):
             self.render(4, 0)  # compile the kernels
@@ -114,6 +115,9 @@ def main():
     ap.add_argument("--heron-args", action="append", default=[],
                     help="extra heron settings measured as further rows, e.g. '--lanes 8'")
     ap.add_argument("--mitsuba-integrator", choices=["path", "direct"], default="path")
+    ap.add_argument("--mitsuba-sampler", default="independent",
+                    help="Mitsuba's sampler for its two runs: independent (its default), "
+                         "stratified, multijitter, orthogonal or ldsampler")
     ap.add_argument("--black-background", action="store_true",
                     help="render a copy of the scene with its background set to 0")
     a = ap.parse_args()
@@ -136,8 +140,10 @@ def main():
     spectra = heron_spectra(binary, scene)
     runners = [Heron(binary, scene, a.threads, [], tmp)]
     runners += [Heron(binary, scene, a.threads, x.split(), tmp) for x in a.heron_args]
-    scalar = Mitsuba("scalar_spectral", scene, spectra, a.threads, integrator, tmp)
-    llvm = Mitsuba("llvm_ad_spectral", scene, spectra, a.threads, integrator, tmp)
+    scalar = Mitsuba("scalar_spectral", scene, spectra, a.threads, integrator, tmp,
+                     a.mitsuba_sampler)
+    llvm = Mitsuba("llvm_ad_spectral", scene, spectra, a.threads, integrator, tmp,
+                   a.mitsuba_sampler)
     runners += [scalar, llvm]
 
     print(f"# {a.scene}{' (black background)' if a.black_background else ''}, Mitsuba "

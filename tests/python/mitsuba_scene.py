@@ -107,11 +107,14 @@ def _write_ply(path: pathlib.Path, mesh: dict) -> None:
 
 
 def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, height=None,
-                 spp: int = 16, max_depth=None, integrator=None, mesh_dir=None) -> dict:
+                 spp: int = 16, max_depth=None, integrator=None, mesh_dir=None,
+                 sampler: str = "independent") -> dict:
     """The Mitsuba scene dictionary of heron scene `scene_path` (variant already set).
 
     `integrator` replaces the default `path` integrator's dictionary; `mesh_dir` is where
-    PLY files of planes and triangles are written (needed only when there are some)."""
+    PLY files of planes and triangles are written (needed only when there are some);
+    `sampler` names Mitsuba's sampler plugin (independent, stratified, multijitter,
+    orthogonal, ldsampler)."""
     doc = tomllib.loads(scene_path.read_text())
     cam = doc["camera"]
     w, h = cam["resolution"]
@@ -130,7 +133,7 @@ def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, hei
             "fov_axis": "y",
             "fov": math.degrees(2.0 * math.atan(1.0 / (2.0 * d))),
             "to_world": _look_at(mi, cam["eye"], cam["look_at"], cam.get("up", [0.0, 1.0, 0.0])),
-            "sampler": {"type": "independent", "sample_count": spp},
+            "sampler": {"type": sampler, "sample_count": spp},
             "film": {"type": "hdrfilm", "width": w, "height": h, "rfilter": {"type": "box"},
                      "pixel_format": "xyz", "component_format": "float32"},
         },
