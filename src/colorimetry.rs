@@ -13,10 +13,12 @@
 //! what was expected.
 //!
 //! The rows are turned into heron's 1 nm table over 360–830 nm by
-//! [`DenseSpectrum::from_samples`], as every spectrum of a scene is: linear interpolation
-//! evaluated at each whole nanometre, the end values held constant beyond the first and
-//! last row. (Data finer than 1 nm is therefore point-sampled at whole nanometres, not
-//! averaged.)
+//! [`DenseSpectrum::from_table`], as every spectral CSV of a scene is, the way
+//! colour-science aligns a distribution (CIE 167:2005): the Sprague (1880) interpolating
+//! polynomial for uniformly spaced rows (at least six), a not-a-knot cubic spline for
+//! irregular ones (at least four), linear for two or three rows, evaluated at each whole
+//! nanometre, the end values held constant beyond the first and last row. (Data finer
+//! than 1 nm is therefore point-sampled at whole nanometres, not averaged.)
 //!
 //! # Colorimetry
 //!
@@ -206,9 +208,10 @@ impl SpectrumCsv {
     }
 
     /// The distribution on heron's 1 nm grid over 360–830 nm
-    /// ([`DenseSpectrum::from_samples`]: linear, held constant beyond the ends).
+    /// ([`DenseSpectrum::from_table`]: as colour-science interpolates, held constant
+    /// beyond the ends).
     pub fn to_dense(&self) -> DenseSpectrum {
-        DenseSpectrum::from_samples(&self.samples)
+        DenseSpectrum::from_table(&self.samples)
     }
 
     /// First and last wavelength, nm.

@@ -233,11 +233,16 @@ fn perfect_reflector_gives_the_illuminant_white() {
 }
 
 #[test]
-fn a_box_spectrum_is_interpolated_at_whole_nanometres() {
-    // 1 on 500–600 nm with linear ramps to 0 at 499 and 601: the 1 nm table holds 1 at
-    // 500..=600 and 0 elsewhere. As an emitter its Y is Σ_{500..600} ȳ / Σ ȳ.
+fn a_box_spectrum_on_the_grid_is_taken_as_it_is() {
+    // Rows every 1 nm over 480–620 nm, 1 on 500–600 and 0 elsewhere: uniform data, so
+    // Sprague interpolation, which passes through every row, gives the 1 nm table back
+    // unchanged. As an emitter its Y is Σ_{500..600} ȳ / Σ ȳ. (Four rows 499/500/600/601
+    // would be irregular and, as in colour-science, a cubic through them, not a box.)
     let d = tempfile::tempdir().unwrap();
-    let boxed = write(d.path(), "box.csv", "499,0\n500,1\n600,1\n601,0\n");
+    let rows: String = (480..=620)
+        .map(|l| format!("{l},{}\n", u8::from((500..=600).contains(&l))))
+        .collect();
+    let boxed = write(d.path(), "box.csv", &rows);
     let y = vec3(&color(&[&boxed, "--illuminant", "none"]), "XYZ")[1];
     let table = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),

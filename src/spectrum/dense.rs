@@ -24,6 +24,17 @@ impl DenseSpectrum {
         DenseSpectrum { values }
     }
 
+    /// A spectral table (wavelength nm, value; wavelengths strictly increasing) on the
+    /// 1 nm grid as colour-science aligns it: Sprague for uniform data, a not-a-knot
+    /// cubic spline otherwise, held constant beyond the ends ([`super::interp`]). Every
+    /// spectral CSV heron reads goes through this.
+    pub fn from_table(samples: &[(f32, f32)]) -> Self {
+        let v = super::interp::interpolate(samples, (0..DENSE_LEN).map(|i| LAMBDA_MIN + i as f32));
+        let mut values = Box::new([0.0f32; DENSE_LEN]);
+        values.copy_from_slice(&v);
+        DenseSpectrum { values }
+    }
+
     /// Piecewise-linear interpolation from (wavelength nm, value) samples sorted by
     /// wavelength; held constant beyond the first and last sample.
     pub fn from_samples(samples: &[(f32, f32)]) -> Self {

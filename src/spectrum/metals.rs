@@ -2,8 +2,10 @@
 //! `spectra/metals/` (gold, silver and copper from Johnson & Christy 1972, aluminium from
 //! Rakić et al. 1998's Lorentz–Drude model; spectra/README.md names the sources and
 //! `scripts/gen_metals.py` made the files) and user tables with rows
-//! `wavelength_nm,n,k`. Values are interpolated linearly in wavelength onto heron's 1 nm
-//! grid.
+//! `wavelength_nm,n,k`. Values go onto heron's 1 nm grid as every spectral CSV does
+//! ([`DenseSpectrum::from_table`]: Sprague for uniform rows, a not-a-knot cubic spline
+//! for irregular ones, as colour-science), and the interpolated table must keep n > 0
+//! and k ≥ 0.
 use crate::bsdf::ComplexIor;
 use crate::colorimetry::parse_columns;
 use crate::spectrum::DenseSpectrum;
@@ -42,10 +44,20 @@ pub fn parse_nk(text: &str, path: &Path) -> Result<ComplexIor> {
     }
     let n: Vec<(f32, f32)> = rows.iter().map(|r| (r[0], r[1])).collect();
     let k: Vec<(f32, f32)> = rows.iter().map(|r| (r[0], r[2])).collect();
-    Ok(ComplexIor {
-        n: DenseSpectrum::from_samples(&n),
-        k: DenseSpectrum::from_samples(&k),
-    })
+    let ior = ComplexIor {
+        n: DenseSpectrum::from_table(&n),
+        k: DenseSpectrum::from_table(&k),
+    };
+    // A spline can overshoot between rows; the interpolated table must stay physical.
+    for (i, (&nv, &kv)) in ior.n.values().iter().zip(ior.k.values()).enumerate() {
+        if !(nv > 0.0) || !(kv >= 0.0) {
+            return Err(HeronError::Invalid(format!(
+                "{file}: the interpolated index has n = {nv} and k = {kv} at {} nm; expected n > 0 and k >= 0 (add rows where the data changes quickly)",
+                crate::spectrum::LAMBDA_MIN + i as f32
+            )));
+        }
+    }
+    Ok(ior)
 }
 
 /// Reads a user's `wavelength_nm,n,k` table.

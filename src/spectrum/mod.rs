@@ -5,6 +5,7 @@
 pub mod cie;
 pub mod color;
 pub mod dense;
+pub mod interp;
 pub mod ior;
 pub mod metals;
 pub mod rgb2spec;
