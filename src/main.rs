@@ -34,6 +34,12 @@ enum Command {
     Bench(BenchCommand),
     /// Print the CIE XYZ, xy and linear sRGB of a spectral distribution CSV as JSON.
     Color(ColorArgs),
+    /// Print the provenance heron wrote into an EXR: version, scene and input hashes,
+    /// integrator, sampler, spp, seed, lanes, wavelengths (one `key: value` per line).
+    Info {
+        /// An EXR written by heron render.
+        exr: PathBuf,
+    },
     /// Rainbow skies: radiance profiles of the sky models (heron::sky).
     #[command(subcommand)]
     Sky(SkyCommand),
@@ -328,6 +334,27 @@ struct RenderArgs {
     /// render.max_depth).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_depth: Option<u32>,
+    /// Write the film's state to FILE (atomically) during the render, so that a killed
+    /// render can continue with --resume FILE.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (written at the first pass boundary after this long;
+    /// 0: after every pass).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 60.0,
+        requires = "checkpoint"
+    )]
+    checkpoint_every: f64,
+    /// Continue the render a checkpoint holds (same scene and settings); the image is
+    /// byte-identical to an uninterrupted render.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
+    /// Stop at the first pass boundary after this many seconds and write the image of
+    /// the samples so far.
+    #[arg(long, value_name = "SECONDS")]
+    time_limit: Option<f64>,
     /// Do not draw the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -387,6 +414,7 @@ fn main() {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
         }
         Command::Color(args) => cmd_color(args),
+        Command::Info { exr } => cmd_info(&exr),
         Command::Sky(c) => cmd_sky(c),
         Command::Spectra { scene } => load_scene(&scene)
             .map_err(Into::into)
@@ -448,6 +476,44 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     opts.wavelengths = wavelength_sampler(&args.wavelengths);
     opts.kernel = heron::scene::features::KernelChoice::parse(&args.kernel)
         .map_err(|e| anyhow::anyhow!("--kernel: {e}"))?;
+    let seconds = |flag: &str, v: f64| -> Result<std::time::Duration> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(std::time::Duration::from_secs_f64(v))
+        } else {
+            bail!("{flag}: expected a finite number of seconds >= 0, got {v}")
+        }
+    };
+    if let Some(c) = &args.checkpoint {
+        if c.extension().and_then(|e| e.to_str()) == Some("exr") {
+            bail!(
+                "--checkpoint {}: expected a file other than an EXR",
+                c.display()
+            );
+        }
+        opts.checkpoint = Some((
+            c.clone(),
+            seconds("--checkpoint-every", args.checkpoint_every)?,
+        ));
+    }
+    if let Some(t) = args.time_limit {
+        opts.time_limit = Some(seconds("--time-limit", t)?);
+    }
+    if let Some(r) = &args.resume {
+        opts.resume = Some(Arc::new(heron::checkpoint::Checkpoint::read(r)?));
+    }
+    // Ctrl-C finishes the current pass and writes what it has (status 130); a second
+    // Ctrl-C exits at once.
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || {
+            if stop.swap(true, std::sync::atomic::Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        })
+        .map_err(|e| anyhow::anyhow!("cannot install the Ctrl-C handler: {e}"))?;
+    }
+    opts.stop = Some(stop.clone());
     let bar = progress_bar(args.quiet);
     if let Some(bar) = &bar {
         let b = bar.clone();
@@ -466,7 +532,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         xyz: args.xyz,
         spectral: args.spectral_bins.is_some(),
     };
-    let exr = stage_exr(&film, &exr_path, channels)?;
+    let provenance = heron::provenance::Provenance::of_render(&scene, &opts, stats.spp);
+    let exr = stage_exr(&film, &exr_path, channels, &provenance)?;
     let png = if args.no_png {
         None
     } else {
@@ -481,7 +548,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         display(&exr_path),
         film.width,
         film.height,
-        opts.spp,
+        stats.spp,
         opts.lanes,
         opts.sampler.name(),
         opts.integrator.name(),
@@ -493,6 +560,31 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         stats.mrays_per_s(),
         stats.nonfinite
     );
+    if let Some(from) = stats.resumed_from {
+        eprintln!(
+            "resumed from {from} spp ({})",
+            display(args.resume.as_deref().unwrap_or(Path::new("")))
+        );
+    }
+    if stats.stopped {
+        let why = if stop.load(std::sync::atomic::Ordering::SeqCst) {
+            "interrupted"
+        } else {
+            "time limit reached"
+        };
+        eprintln!(
+            "{why}: the image holds {} of {} spp per pixel{}",
+            stats.spp,
+            opts.spp,
+            match &opts.checkpoint {
+                Some((c, _)) => format!("; continue with --resume {}", display(c)),
+                None => String::new(),
+            }
+        );
+        if why == "interrupted" {
+            std::process::exit(130);
+        }
+    }
     Ok(())
 }
 
@@ -602,6 +694,21 @@ fn cmd_bench_traversal(a: TraversalArgs) -> Result<()> {
             cell(row.raw_mrays(), has_raw),
             cell(row.ratio(), has_raw),
         );
+    }
+    Ok(())
+}
+
+fn cmd_info(path: &Path) -> Result<()> {
+    let attrs = heron::film::exr::read_provenance(path)?;
+    if attrs.is_empty() {
+        anyhow::bail!(
+            "{}: no heron provenance in this EXR (expected heron.* header attributes)",
+            path.display()
+        );
+    }
+    for (k, v) in attrs {
+        // Multi-line values (the input files) are indented under their key.
+        println!("{k}: {}", v.replace('\n', "\n  "));
     }
     Ok(())
 }

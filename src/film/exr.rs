@@ -6,6 +6,7 @@
 //! decimal comma as the paper specifies), the `spectralLayoutVersion` attribute "1.0"
 //! and `emissiveUnits` "W.m^-2.sr^-1".
 use super::{Film, Staged};
+use crate::provenance::{Provenance, PREFIX};
 use crate::spectrum::color::SRGB_CHROMATICITIES;
 use exr::prelude::*;
 use std::path::Path;
@@ -25,12 +26,23 @@ pub fn spectral_channel_name(lambda: f32) -> String {
 }
 
 /// Writes the EXR file; see [`stage_exr`] to write several outputs together.
-pub fn write_exr(film: &Film, path: &Path, channels: ExrChannels) -> crate::Result<()> {
-    stage_exr(film, path, channels)?.commit()
+pub fn write_exr(
+    film: &Film,
+    path: &Path,
+    channels: ExrChannels,
+    provenance: &Provenance,
+) -> crate::Result<()> {
+    stage_exr(film, path, channels, provenance)?.commit()
 }
 
-/// Writes the EXR file to a temporary file, to be committed later.
-pub fn stage_exr(film: &Film, path: &Path, which: ExrChannels) -> crate::Result<Staged> {
+/// Writes the EXR file to a temporary file, to be committed later. `provenance` goes
+/// into the header as text attributes `heron.<key>` ([`crate::provenance`]).
+pub fn stage_exr(
+    film: &Film,
+    path: &Path,
+    which: ExrChannels,
+    provenance: &Provenance,
+) -> crate::Result<Staged> {
     let (w, h) = (film.width as usize, film.height as usize);
     let rgb = film.linear_srgb();
     let plane = |f: &dyn Fn(usize) -> f32| FlatSamples::F32((0..w * h).map(f).collect());
@@ -44,6 +56,12 @@ pub fn stage_exr(film: &Film, path: &Path, which: ExrChannels) -> crate::Result<
         }
     }
     let mut layer_attrs = LayerAttributes::named("heron");
+    for (k, v) in &provenance.0 {
+        layer_attrs.other.insert(
+            Text::from(format!("{PREFIX}{k}").as_str()),
+            attribute::AttributeValue::Text(Text::from(v.as_str())),
+        );
+    }
     if let (true, Some((bins, data))) = (which.spectral, &film.spectral) {
         for k in 0..bins.count {
             let name = spectral_channel_name(bins.centre(k));
@@ -77,10 +95,85 @@ pub fn stage_exr(film: &Film, path: &Path, which: ExrChannels) -> crate::Result<
     });
     Staged::write(path, |tmp| {
         // Single-threaded compression keeps the bytes independent of scheduling.
+        let mut bytes = std::io::Cursor::new(Vec::new());
         image
             .write()
             .non_parallel()
-            .to_file(tmp)
-            .map_err(|e| format!("cannot write EXR: {e}"))
+            .to_buffered(&mut bytes)
+            .map_err(|e| format!("cannot write EXR: {e}"))?;
+        let mut bytes = bytes.into_inner();
+        sort_header_attributes(&mut bytes)?;
+        std::fs::write(tmp, bytes).map_err(|e| format!("cannot write EXR: {e}"))
     })
+}
+
+/// Sorts the attributes of a single-part EXR header by name, in place. The exr crate
+/// keeps custom attributes in a `HashMap` and writes them in its (per-process random)
+/// order, which would make identical renders differ in their header bytes. Attribute
+/// order is free in OpenEXR, and sorting keeps the header's length, so the offset table
+/// and pixel data that follow stay valid. Layout (OpenEXR file layout, "Header"): magic
+/// and version (8 bytes), then attributes `name\0 type\0 size:i32le value[size]`, then a
+/// zero byte.
+fn sort_header_attributes(bytes: &mut [u8]) -> std::result::Result<(), String> {
+    let bad = || "cannot write EXR: unexpected header layout".to_string();
+    let start = 8;
+    let mut at = start;
+    let mut attrs: Vec<(Vec<u8>, std::ops::Range<usize>)> = Vec::new();
+    let cstr = |from: usize| -> Option<usize> {
+        bytes[from..].iter().position(|&b| b == 0).map(|n| from + n)
+    };
+    loop {
+        if *bytes.get(at).ok_or_else(bad)? == 0 {
+            break;
+        }
+        let name_end = cstr(at).ok_or_else(bad)?;
+        let type_end = cstr(name_end + 1).ok_or_else(bad)?;
+        let size_at = type_end + 1;
+        let size: [u8; 4] = bytes
+            .get(size_at..size_at + 4)
+            .ok_or_else(bad)?
+            .try_into()
+            .unwrap();
+        let end = size_at + 4 + i32::from_le_bytes(size).max(0) as usize;
+        if end > bytes.len() {
+            return Err(bad());
+        }
+        attrs.push((bytes[at..name_end].to_vec(), at..end));
+        at = end;
+    }
+    let region: Vec<u8> = bytes[start..at].to_vec();
+    attrs.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut out = Vec::with_capacity(region.len());
+    for (_, r) in &attrs {
+        out.extend_from_slice(&region[r.start - start..r.end - start]);
+    }
+    bytes[start..at].copy_from_slice(&out);
+    Ok(())
+}
+
+/// The `heron.*` text attributes of the EXR at `path` (the provenance `heron info`
+/// prints), sorted by key. Errors name the file.
+pub fn read_provenance(path: &Path) -> crate::Result<Vec<(String, String)>> {
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| crate::HeronError::Io {
+            path: path.to_path_buf(),
+            message: format!("cannot read it as OpenEXR: {e}"),
+        })?;
+    let mut out = Vec::new();
+    for h in &meta.headers {
+        for (k, v) in h
+            .own_attributes
+            .other
+            .iter()
+            .chain(&h.shared_attributes.other)
+        {
+            let key = k.to_string();
+            if let (Some(name), attribute::AttributeValue::Text(t)) = (key.strip_prefix(PREFIX), v)
+            {
+                out.push((name.to_string(), t.to_string()));
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
 }

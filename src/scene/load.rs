@@ -55,7 +55,9 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 /// messages and its folder is where relative mesh paths start.
 pub fn load_scene_from_str(text: &str, path: &Path) -> Result<Scene> {
     let file = parse_scene_file(text).map_err(|m| scene_error(path, m))?;
-    build(path, file)
+    let mut scene = build(path, file)?;
+    scene.source_sha256 = crate::provenance::sha256_hex(text.as_bytes());
+    Ok(scene)
 }
 
 /// Stages 1 and 2: TOML text to [`SceneFile`]. The error is the one-line message.
@@ -415,12 +417,15 @@ fn friendly(path: &[Seg], msg: &str) -> String {
 fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     let err = |m: String| scene_error(path, m);
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    // Every file the scene reads besides itself (meshes, tables), for provenance.
+    let mut inputs: Vec<String> = Vec::new();
 
     // Materials, sorted by name.
     let mut materials = Vec::with_capacity(file.materials.len());
     let mut material_names = Vec::with_capacity(file.materials.len());
     for (name, m) in &file.materials {
-        materials.push(build_material(&key("materials", name), m, &base_dir).map_err(err)?);
+        materials
+            .push(build_material(&key("materials", name), m, &base_dir, &mut inputs).map_err(err)?);
         material_names.push(name.clone());
     }
     // A shape that emits and names no material is a pure emitter: it gets a black
@@ -539,6 +544,7 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                 }
                 let fallback = m.emission.as_ref().map(|_| black);
                 shapes.extend(build_mesh(path, &base_dir, &at, m, &lookup, fallback)?);
+                inputs.push(m.file.clone());
             }
         }
         shape_entry.resize(shapes.len(), i);
@@ -702,7 +708,8 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     )
     .map_err(|e| err(format!("camera: {e}")))?;
 
-    Ok(Scene::from_parts(super::SceneParts {
+    let inputs = crate::provenance::hash_inputs(&base_dir, inputs).map_err(err)?;
+    let mut scene = Scene::from_parts(super::SceneParts {
         source: path.to_path_buf(),
         camera,
         shapes,
@@ -713,7 +720,9 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         background,
         sky,
         settings,
-    }))
+    });
+    scene.inputs = inputs;
+    Ok(scene)
 }
 
 /// The sphere around the shapes' bounding box (a unit sphere at the origin for a scene
@@ -748,7 +757,12 @@ pub fn scene_bounds(shapes: &[Shape]) -> crate::light::SceneBounds {
 }
 
 /// The refractive-index model of `spec`; a table file is read relative to `base_dir`.
-fn build_ior(at: &str, spec: &IorSpec, base_dir: &Path) -> std::result::Result<Ior, String> {
+fn build_ior(
+    at: &str,
+    spec: &IorSpec,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<Ior, String> {
     let ior = match spec {
         IorSpec::Constant(n) => Ior::Constant(*n),
         IorSpec::Named(name) => crate::spectrum::ior::named(name)
@@ -763,6 +777,7 @@ fn build_ior(at: &str, spec: &IorSpec, base_dir: &Path) -> std::result::Result<I
             let p = base_dir.join(file);
             let csv =
                 crate::colorimetry::SpectrumCsv::read(&p).map_err(|e| format!("{at}: {e}"))?;
+            inputs.push(file.clone());
             Ior::Table(csv.to_dense())
         }
     };
@@ -775,12 +790,14 @@ fn build_metal(
     at: &str,
     spec: &MetalSpec,
     base_dir: &Path,
+    inputs: &mut Vec<String>,
 ) -> std::result::Result<ComplexIor, String> {
     let at = format!("{at}.metal");
     match spec {
         MetalSpec::Named(name) => crate::spectrum::metals::named(name)
             .ok_or_else(|| format!("{at}: unknown metal {name:?}")),
         MetalSpec::Table(file) => {
+            inputs.push(file.clone());
             crate::spectrum::metals::read_nk(&base_dir.join(file)).map_err(|e| format!("{at}: {e}"))
         }
         MetalSpec::Constant { n, k } => Ok(ComplexIor {
@@ -794,6 +811,7 @@ fn build_material(
     at: &str,
     m: &MaterialFile,
     base_dir: &Path,
+    inputs: &mut Vec<String>,
 ) -> std::result::Result<Material, String> {
     Ok(match m {
         MaterialFile::Lambertian(l) => Material::Lambertian(Lambertian {
@@ -808,11 +826,11 @@ fn build_material(
         }),
         MaterialFile::Dielectric(d) => {
             let mut interface = Dielectric::new(
-                build_ior(&format!("{at}.ior"), &d.ior, base_dir)?,
+                build_ior(&format!("{at}.ior"), &d.ior, base_dir, inputs)?,
                 d.fresnel.unwrap_or(true),
             );
             if let Some(o) = &d.outside_ior {
-                interface.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir)?;
+                interface.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir, inputs)?;
             }
             let alpha = d.roughness.map_or(0.0, |r| r.0);
             if alpha < MIN_ALPHA {
@@ -830,7 +848,7 @@ fn build_material(
             }
         }
         MaterialFile::Conductor(c) => {
-            let ior = build_metal(at, &c.metal, base_dir)?;
+            let ior = build_metal(at, &c.metal, base_dir, inputs)?;
             let alpha = c.roughness.map_or(0.0, |r| r.0);
             if alpha < MIN_ALPHA {
                 Material::Conductor(Conductor { ior })
@@ -871,7 +889,7 @@ fn build_material(
                 shininess: g.shininess.0,
                 base: match &g.ior {
                     Some(spec) => Some(Dielectric::new(
-                        build_ior(&format!("{at}.ior"), spec, base_dir)?,
+                        build_ior(&format!("{at}.ior"), spec, base_dir, inputs)?,
                         g.fresnel.unwrap_or(true),
                     )),
                     None => None,

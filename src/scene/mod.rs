@@ -55,6 +55,11 @@ pub const NO_LIGHT: u32 = u32::MAX;
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub source: PathBuf,
+    /// SHA-256 of the scene file's text (hex; empty for scenes built in code).
+    pub source_sha256: String,
+    /// The other files the scene read (meshes, index and n, k tables): the path as the
+    /// scene names it and the SHA-256 of its bytes, sorted by path.
+    pub inputs: Vec<(String, String)>,
     pub camera: Camera,
     pub shapes: Vec<Shape>,
     pub materials: Vec<Material>,
@@ -128,6 +133,8 @@ impl Scene {
         };
         Scene {
             source: p.source,
+            source_sha256: String::new(),
+            inputs: Vec::new(),
             camera: p.camera,
             shapes: p.shapes,
             materials: p.materials,

@@ -195,6 +195,44 @@ def test_exr_channels_window_and_chromaticities(render):
                                   err_msg="chromaticities (rx ry gx gy bx by wx wy) are not sRGB/D65")
 
 
+def test_exr_carries_provenance_readable_by_openexr(render, tmp_path):
+    """Issue 10, part 5: heron's provenance as text attributes any OpenEXR reader sees."""
+    import hashlib
+    import subprocess
+
+    import OpenEXR
+
+    r = render("background_e.toml", spp=4, seed=9, extra=("--lanes", "4"))
+    header, _, _ = read_exr(r.exr)
+    got = {k: v for k, v in header.items() if k.startswith("heron.")}
+    scene_sha = hashlib.sha256(r.scene.read_bytes()).hexdigest()
+    assert got == {
+        "heron.version": got.get("heron.version"),
+        "heron.scene": "background_e.toml",
+        "heron.sceneSha256": scene_sha,
+        "heron.inputs": "",
+        "heron.integrator": "whitted",
+        "heron.sampler": "sobol",
+        "heron.spp": "4",
+        "heron.seed": "9",
+        "heron.lanes": "4",
+        "heron.wavelengths": "visible",
+        "heron.maxDepth": got.get("heron.maxDepth"),
+        "heron.packets": "true",
+        "heron.spectralBins": "0",
+    }, got
+    assert got["heron.version"] and got["heron.maxDepth"].isdigit()
+    # An EXR without them: `heron info` says so in one line and fails.
+    plain = tmp_path / "plain.exr"
+    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
+                      {"Y": np.zeros((2, 3), dtype=np.float32)}) as f:
+        f.write(str(plain))
+    proc = subprocess.run([str(require_heron_bin()), "info", str(plain)], capture_output=True,
+                          text=True)
+    assert proc.returncode == 1 and "no heron provenance" in proc.stderr, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+
+
 # ------------------------------------------------------------------ (v) PNG preview
 
 

@@ -1,0 +1,85 @@
+//! Provenance: what made an image, written into every EXR heron renders as header
+//! attributes, and printed back by `heron info`.
+//!
+//! The attributes are strings named `heron.<key>`: the version of heron, the scene file's
+//! name and the SHA-256 of its text, the SHA-256 of every other file it read (meshes,
+//! index and n, k tables), and the render settings that change the pixels: integrator,
+//! sampler, samples per pixel reached, seed, lanes, wavelength sampler, maximum depth,
+//! camera packets and spectral bins. Nothing that differs between identical runs (no
+//! date, no wall time, no thread count, no absolute path) is recorded, so identical
+//! renders stay byte-identical.
+use crate::render::RenderOptions;
+use crate::scene::Scene;
+use crate::spectrum::WavelengthSampler;
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+/// The attribute-name prefix.
+pub const PREFIX: &str = "heron.";
+
+/// SHA-256 of `bytes`, as 64 lowercase hex digits.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// (path as the scene names it, SHA-256 of the file's bytes) for each distinct file,
+/// sorted by path. The files were just read by the loader; an error names the file.
+pub fn hash_inputs(
+    base_dir: &Path,
+    mut files: Vec<String>,
+) -> std::result::Result<Vec<(String, String)>, String> {
+    files.sort();
+    files.dedup();
+    files
+        .into_iter()
+        .map(|f| {
+            let bytes = std::fs::read(base_dir.join(&f))
+                .map_err(|e| format!("{f}: cannot read it again to hash it: {e}"))?;
+            Ok((f, sha256_hex(&bytes)))
+        })
+        .collect()
+}
+
+/// The provenance of a render, as (key, value) pairs in a fixed order; the EXR
+/// attribute of each is `heron.<key>`.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Provenance(pub Vec<(&'static str, String)>);
+
+impl Provenance {
+    /// What `scene` rendered with `opts` to `spp` samples per pixel records.
+    pub fn of_render(scene: &Scene, opts: &RenderOptions, spp: u32) -> Provenance {
+        let name = scene
+            .source
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let inputs = scene
+            .inputs
+            .iter()
+            .map(|(f, h)| format!("{h}  {f}"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let wavelengths = match opts.wavelengths {
+            WavelengthSampler::Uniform => "uniform",
+            WavelengthSampler::Visible => "visible",
+        };
+        Provenance(vec![
+            ("version", env!("CARGO_PKG_VERSION").to_string()),
+            ("scene", name),
+            ("sceneSha256", scene.source_sha256.clone()),
+            ("inputs", inputs),
+            ("integrator", opts.integrator.name().to_string()),
+            ("sampler", opts.sampler.name().to_string()),
+            ("spp", spp.to_string()),
+            ("seed", opts.seed.to_string()),
+            ("lanes", opts.lanes.to_string()),
+            ("wavelengths", wavelengths.to_string()),
+            ("maxDepth", scene.settings.max_depth.to_string()),
+            ("packets", opts.packets.to_string()),
+            ("spectralBins", opts.spectral_bins.to_string()),
+        ])
+    }
+}
