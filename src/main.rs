@@ -351,6 +351,10 @@ struct RenderArgs {
     /// byte-identical to an uninterrupted render.
     #[arg(long, value_name = "FILE")]
     resume: Option<PathBuf>,
+    /// Exit with status 3 (after writing the image) if any sample was NaN or infinite;
+    /// the count and the first pixel and sample are printed either way.
+    #[arg(long)]
+    check_finite: bool,
     /// Stop at the first pass boundary after this many seconds and write the image of
     /// the samples so far.
     #[arg(long, value_name = "SECONDS")]
@@ -560,6 +564,16 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         stats.mrays_per_s(),
         stats.nonfinite
     );
+    if stats.nonfinite > 0 {
+        let at = match stats.first_nonfinite {
+            Some((x, y, s)) => format!("; the first at pixel ({x}, {y}), sample {s}"),
+            None => " (in splats)".to_string(),
+        };
+        eprintln!(
+            "non-finite: {} samples were NaN or infinite and left out of the image{at}",
+            stats.nonfinite
+        );
+    }
     if let Some(from) = stats.resumed_from {
         eprintln!(
             "resumed from {from} spp ({})",
@@ -584,6 +598,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         if why == "interrupted" {
             std::process::exit(130);
         }
+    }
+    if args.check_finite && stats.nonfinite > 0 {
+        std::process::exit(3);
     }
     Ok(())
 }

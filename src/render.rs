@@ -90,6 +90,9 @@ pub struct RenderStats {
     /// Samples whose radiance was NaN or infinite; they are left out of the image and
     /// counted here.
     pub nonfinite: u64,
+    /// Where this process met its first non-finite sample, in render order (pass, tile,
+    /// row, packet, sample, lane): (x, y, sample index).
+    pub first_nonfinite: Option<(u32, u32, u32)>,
     pub samples: u64,
     /// The kernel that ran ([`crate::scene::features::flag_names`] names it).
     pub kernel: KernelFlags,
@@ -424,6 +427,7 @@ pub(crate) fn render_passes(
             state.rays += t.counters.rays;
             state.shadow_rays += t.counters.shadow_rays;
             state.nonfinite += t.nonfinite + t.splats.nonfinite;
+            stats.first_nonfinite = stats.first_nonfinite.or(t.first_nonfinite);
         }
         state.passes_done += 1;
         state.spp_done = s1;
@@ -513,6 +517,7 @@ struct TileResult {
     splats: Splats,
     counters: TraceCounters,
     nonfinite: u64,
+    first_nonfinite: Option<(u32, u32, u32)>,
 }
 
 fn render_tile<const N: usize>(
@@ -546,6 +551,7 @@ fn render_tile<const N: usize>(
     }
     let mut counters = TraceCounters::default();
     let mut nonfinite = 0u64;
+    let mut first_nonfinite = None;
     let mut splats = Splats::with_bins(
         cam.width * cam.height,
         (opts.spectral_bins > 0).then_some(SpectralBins {
@@ -598,6 +604,7 @@ fn render_tile<const N: usize>(
                     let i = (y * w + xs + k as u32) as usize;
                     if !l.is_finite() {
                         nonfinite += 1;
+                        first_nonfinite = first_nonfinite.or(Some((x0 + xs + k as u32, y0 + y, s)));
                         continue;
                     }
                     let c = xyz_of_sample(&l, &wls[k]);
@@ -624,6 +631,7 @@ fn render_tile<const N: usize>(
         splats,
         counters,
         nonfinite,
+        first_nonfinite,
     }
 }
 

@@ -262,3 +262,77 @@ fn converge_reports_error_falling_with_samples() {
     // about 8 (less, as the reference's own noise adds in); require at least 3.
     assert!(e1 > 3.0 * e64, "1 spp error {e1}, 64 spp error {e64}");
 }
+
+/// A point light of intensity 3e38 a millimetre above a sphere: the irradiance I/r²
+/// overflows f32, so some samples are infinite.
+const OVERFLOW: &str = r#"
+[camera]
+eye = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+resolution = [32, 24]
+[materials.white]
+type = "lambertian"
+rho_d = 0.8
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "white"
+[[lights]]
+type = "point"
+position = [0.0, 0.0, 1.001]
+intensity = 3.0e38
+"#;
+
+#[test]
+fn check_finite_reports_the_count_and_first_location() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = d.path().join("overflow.toml");
+    std::fs::write(&scene, OVERFLOW).unwrap();
+    let out = d.path().join("o.exr");
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(&["--spp", "2", "--quiet", "--no-png"]);
+        a.extend_from_slice(extra);
+        heron(&a)
+    };
+    let report = |o: &Output| {
+        String::from_utf8_lossy(&o.stderr)
+            .lines()
+            .find(|l| l.starts_with("non-finite: "))
+            .map(str::to_string)
+    };
+    // Without the flag: reported, status 0. With it: the image is still written and
+    // the status is 3. The first location is the same whatever the thread count.
+    let plain = run(&["--threads", "1"]);
+    assert!(plain.status.success());
+    let msg = report(&plain).expect("a non-finite report");
+    assert!(
+        msg.ends_with("left out of the image; the first at pixel (15, 11), sample 0"),
+        "{msg}"
+    );
+    std::fs::remove_file(&out).unwrap();
+    let checked = run(&["--threads", "2", "--check-finite"]);
+    assert_eq!(checked.status.code(), Some(3));
+    assert_eq!(report(&checked).as_deref(), Some(msg.as_str()));
+    assert!(out.exists());
+    // A scene without overflow passes the check silently.
+    let fine = heron(&[
+        "render",
+        &repo("scenes/default.toml"),
+        "-o",
+        out.to_str().unwrap(),
+        "--spp",
+        "1",
+        "--quiet",
+        "--no-png",
+        "--check-finite",
+    ]);
+    assert!(fine.status.success());
+    assert_eq!(report(&fine), None);
+}
