@@ -384,6 +384,19 @@ fn valid_ray(r: &RayQuery) -> bool {
         && r.tfar >= r.tnear
 }
 
+/// The hit of a single-ray record after a query, or None if it missed.
+#[inline]
+fn hit_of(rh: &sys::RTCRayHit) -> Option<Hit> {
+    (rh.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID).then(|| Hit {
+        t: rh.ray.tfar,
+        geom_id: rh.hit.geomID,
+        prim_id: rh.hit.primID,
+        ng: Vec3::new(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z),
+        u: rh.hit.u,
+        v: rh.hit.v,
+    })
+}
+
 #[inline]
 fn to_rtc_ray(r: &RayQuery) -> sys::RTCRay {
     sys::RTCRay {
@@ -519,14 +532,7 @@ impl Scene {
         // SAFETY: `self.raw` is a committed scene that nothing modifies (see the Send/Sync
         // impls); `rh` is a valid, aligned, exclusive ray/hit record.
         unsafe { sys::intersect1(self.raw, &mut rh, coherence == RayCoherence::Coherent) };
-        (rh.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID).then(|| Hit {
-            t: rh.ray.tfar,
-            geom_id: rh.hit.geomID,
-            prim_id: rh.hit.primID,
-            ng: Vec3::new(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z),
-            u: rh.hit.u,
-            v: rh.hit.v,
-        })
+        hit_of(&rh)
     }
 
     /// Whether anything lies along `ray` within `[tnear, tfar]` (`rtcOccluded1(3)`,
@@ -601,14 +607,7 @@ impl Scene {
             return false;
         }
         for (h, rh) in hits.iter_mut().zip(records.iter()) {
-            *h = (rh.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID).then(|| Hit {
-                t: rh.ray.tfar,
-                geom_id: rh.hit.geomID,
-                prim_id: rh.hit.primID,
-                ng: Vec3::new(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z),
-                u: rh.hit.u,
-                v: rh.hit.v,
-            });
+            *h = hit_of(rh);
         }
         true
     }
