@@ -32,7 +32,7 @@
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
 use super::lighttrace::pixel_of;
 use super::{query, Context, TraceCounters};
-use crate::accel::embree::{Hit, RayQuery};
+use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::film::Splats;
 use crate::geometry::{Interaction, Ray};
@@ -508,23 +508,9 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         g
     }
 
+    /// The seed's shadow ray between two vertices ([`super::occluded`]).
     fn blocked(&self, x: Vec3, w: Vec3, dist: f32, counters: &mut TraceCounters) -> bool {
-        let eps = self.scene().settings.epsilon;
-        let t_max = if dist.is_finite() {
-            dist - eps
-        } else {
-            f32::INFINITY
-        };
-        if t_max <= eps {
-            return true;
-        }
-        counters.shadow_rays += 1;
-        self.ctx.accel.occluded1(&RayQuery {
-            origin: x,
-            dir: w,
-            tnear: eps,
-            tfar: t_max,
-        })
+        super::occluded(self.ctx, x, w, dist, counters)
     }
 
     /// The power-heuristic weight of strategy (s, t); `sampled` replaces the
