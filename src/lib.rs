@@ -24,6 +24,7 @@ pub mod sampler;
 pub mod scene;
 pub mod sky;
 pub mod spectrum;
+pub mod stress;
 pub mod trace;
 
 pub use error::{HeronError, Result};

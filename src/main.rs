@@ -40,6 +40,11 @@ enum Command {
         /// An EXR written by heron render.
         exr: PathBuf,
     },
+    /// Random rays at the numerical edge cases of a scene's materials (grazing incidence,
+    /// the edge of total internal reflection) and shapes (grazing hits, continuations
+    /// leaving them); counts non-finite values, non-unit directions, self-intersections
+    /// and light leaks, and exits with status 3 if there is any.
+    Stress(StressArgs),
     /// Rainbow skies: radiance profiles of the sky models (heron::sky).
     #[command(subcommand)]
     Sky(SkyCommand),
@@ -50,6 +55,28 @@ enum Command {
         /// Scene file (TOML).
         scene: PathBuf,
     },
+}
+
+#[derive(clap::Args)]
+struct StressArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Rays per case (each material in each incidence regime, each shape).
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    rays: u64,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: one per core). The counts do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
+    /// The ray offsets of a render by this integrator (whitted, path, lighttrace, bdpt);
+    /// default: the scene's.
+    #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
+    integrator: Option<String>,
+    /// auto, epsilon or robust (as render --offset); default: the scene's render.offset.
+    #[arg(long, value_parser = ["auto", "epsilon", "robust"])]
+    offset: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -334,6 +361,12 @@ struct RenderArgs {
     /// render.max_depth).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_depth: Option<u32>,
+    /// How rays leave surfaces: epsilon (the seed's fixed ε, the scene's render.epsilon),
+    /// robust (offset by the hit point's floating-point error bound, pbrt-v4 §6.8.6) or
+    /// auto (epsilon for whitted, robust for path, lighttrace and bdpt); default: the
+    /// scene's render.offset, else auto.
+    #[arg(long, value_parser = ["auto", "epsilon", "robust"])]
+    offset: Option<String>,
     /// Write the film's state to FILE (atomically) during the render, so that a killed
     /// render can continue with --resume FILE.
     #[arg(long, value_name = "FILE")]
@@ -419,6 +452,7 @@ fn main() {
         }
         Command::Color(args) => cmd_color(args),
         Command::Info { exr } => cmd_info(&exr),
+        Command::Stress(args) => cmd_stress(args),
         Command::Sky(c) => cmd_sky(c),
         Command::Spectra { scene } => load_scene(&scene)
             .map_err(Into::into)
@@ -457,6 +491,10 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(&args.scene)?;
     if let Some(d) = args.max_depth {
         scene.settings.max_depth = d;
+    }
+    if let Some(o) = &args.offset {
+        scene.settings.offset =
+            heron::scene::OffsetMode::parse(o).map_err(|e| anyhow::anyhow!("--offset: {e}"))?;
     }
     let mut opts = RenderOptions::from_scene(&scene);
     if let Some(i) = &args.integrator {
@@ -726,6 +764,44 @@ fn cmd_info(path: &Path) -> Result<()> {
     for (k, v) in attrs {
         // Multi-line values (the input files) are indented under their key.
         println!("{k}: {}", v.replace('\n', "\n  "));
+    }
+    Ok(())
+}
+
+fn cmd_stress(args: StressArgs) -> Result<()> {
+    let mut scene = load_scene(&args.scene)?;
+    let kind = match &args.integrator {
+        Some(i) => heron::integrator::IntegratorKind::parse(i)
+            .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?,
+        None => scene.settings.integrator,
+    };
+    if let Some(o) = &args.offset {
+        scene.settings.offset =
+            heron::scene::OffsetMode::parse(o).map_err(|e| anyhow::anyhow!("--offset: {e}"))?;
+    }
+    let offset = scene.settings.ray_offset(kind);
+    let device = heron::accel::embree::Device::new("")?;
+    let accel = heron::render::build_accel(&scene, &device)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.map_or(0, usize::from))
+        .build()?;
+    let start = std::time::Instant::now();
+    let reports = pool.install(|| heron::stress::run(&scene, &accel, offset, args.rays, args.seed));
+    let failures: u64 = reports.iter().map(|r| r.failures()).sum();
+    let rays: u64 = reports.iter().map(|r| r.rays).sum();
+    print!("{}", heron::stress::format_table(&reports));
+    println!(
+        "{}: {} cases, {rays} rays, offsets {}, {failures} failures in {:.1} s",
+        display(&args.scene),
+        reports.len(),
+        match offset {
+            heron::geometry::RayOffset::Epsilon(e) => format!("epsilon {e}"),
+            heron::geometry::RayOffset::Robust => "robust".into(),
+        },
+        start.elapsed().as_secs_f64()
+    );
+    if failures > 0 {
+        std::process::exit(3);
     }
     Ok(())
 }

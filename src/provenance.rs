@@ -5,9 +5,10 @@
 //! name and the SHA-256 of its text, the SHA-256 of every other file it read (meshes,
 //! index and n, k tables), and the render settings that change the pixels: integrator,
 //! sampler, samples per pixel reached, seed, lanes, wavelength sampler, maximum depth,
-//! camera packets and spectral bins. Nothing that differs between identical runs (no
+//! ray offsets, camera packets and spectral bins. Nothing that differs between identical runs (no
 //! date, no wall time, no thread count, no absolute path) is recorded, so identical
 //! renders stay byte-identical.
+use crate::geometry::RayOffset;
 use crate::render::RenderOptions;
 use crate::scene::Scene;
 use crate::spectrum::WavelengthSampler;
@@ -78,6 +79,13 @@ impl Provenance {
             ("lanes", opts.lanes.to_string()),
             ("wavelengths", wavelengths.to_string()),
             ("maxDepth", scene.settings.max_depth.to_string()),
+            (
+                "offset",
+                match scene.settings.ray_offset(opts.integrator) {
+                    RayOffset::Epsilon(eps) => format!("epsilon {eps}"),
+                    RayOffset::Robust => "robust".into(),
+                },
+            ),
             ("packets", opts.packets.to_string()),
             ("spectralBins", opts.spectral_bins.to_string()),
         ])

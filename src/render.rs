@@ -216,8 +216,12 @@ fn render_with(
     pool: &rayon::ThreadPool,
     opts: &RenderOptions,
 ) -> Result<(Film, RenderStats)> {
-    let ctx = Context { scene, accel };
     let kind = opts.integrator;
+    let ctx = Context {
+        scene,
+        accel,
+        offset: scene.settings.ray_offset(kind),
+    };
     // The kernel is decided here, once per render, from what the scene uses.
     let k = Features::of(scene)
         .choose(kind, opts.kernel)
@@ -658,6 +662,7 @@ mod tests {
         let ctx = Context {
             scene: &scene,
             accel: &accel,
+            offset: scene.settings.ray_offset(IntegratorKind::Whitted),
         };
         fn splat_one(
             _: &Context,

@@ -95,7 +95,8 @@ pub fn trace(
             "--lambda: expected a wavelength in 360–830 nm, got {lambda_nm}"
         )));
     }
-    let eps = scene.settings.epsilon;
+    // Offsets as a render of the scene's own integrator would make them.
+    let offset = scene.settings.ray_offset(scene.settings.integrator);
     let mut ray = Ray::new(origin, dir.normalize(), 0.0, f32::INFINITY);
     let mut events = Vec::new();
     let mut dielectric_events = 0usize;
@@ -127,7 +128,15 @@ pub fn trace(
         };
         let shape = &scene.shapes[hit.geom_id as usize];
         let material = &scene.materials[shape.material as usize];
-        let it = Interaction::new(&ray, &hit, shape, material, depth, lambda_nm);
+        let it = Interaction::new(
+            &ray,
+            &hit,
+            shape,
+            material,
+            depth,
+            lambda_nm,
+            offset.is_robust(),
+        );
         let wo = -ray.dir;
         let mut ev = TraceEvent {
             kind: EventKind::Absorb,
@@ -194,7 +203,7 @@ pub fn trace(
                 truncated: false,
             });
         };
-        ray = Ray::new(it.position, d, eps, f32::INFINITY);
+        ray = offset.spawn(&it.spawn_point(), d);
     }
     Ok(TraceReport {
         lambda_nm,

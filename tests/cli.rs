@@ -120,7 +120,10 @@ fn bad_scenes_give_clear_errors_and_no_files() {
         &["render", scene.to_str().unwrap(), "-o", out],
         &["nowhere.obj"],
     );
-    let far = SMALL.replacen("center = [0.0, 0.5, 0.0]", "center = [0.0, 3e18, 0.0]", 1);
+    // Beyond Embree's reach (a sphere big enough to be representable there).
+    let far = SMALL
+        .replacen("center = [0.0, 0.5, 0.0]", "center = [0.0, 3e18, 0.0]", 1)
+        .replacen("radius = 0.3", "radius = 1e13", 1);
     let scene = write_scene(d.path(), "far.toml", &far);
     assert_bad(
         d.path(),

@@ -84,6 +84,7 @@ fn render_records_what_made_the_image_and_info_prints_it() {
         "integrator: path".into(),
         "lanes: 4".into(),
         "maxDepth: 5".into(),
+        "offset: robust".into(),
         "packets: true".into(),
         "sampler: independent".into(),
         "scene: cornell.toml".into(),

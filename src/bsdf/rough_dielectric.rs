@@ -135,6 +135,9 @@ impl RoughDielectric {
         ctx: &BsdfContext,
     ) -> SampledSpectrum<N> {
         let eta = self.interface.eta(wl.lambda[0]);
+        if eta == 1.0 {
+            return SampledSpectrum::zero();
+        }
         let Some((wm, etap, is_reflection)) = half(wo, wi, eta) else {
             return SampledSpectrum::zero();
         };
@@ -163,6 +166,9 @@ impl RoughDielectric {
         ctx: &BsdfContext,
     ) -> f32 {
         let eta = self.interface.eta(wl.lambda[0]);
+        if eta == 1.0 {
+            return 0.0;
+        }
         let Some((wm, etap, is_reflection)) = half(wo, wi, eta) else {
             return 0.0;
         };
@@ -190,6 +196,12 @@ impl RoughDielectric {
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
         let eta = self.interface.eta(wl.lambda[0]);
+        if eta == 1.0 {
+            // Equal indices are no interface, however rough: light passes straight
+            // through, a delta (pbrt-v4 `DielectricBxDF` does the same). The microfacet
+            // lobe would divide by the zero half vector ωo + ωi (found by heron stress).
+            return self.interface.sample(wo, uc, wl, ctx);
+        }
         let d = &self.distribution;
         let wm = d.sample_wm(wo, u);
         let cos_om = wo.dot(wm);

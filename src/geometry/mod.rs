@@ -2,9 +2,11 @@
 //! surface interaction record (the lecture's HitInfo).
 pub mod interaction;
 pub mod ray;
+pub mod spawn;
 
 pub use interaction::Interaction;
 pub use ray::Ray;
+pub use spawn::{RayOffset, SpawnPoint};
 
 use glam::Vec3;
 

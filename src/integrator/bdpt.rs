@@ -35,7 +35,7 @@ use super::{query, Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::film::Splats;
-use crate::geometry::{Interaction, Ray};
+use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::Light;
 use crate::math::Frame;
 use crate::sampler::Sampler;
@@ -61,6 +61,8 @@ struct Vertex<const N: usize> {
     kind: Kind,
     beta: SampledSpectrum<N>,
     p: Vec3,
+    /// Floating-point error bound of `p` (surfaces and area lights; zero otherwise).
+    err: Vec3,
     /// Outward geometric normal (surfaces, area lights, portals; zero for points).
     n: Vec3,
     /// Unit direction toward the previous vertex of its own subpath (surfaces).
@@ -84,6 +86,7 @@ impl<const N: usize> Vertex<N> {
         kind: Kind::Surface,
         beta: SampledSpectrum::zero(),
         p: Vec3::ZERO,
+        err: Vec3::ZERO,
         n: Vec3::ZERO,
         wo: Vec3::ZERO,
         frame: Frame {
@@ -102,6 +105,15 @@ impl<const N: usize> Vertex<N> {
 
     fn on_surface(&self) -> bool {
         self.n != Vec3::ZERO
+    }
+
+    /// Where rays to and from this vertex start and end ([`SpawnPoint`]).
+    fn spawn_point(&self) -> SpawnPoint {
+        SpawnPoint {
+            p: self.p,
+            err: self.err,
+            n: self.n,
+        }
     }
 
     fn is_light(&self) -> bool {
@@ -299,7 +311,6 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             return 0;
         }
         let scene = self.scene();
-        let eps = scene.settings.epsilon;
         let mut pdf_fwd = pdf;
         let mut ended = path[0].ended;
         let mut bounces = 0usize;
@@ -338,11 +349,13 @@ impl<'a, const N: usize> Bdpt<'a, N> {
                 material,
                 bounces as u32,
                 self.wl.lambda[0],
+                self.ctx.offset.is_robust(),
             );
             let mut v = Vertex::EMPTY;
             v.kind = Kind::Surface;
             v.beta = beta;
             v.p = it.position;
+            v.err = it.p_err;
             v.n = it.n_outward;
             v.wo = -ray.dir;
             v.frame = it.frame();
@@ -378,7 +391,10 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if beta.is_zero() {
                 break;
             }
-            ray = Ray::new(v.p, v.frame.to_world(bs.wi), eps, f32::INFINITY);
+            ray = self
+                .ctx
+                .offset
+                .spawn(&v.spawn_point(), v.frame.to_world(bs.wi));
         }
         bounces
     }
@@ -410,6 +426,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         v.kind = Kind::Light;
         v.light = li as u32;
         v.p = le.origin;
+        v.err = le.origin_err;
         v.n = if light.is_infinite() {
             Vec3::ZERO
         } else {
@@ -421,12 +438,10 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         v.delta = light.is_delta();
         path[0] = v;
         let beta = le.l * (cos / (pmf * le.pdf_pos * le.pdf_dir));
-        let t_min = if matches!(light, Light::Area(_)) {
-            scene.settings.epsilon
-        } else {
-            0.0
+        let ray = match light {
+            Light::Area(_) => self.ctx.offset.spawn(&v.spawn_point(), le.dir),
+            _ => Ray::new(le.origin, le.dir, 0.0, f32::INFINITY),
         };
-        let ray = Ray::new(le.origin, le.dir, t_min, f32::INFINITY);
         let n = self.random_walk(
             ray,
             None,
@@ -502,15 +517,22 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         if b.on_surface() {
             g *= b.n.dot(w).abs();
         }
-        if g == 0.0 || self.blocked(a.p, w, d, counters) {
+        if g == 0.0 || self.blocked(&a.spawn_point(), w, d, &b.spawn_point(), counters) {
             return 0.0;
         }
         g
     }
 
-    /// The seed's shadow ray between two vertices ([`super::occluded`]).
-    fn blocked(&self, x: Vec3, w: Vec3, dist: f32, counters: &mut TraceCounters) -> bool {
-        super::occluded(self.ctx, x, w, dist, counters)
+    /// The shadow ray between two vertices ([`super::occluded`]).
+    fn blocked(
+        &self,
+        from: &SpawnPoint,
+        w: Vec3,
+        dist: f32,
+        to: &SpawnPoint,
+        counters: &mut TraceCounters,
+    ) -> bool {
+        super::occluded(self.ctx, from, w, dist, to, counters)
     }
 
     /// The power-heuristic weight of strategy (s, t); `sampled` replaces the
@@ -660,7 +682,8 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if qs.on_surface() {
                 c *= qs.n.dot(cs.wi).abs();
             }
-            if c.is_zero() || self.blocked(qs.p, cs.wi, cs.dist, counters) {
+            let eye = SpawnPoint::free(cam.eye);
+            if c.is_zero() || self.blocked(&qs.spawn_point(), cs.wi, cs.dist, &eye, counters) {
                 return zero;
             }
             sampled = Some(cv);
@@ -702,7 +725,9 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if pt.on_surface() {
                 c *= pt.n.dot(ls.wi).abs();
             }
-            if c.is_zero() || self.blocked(pt.p, ls.wi, ls.dist, counters) {
+            if c.is_zero()
+                || self.blocked(&pt.spawn_point(), ls.wi, ls.dist, &ls.target(), counters)
+            {
                 return zero;
             }
             sampled = Some(lv);

@@ -22,7 +22,7 @@
 use super::{occluded, query, Context, TraceCounters};
 use crate::bsdf::{BsdfContext, TransportMode};
 use crate::film::Splats;
-use crate::geometry::{Interaction, Ray};
+use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::Light;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -47,7 +47,6 @@ pub fn radiance<const N: usize>(
     let scene = ctx.scene;
     let cam = &scene.camera;
     let settings = &scene.settings;
-    let eps = settings.epsilon;
     let u_light = sampler.get_1d();
     let u_pos = sampler.get_2d();
     let u_dir = sampler.get_2d();
@@ -63,12 +62,23 @@ pub fn radiance<const N: usize>(
         return zero;
     }
     let cos_l = le.normal.map_or(1.0, |n| n.dot(le.dir).abs());
+    // Rays leave a light's surface as they leave any surface; other lights' origins are
+    // in free space.
+    let light_point = match (light, le.normal) {
+        (Light::Area(_), Some(n)) => SpawnPoint {
+            p: le.origin,
+            err: le.origin_err,
+            n,
+        },
+        _ => SpawnPoint::free(le.origin),
+    };
+    let eye = SpawnPoint::free(cam.eye);
 
     // An emitting surface seen by the camera: the light's own vertex.
     if let (Light::Area(a), Some(n)) = (light, le.normal) {
         if let Some(cs) = cam.sample_wi(le.origin) {
             let emitted = a.l(n, cs.wi, wl);
-            if !emitted.is_zero() && !occluded(ctx, le.origin, cs.wi, cs.dist, counters) {
+            if !emitted.is_zero() && !occluded(ctx, &light_point, cs.wi, cs.dist, &eye, counters) {
                 let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
                 splats.add(pixel_of(cam, cs.raster), &(emitted * k), wl);
             }
@@ -76,12 +86,15 @@ pub fn radiance<const N: usize>(
     }
 
     let mut beta = le.l * (cos_l / (pmf * le.pdf_pos * le.pdf_dir));
-    let t_min = if matches!(light, Light::Area(_)) {
-        eps
-    } else {
-        0.0
+    // The light path's throughput carries the light's flux, whose size depends on the
+    // scene's units (an area light's flux scales with its area); the roulette compares
+    // the throughput with where it started, so that a scene scaled by 1e-4 is not
+    // cut short (tests/stability.rs).
+    let beta_start = beta.max_value();
+    let mut ray = match light {
+        Light::Area(_) => ctx.offset.spawn(&light_point, le.dir),
+        _ => Ray::new(le.origin, le.dir, 0.0, f32::INFINITY),
     };
-    let mut ray = Ray::new(le.origin, le.dir, t_min, f32::INFINITY);
     let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(TransportMode::Importance);
     let mut depth = 0u32;
     loop {
@@ -91,7 +104,15 @@ pub fn radiance<const N: usize>(
         };
         let shape = &scene.shapes[hit.geom_id as usize];
         let material = &scene.materials[shape.material as usize];
-        let it = Interaction::new(&ray, &hit, shape, material, depth, wl.lambda[0]);
+        let it = Interaction::new(
+            &ray,
+            &hit,
+            shape,
+            material,
+            depth,
+            wl.lambda[0],
+            ctx.offset.is_robust(),
+        );
         // The path has scattered `depth` times before this vertex; scattering here
         // toward the camera is one more.
         if depth == settings.max_depth {
@@ -108,7 +129,8 @@ pub fn radiance<const N: usize>(
             if let Some(cs) = cam.sample_wi(it.position) {
                 let wi = frame.to_local(cs.wi);
                 let f = material.eval(wo, wi, wl, &bsdf_ctx);
-                if !f.is_zero() && !occluded(ctx, it.position, cs.wi, cs.dist, counters) {
+                if !f.is_zero() && !occluded(ctx, &it.spawn_point(), cs.wi, cs.dist, &eye, counters)
+                {
                     let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
                     splats.add(pixel_of(cam, cs.raster), &c, wl);
                 }
@@ -127,9 +149,9 @@ pub fn radiance<const N: usize>(
         if beta.is_zero() {
             break;
         }
-        ray = Ray::new(it.position, frame.to_world(bs.wi), eps, f32::INFINITY);
-        // Russian roulette on the importance throughput.
-        let rr = beta.max_value();
+        ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
+        // Russian roulette on the importance throughput, relative to the light's.
+        let rr = beta.max_value() / beta_start;
         if rr < 1.0 && depth >= settings.rr_depth {
             let q = (1.0 - rr).max(0.0);
             if u_rr < q {

@@ -18,7 +18,7 @@ pub mod whitted;
 
 use crate::accel::embree::{self, Hit, RayQuery};
 use crate::film::Splats;
-use crate::geometry::Ray;
+use crate::geometry::{Ray, RayOffset, SpawnPoint};
 use crate::sampler::Sampler;
 use crate::scene::features::{KernelFlags, ALL, SPECULAR};
 use crate::scene::Scene;
@@ -81,6 +81,8 @@ impl IntegratorKind {
 pub struct Context<'a> {
     pub scene: &'a Scene,
     pub accel: &'a embree::Scene,
+    /// How rays leave surfaces in this render.
+    pub offset: RayOffset,
 }
 
 /// Counters one worker keeps while tracing (summed per tile, never shared).
@@ -190,31 +192,22 @@ pub(crate) fn query(ray: &Ray) -> RayQuery {
     }
 }
 
-/// Whether a shadow ray from `x` toward unit `wi` is blocked before `dist` (the seed:
-/// t_min = ε, t_max = dist − ε; no cutoff for lights at infinity). A light closer than
-/// 2ε counts as blocked.
+/// Whether the shadow ray from `from` toward `to`, which lies along unit `wi` at
+/// distance `dist` (infinite: a light at infinity), is blocked, with the cutoffs of the
+/// render's [`RayOffset`] (the seed's: t_min = ε, t_max = dist − ε). Points too close to
+/// tell apart count as blocked.
 #[inline]
 pub(crate) fn occluded(
     ctx: &Context,
-    x: glam::Vec3,
+    from: &SpawnPoint,
     wi: glam::Vec3,
     dist: f32,
+    to: &SpawnPoint,
     counters: &mut TraceCounters,
 ) -> bool {
-    let eps = ctx.scene.settings.epsilon;
-    let t_max = if dist.is_finite() {
-        dist - eps
-    } else {
-        f32::INFINITY
-    };
-    if t_max <= eps {
+    let Some(q) = ctx.offset.shadow(from, wi, dist, to) else {
         return true;
-    }
+    };
     counters.shadow_rays += 1;
-    ctx.accel.occluded1(&RayQuery {
-        origin: x,
-        dir: wi,
-        tnear: eps,
-        tfar: t_max,
-    })
+    ctx.accel.occluded1(&q)
 }

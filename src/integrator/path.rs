@@ -46,7 +46,6 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
 ) -> SampledSpectrum<N> {
     let scene = ctx.scene;
     let settings = &scene.settings;
-    let eps = settings.epsilon;
     let mut l = SampledSpectrum::<N>::zero();
     let mut beta = SampledSpectrum::<N>::splat(1.0);
     let mut bsdf_ctx = BsdfContext::radiance::<N>();
@@ -87,7 +86,15 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         };
         let shape = &scene.shapes[hit.geom_id as usize];
         let material = &scene.materials[shape.material as usize];
-        let it = Interaction::new(&ray, &hit, shape, material, depth, wl.lambda[0]);
+        let it = Interaction::new(
+            &ray,
+            &hit,
+            shape,
+            material,
+            depth,
+            wl.lambda[0],
+            ctx.offset.is_robust(),
+        );
         let wo = -ray.dir;
 
         // Emission of an area light the path has reached.
@@ -138,7 +145,16 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
                     let wi_local = frame.to_local(ls.wi);
                     if ls.pdf > 0.0 && !ls.l.is_zero() {
                         let f = material.eval(wo_local, wi_local, wl, &bsdf_ctx) * wi_local.z.abs();
-                        if !f.is_zero() && !occluded(ctx, it.position, ls.wi, ls.dist, counters) {
+                        if !f.is_zero()
+                            && !occluded(
+                                ctx,
+                                &it.spawn_point(),
+                                ls.wi,
+                                ls.dist,
+                                &ls.target(),
+                                counters,
+                            )
+                        {
                             let p_l = pmf * ls.pdf;
                             let w = if ls.delta {
                                 1.0
@@ -169,7 +185,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         if bs.is_transmission() {
             eta_scale *= bs.eta * bs.eta;
         }
-        ray = Ray::new(it.position, frame.to_world(bs.wi), eps, f32::INFINITY);
+        ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
         if beta.is_zero() {
             break;
         }

@@ -48,7 +48,6 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
     let scene = ctx.scene;
-    let eps = scene.settings.epsilon;
     let mut beta = SampledSpectrum::<N>::splat(1.0);
     let mut l = SampledSpectrum::<N>::zero();
     let mut pending = first_hit;
@@ -70,7 +69,15 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         };
         let shape = &scene.shapes[hit.geom_id as usize];
         let material = &scene.materials[shape.material as usize];
-        let mut it = Interaction::new(&ray, &hit, shape, material, depth, wl.lambda[0]);
+        let mut it = Interaction::new(
+            &ray,
+            &hit,
+            shape,
+            material,
+            depth,
+            wl.lambda[0],
+            ctx.offset.is_robust(),
+        );
         let wo = -ray.dir;
         if on(K, EMITTERS) {
             let emitter = scene.shape_light[hit.geom_id as usize];
@@ -110,7 +117,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         if depth > scene.settings.max_depth {
             break;
         }
-        ray = Ray::new(it.position, frame.to_world(bs.wi), eps, f32::INFINITY);
+        ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
     }
     l
 }
@@ -128,6 +135,7 @@ fn direct_lighting<const N: usize>(
     mut visit: impl FnMut(Vec3, SampledSpectrum<N>),
 ) {
     let x = it.position;
+    let from = it.spawn_point();
     let n = it.normal;
     for light in &ctx.scene.lights {
         if matches!(light, Light::Environment(_)) {
@@ -145,7 +153,7 @@ fn direct_lighting<const N: usize>(
         if cos <= 0.0 || !(ls.pdf > 0.0) {
             continue;
         }
-        if !occluded(ctx, x, ls.wi, ls.dist, counters) {
+        if !occluded(ctx, &from, ls.wi, ls.dist, &ls.target(), counters) {
             visit(ls.wi, ls.l * (cos / ls.pdf));
         }
     }

@@ -11,6 +11,7 @@
 //!   (Heitz 2019's low-distortion map); the area density 1/A becomes a solid-angle
 //!   density by d²/|cos θ_light|.
 use super::{LightLeSample, LightLiSample};
+use crate::geometry::spawn;
 use crate::math::warp::{cosine_hemisphere, uniform_sphere, uniform_triangle};
 use crate::math::{Distribution1D, Frame};
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
@@ -101,22 +102,22 @@ impl AreaLight {
         wl.eval(&self.emission)
     }
 
-    /// A point uniform over the surface, its outward normal, and the area density.
+    /// A point uniform over the surface, its outward normal, and the point's
+    /// floating-point error bound.
     #[inline]
-    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3) {
+    fn sample_area(&self, u: Vec2) -> (Vec3, Vec3, Vec3) {
         match &self.geometry {
             AreaShape::Sphere { center, radius } => {
                 let n = uniform_sphere(u);
-                (*center + *radius * n, n)
+                let (p, err) = spawn::sphere_point(*center, *radius, n);
+                (p, n, err)
             }
             AreaShape::Triangles { triangles, by_area } => {
                 let (i, _, t) = by_area.sample_discrete(u.x);
                 let [a, b, c] = triangles[i];
                 let bc = uniform_triangle(Vec2::new(t, u.y));
-                (
-                    bc[0] * a + bc[1] * b + bc[2] * c,
-                    (b - a).cross(c - a).normalize(),
-                )
+                let (p, err) = spawn::triangle_point(a, b, c, bc[1], bc[2]);
+                (p, (b - a).cross(c - a).normalize(), err)
             }
         }
     }
@@ -128,22 +129,23 @@ impl AreaLight {
         u: Vec2,
         wl: &SampledWavelengths<N>,
     ) -> Option<LightLiSample<N>> {
-        let (ps, n, pdf) = match &self.geometry {
+        let (ps, n, pdf, p_err) = match &self.geometry {
             AreaShape::Sphere { center, radius }
                 if (p - *center).length_squared() > radius * radius =>
             {
-                let (ps, n, pdf) = sample_sphere_cone(*center, *radius, p, u);
-                (ps, n, pdf)
+                let (_, n, pdf) = sample_sphere_cone(*center, *radius, p, u);
+                let (ps, err) = spawn::sphere_point(*center, *radius, n);
+                (ps, n, pdf, err)
             }
             _ => {
-                let (ps, n) = self.sample_area(u);
+                let (ps, n, err) = self.sample_area(u);
                 let to = ps - p;
                 let d2 = to.length_squared();
                 let cos_l = n.dot(-to).abs() / d2.sqrt();
                 if !(d2 > 0.0) || cos_l == 0.0 {
                     return None;
                 }
-                (ps, n, d2 / (cos_l * self.area))
+                (ps, n, d2 / (cos_l * self.area), err)
             }
         };
         let to = ps - p;
@@ -163,6 +165,8 @@ impl AreaLight {
             dist: d,
             delta: false,
             n,
+            p: ps,
+            p_err,
         })
     }
 
@@ -200,7 +204,7 @@ impl AreaLight {
         u2: Vec2,
         wl: &SampledWavelengths<N>,
     ) -> Option<LightLeSample<N>> {
-        let (p, n) = self.sample_area(u1);
+        let (p, n, origin_err) = self.sample_area(u1);
         let (mut u2, mut side) = (u2, 1.0);
         if self.two_sided {
             // The first half of u2.x emits from the front, the second from the back.
@@ -219,6 +223,7 @@ impl AreaLight {
         }
         Some(LightLeSample {
             origin: p,
+            origin_err,
             dir,
             l: self.l(n, dir, wl),
             pdf_pos: 1.0 / self.area,

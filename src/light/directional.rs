@@ -22,6 +22,8 @@ impl DirectionalLight {
             dist: f32::INFINITY,
             delta: true,
             n: Vec3::ZERO,
+            p: Vec3::ZERO,
+            p_err: Vec3::ZERO,
         }
     }
 
@@ -37,6 +39,7 @@ impl DirectionalLight {
         let (origin, pdf_pos) = bounds.disk_point(-self.direction, u);
         LightLeSample {
             origin,
+            origin_err: Vec3::ZERO,
             dir: self.direction,
             l: wl.eval(&self.radiance),
             pdf_pos,

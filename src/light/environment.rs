@@ -199,6 +199,8 @@ impl EnvironmentLight {
             dist: f32::INFINITY,
             delta: false,
             n: Vec3::ZERO,
+            p: Vec3::ZERO,
+            p_err: Vec3::ZERO,
         })
     }
 
@@ -227,6 +229,7 @@ impl EnvironmentLight {
         let (origin, pdf_pos) = bounds.disk_point(w, u2);
         Some(LightLeSample {
             origin,
+            origin_err: Vec3::ZERO,
             dir: -w,
             l: self.le(w, wl),
             pdf_pos,

@@ -28,6 +28,7 @@ pub use sampler::LightSampler;
 pub use spot::SpotLight;
 pub use sun::{Portal, SunLight};
 
+use crate::geometry::SpawnPoint;
 use crate::math::warp::concentric_disk;
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -48,12 +49,30 @@ pub struct LightLiSample<const N: usize> {
     pub delta: bool,
     /// The light's outward normal at the sampled point (area lights; zero otherwise).
     pub n: Vec3,
+    /// The sampled point (lights at infinity: unused) and its floating-point error
+    /// bound (zero but for area lights), for robust shadow rays.
+    pub p: Vec3,
+    pub p_err: Vec3,
+}
+
+impl<const N: usize> LightLiSample<N> {
+    /// The sampled point as the far end of a shadow ray.
+    #[inline]
+    pub fn target(&self) -> SpawnPoint {
+        SpawnPoint {
+            p: self.p,
+            err: self.p_err,
+            n: self.n,
+        }
+    }
 }
 
 /// A ray leaving a light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightLeSample<const N: usize> {
     pub origin: Vec3,
+    /// Floating-point error bound of `origin` (area lights; zero otherwise).
+    pub origin_err: Vec3,
     /// Unit direction of travel.
     pub dir: Vec3,
     /// Emitted radiance (point and spot lights: intensity) per lane.

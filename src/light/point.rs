@@ -33,6 +33,8 @@ impl PointLight {
             dist: d,
             delta: true,
             n: Vec3::ZERO,
+            p: self.position,
+            p_err: Vec3::ZERO,
         })
     }
 
@@ -45,6 +47,7 @@ impl PointLight {
     ) -> LightLeSample<N> {
         LightLeSample {
             origin: self.position,
+            origin_err: Vec3::ZERO,
             dir: uniform_sphere(u),
             l: wl.eval(&self.intensity),
             pdf_pos: 1.0,

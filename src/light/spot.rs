@@ -62,6 +62,8 @@ impl SpotLight {
             dist: d,
             delta: true,
             n: Vec3::ZERO,
+            p: self.position,
+            p_err: Vec3::ZERO,
         })
     }
 
@@ -80,6 +82,7 @@ impl SpotLight {
         }
         Some(LightLeSample {
             origin: self.position,
+            origin_err: Vec3::ZERO,
             dir,
             l: wl.eval(&self.intensity) * k,
             pdf_pos: 1.0,

@@ -130,6 +130,8 @@ impl SunLight {
             dist: f32::INFINITY,
             delta: false,
             n: Vec3::ZERO,
+            p: Vec3::ZERO,
+            p_err: Vec3::ZERO,
         }
     }
 
@@ -163,6 +165,7 @@ impl SunLight {
         };
         LightLeSample {
             origin,
+            origin_err: Vec3::ZERO,
             dir: -w,
             l: wl.eval(&self.radiance),
             pdf_pos,

@@ -26,7 +26,8 @@
 //! [render]                          # optional, defaults from RenderSettings::default()
 //! spp = 16
 //! max_depth = 10
-//! epsilon = 1e-4
+//! epsilon = 1e-4                   # the seed's ray offset, where offsets are epsilon
+//! offset = "auto"                   # auto | epsilon | robust (auto: epsilon for whitted)
 //! seed = 0
 //!
 //! [materials.floor]
@@ -138,6 +139,10 @@ pub struct RenderFile {
     /// How the path integrator picks a light: power (default) or uniform.
     #[serde(default)]
     pub light_sampler: Option<String>,
+    /// How rays leave surfaces: auto (default: epsilon for whitted, robust otherwise),
+    /// epsilon or robust.
+    #[serde(default)]
+    pub offset: Option<String>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.

@@ -45,6 +45,9 @@ use std::path::{Path, PathBuf};
 
 /// Reads, parses and validates the scene file at `path` (meshes are resolved relative to
 /// it). Every error names the file, the key path and what was expected.
+/// The smallest sphere radius accepted, relative to the centre's largest coordinate.
+pub const MIN_RELATIVE_RADIUS: f32 = 1e-6;
+
 pub fn load_scene(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| scene_error(path, format!("cannot read the scene file: {e}")))?;
@@ -479,13 +482,26 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     for (i, s) in file.shapes.iter().enumerate() {
         let at = format!("shapes[{i}]");
         match s {
-            ShapeFile::Sphere(sp) => shapes.push(Shape {
-                kind: ShapeKind::Sphere {
-                    center: sp.center.0,
-                    radius: sp.radius.0,
-                },
-                material: resolve(&at, s)?,
-            }),
+            ShapeFile::Sphere(sp) => {
+                // Below this a sphere spans a handful of f32 steps at its centre, less
+                // than the error bound of its hit points (geometry::spawn): rays would
+                // pass through it (heron stress finds leaks from 2e-7 down).
+                let reach = sp.center.0.abs().max_element();
+                if sp.radius.0 < MIN_RELATIVE_RADIUS * reach {
+                    return Err(err(format!(
+                        "{at}.radius: expected at least {MIN_RELATIVE_RADIUS:e} × the centre's largest coordinate ({reach}), i.e. {:e}, got {}: a smaller sphere is below float precision where it is",
+                        MIN_RELATIVE_RADIUS * reach,
+                        sp.radius.0
+                    )));
+                }
+                shapes.push(Shape {
+                    kind: ShapeKind::Sphere {
+                        center: sp.center.0,
+                        radius: sp.radius.0,
+                    },
+                    material: resolve(&at, s)?,
+                })
+            }
             ShapeFile::Triangle(t) => {
                 let material = resolve(&at, s)?;
                 let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
@@ -669,6 +685,10 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
         }
         if let Some(x) = r.rr_depth {
             settings.rr_depth = x;
+        }
+        if let Some(name) = &r.offset {
+            settings.offset =
+                super::OffsetMode::parse(name).map_err(|e| err(format!("render.offset: {e}")))?;
         }
         if let Some(name) = &r.light_sampler {
             settings.light_sampler = match name.as_str() {

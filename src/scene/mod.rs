@@ -10,7 +10,7 @@ pub use load::load_scene;
 
 use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::geometry::Shape;
+use crate::geometry::{RayOffset, Shape};
 use crate::integrator::IntegratorKind;
 use crate::light::sampler::LightSamplerKind;
 use crate::light::{Light, LightSampler, SceneBounds};
@@ -24,7 +24,7 @@ pub struct RenderSettings {
     pub spp: u32,
     /// Maximum path depth (the lecture's `depth` limit on continued rays).
     pub max_depth: u32,
-    /// Ray offset ε for rays leaving surfaces (seed: 1e-4).
+    /// Ray offset ε for rays leaving surfaces (seed: 1e-4), where offsets are ε.
     pub epsilon: f32,
     pub seed: u64,
     /// The scene's integrator (the CLI may override it).
@@ -32,6 +32,46 @@ pub struct RenderSettings {
     /// Path depth from which Russian roulette may end a path (path integrator).
     pub rr_depth: u32,
     pub light_sampler: LightSamplerKind,
+    /// How rays leave surfaces ([`OffsetMode`]).
+    pub offset: OffsetMode,
+}
+
+/// The `offset` setting: which [`RayOffset`] a render uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OffsetMode {
+    /// The seed's ε for the `whitted` integrator, robust offsets for the physically
+    /// based ones.
+    #[default]
+    Auto,
+    Epsilon,
+    Robust,
+}
+
+impl OffsetMode {
+    pub const NAMES: &'static [&'static str] = &["auto", "epsilon", "robust"];
+
+    pub fn parse(name: &str) -> Result<OffsetMode, String> {
+        match name {
+            "auto" => Ok(OffsetMode::Auto),
+            "epsilon" => Ok(OffsetMode::Epsilon),
+            "robust" => Ok(OffsetMode::Robust),
+            other => Err(format!("expected auto, epsilon or robust, got {other:?}")),
+        }
+    }
+}
+
+impl RenderSettings {
+    /// The ray offsets of a render by `integrator`: `offset`, with `auto` resolved by
+    /// the integrator.
+    #[inline]
+    pub fn ray_offset(&self, integrator: IntegratorKind) -> RayOffset {
+        match (self.offset, integrator) {
+            (OffsetMode::Epsilon, _) | (OffsetMode::Auto, IntegratorKind::Whitted) => {
+                RayOffset::Epsilon(self.epsilon)
+            }
+            _ => RayOffset::Robust,
+        }
+    }
 }
 
 impl Default for RenderSettings {
@@ -44,6 +84,7 @@ impl Default for RenderSettings {
             integrator: IntegratorKind::Whitted,
             rr_depth: 5,
             light_sampler: LightSamplerKind::Power,
+            offset: OffsetMode::Auto,
         }
     }
 }

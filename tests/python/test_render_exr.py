@@ -218,6 +218,7 @@ def test_exr_carries_provenance_readable_by_openexr(render, tmp_path):
         "heron.lanes": "4",
         "heron.wavelengths": "visible",
         "heron.maxDepth": got.get("heron.maxDepth"),
+        "heron.offset": "epsilon 0.0001",
         "heron.packets": "true",
         "heron.spectralBins": "0",
     }, got
