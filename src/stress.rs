@@ -335,17 +335,23 @@ fn shape_point(shape: &Shape, rng: &mut Rng) -> (Vec3, Vec3, f32) {
     }
 }
 
-/// One shape case: `rays` rays traced at and from shape `index` of `scene`.
+/// Whether each shape of the scene is closed ([`closed`]), computed once per scene.
+pub fn closed_shapes(scene: &Scene) -> Vec<bool> {
+    scene.shapes.iter().map(closed).collect()
+}
+
+/// One shape case: `rays` rays traced at and from shape `index` of `scene`; `closed` is
+/// [`closed_shapes`] of the scene.
 pub fn shape_case(
     scene: &Scene,
     accel: &embree::Scene,
     offset: RayOffset,
+    closed: &[bool],
     index: usize,
     rays: u64,
     seed: u64,
 ) -> CaseReport {
     let shape = &scene.shapes[index];
-    let closed: Vec<bool> = scene.shapes.iter().map(closed).collect();
     let is_closed = closed[index];
     let kind = match &shape.kind {
         ShapeKind::Sphere { radius, .. } => format!("sphere r = {radius:e}"),
@@ -364,7 +370,7 @@ pub fn shape_case(
         embree::set_flush_denormals();
         let budget = r.rays + n;
         while r.rays < budget {
-            shape_sample(scene, accel, offset, index, &closed, rng, r, &label);
+            shape_sample(scene, accel, offset, index, closed, rng, r, &label);
         }
     })
 }
@@ -568,8 +574,9 @@ pub fn run(
             ));
         }
     }
+    let closed = closed_shapes(scene);
     for i in 0..scene.shapes.len() {
-        out.push(shape_case(scene, accel, offset, i, rays, seed));
+        out.push(shape_case(scene, accel, offset, &closed, i, rays, seed));
     }
     out
 }

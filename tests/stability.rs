@@ -299,8 +299,9 @@ fn shape_cases(scene: &Scene, offset: RayOffset, seed: u64) -> Vec<CaseReport> {
     let device = embree::Device::new("").unwrap();
     let accel = build_accel(scene, &device).unwrap();
     let each = RAYS.div_ceil(scene.shapes.len() as u64);
+    let closed = stress::closed_shapes(scene);
     (0..scene.shapes.len())
-        .map(|i| stress::shape_case(scene, &accel, offset, i, each, seed))
+        .map(|i| stress::shape_case(scene, &accel, offset, &closed, i, each, seed))
         .collect()
 }
 
@@ -562,8 +563,9 @@ fn the_seeds_epsilon_self_intersects_and_leaks_on_the_same_shapes() {
     for scene in [slabs(dir.path()), spheres(dir.path())] {
         let device = embree::Device::new("").unwrap();
         let accel = build_accel(&scene, &device).unwrap();
+        let closed = stress::closed_shapes(&scene);
         for i in 0..scene.shapes.len() {
-            let r = stress::shape_case(&scene, &accel, eps, i, 200_000, 24);
+            let r = stress::shape_case(&scene, &accel, eps, &closed, i, 200_000, 24);
             found.0 += r.self_hits;
             found.1 += r.leaks;
         }
