@@ -75,7 +75,7 @@ struct StressArgs {
     #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
     integrator: Option<String>,
     /// auto, epsilon or robust (as render --offset); default: the scene's render.offset.
-    #[arg(long, value_parser = ["auto", "epsilon", "robust"])]
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::scene::OffsetMode::NAMES))]
     offset: Option<String>,
 }
 
@@ -365,7 +365,7 @@ struct RenderArgs {
     /// robust (offset by the hit point's floating-point error bound, pbrt-v4 §6.8.6) or
     /// auto (epsilon for whitted, robust for path, lighttrace and bdpt); default: the
     /// scene's render.offset, else auto.
-    #[arg(long, value_parser = ["auto", "epsilon", "robust"])]
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::scene::OffsetMode::NAMES))]
     offset: Option<String>,
     /// Write the film's state to FILE (atomically) during the render, so that a killed
     /// render can continue with --resume FILE.
@@ -492,10 +492,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if let Some(d) = args.max_depth {
         scene.settings.max_depth = d;
     }
-    if let Some(o) = &args.offset {
-        scene.settings.offset =
-            heron::scene::OffsetMode::parse(o).map_err(|e| anyhow::anyhow!("--offset: {e}"))?;
-    }
+    apply_offset(&mut scene, &args.offset)?;
     let mut opts = RenderOptions::from_scene(&scene);
     if let Some(i) = &args.integrator {
         opts.integrator = heron::integrator::IntegratorKind::parse(i)
@@ -775,10 +772,7 @@ fn cmd_stress(args: StressArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?,
         None => scene.settings.integrator,
     };
-    if let Some(o) = &args.offset {
-        scene.settings.offset =
-            heron::scene::OffsetMode::parse(o).map_err(|e| anyhow::anyhow!("--offset: {e}"))?;
-    }
+    apply_offset(&mut scene, &args.offset)?;
     let offset = scene.settings.ray_offset(kind);
     let device = heron::accel::embree::Device::new("")?;
     let accel = heron::render::build_accel(&scene, &device)?;
@@ -791,17 +785,28 @@ fn cmd_stress(args: StressArgs) -> Result<()> {
     let rays: u64 = reports.iter().map(|r| r.rays).sum();
     print!("{}", heron::stress::format_table(&reports));
     println!(
-        "{}: {} cases, {rays} rays, offsets {}, {failures} failures in {:.1} s",
+        "{}: {} cases, {rays} rays, offsets {offset}, {failures} failures in {:.1} s",
         display(&args.scene),
         reports.len(),
-        match offset {
-            heron::geometry::RayOffset::Epsilon(e) => format!("epsilon {e}"),
-            heron::geometry::RayOffset::Robust => "robust".into(),
-        },
         start.elapsed().as_secs_f64()
     );
+    if failures > 0 && !offset.is_robust() {
+        println!(
+            "note: these are the seed's fixed ε offsets (the default of the whitted \
+             integrator); --offset robust checks the offsets of path, lighttrace and bdpt"
+        );
+    }
     if failures > 0 {
         std::process::exit(3);
+    }
+    Ok(())
+}
+
+/// Applies `--offset NAME` (when given) to the scene's settings.
+fn apply_offset(scene: &mut heron::scene::Scene, flag: &Option<String>) -> Result<()> {
+    if let Some(o) = flag {
+        scene.settings.offset =
+            heron::scene::OffsetMode::parse(o).map_err(|e| anyhow::anyhow!("--offset: {e}"))?;
     }
     Ok(())
 }

@@ -8,7 +8,6 @@
 //! ray offsets, camera packets and spectral bins. Nothing that differs between identical runs (no
 //! date, no wall time, no thread count, no absolute path) is recorded, so identical
 //! renders stay byte-identical.
-use crate::geometry::RayOffset;
 use crate::render::RenderOptions;
 use crate::scene::Scene;
 use crate::spectrum::WavelengthSampler;
@@ -81,10 +80,7 @@ impl Provenance {
             ("maxDepth", scene.settings.max_depth.to_string()),
             (
                 "offset",
-                match scene.settings.ray_offset(opts.integrator) {
-                    RayOffset::Epsilon(eps) => format!("epsilon {eps}"),
-                    RayOffset::Robust => "robust".into(),
-                },
+                scene.settings.ray_offset(opts.integrator).to_string(),
             ),
             ("packets", opts.packets.to_string()),
             ("spectralBins", opts.spectral_bins.to_string()),

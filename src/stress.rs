@@ -17,16 +17,19 @@
 //!   must be finite, and three rays leave it with the render's [`RayOffset`]: the
 //!   material's own sample, a grazing one back to the side the ray came from and one to
 //!   the other side. Each is traced and classified:
-//!   - a **self-hit** when it hits what it left: the same triangle, a coincident copy, any
-//!     surface within a few error bounds of where it left (away from edges), the same
-//!     sphere from outside, or the same sphere entering it from inside;
+//!   - a **self-hit** when it meets what it left: the same triangle, a coincident copy,
+//!     a surface in the same plane within a few error bounds (away from edges), the same
+//!     sphere after leaving it outward, a sphere it entered met from outside, a closed
+//!     mesh it left outward met from inside;
 //!   - a **leak** when it left into a closed shape (a sphere, or a mesh whose every edge
-//!     has two triangles) and escaped the scene without hitting anything.
+//!     has two triangles) and escaped the scene, or left a sphere inward and met
+//!     something outside it.
 //!
 //! Counts are deterministic for a seed: the rays are drawn in chunks of [`CHUNK`] from
 //! per-chunk random streams, whatever the thread count.
 use crate::accel::embree::{self, Hit};
 use crate::bsdf::{BsdfContext, Material, TransportMode};
+use crate::geometry::interaction::unit_normal;
 use crate::geometry::{Interaction, Ray, RayOffset, Shape, ShapeKind};
 use crate::math::warp::{cosine_hemisphere, uniform_sphere, uniform_triangle};
 use crate::math::{Frame, Rng};
@@ -131,6 +134,8 @@ fn chunked(
     let parts: Vec<CaseReport> = (0..chunks)
         .into_par_iter()
         .map(|c| {
+            // The renderer's float mode (flush-to-zero), whichever worker runs the chunk.
+            embree::set_flush_denormals();
             let mut rng = Rng::new(seed ^ stream.wrapping_mul(0x9e37_79b9_7f4a_7c15), c);
             let n = CHUNK.min(rays - c * CHUNK);
             let mut r = CaseReport::default();
@@ -232,7 +237,8 @@ pub fn material_case(
                 let (uc, u) = (rng.uniform(), u2(rng));
                 let at = || format!("{name}: wo {wo:?}, λ {} nm, {mode:?}", wl.lambda[0]);
                 if let Some(bs) = m.sample(wo, uc, u, &wl, &ctx) {
-                    if !bs.wi.is_finite() || !finite(&bs.f) || !(bs.pdf >= 0.0) {
+                    if !(bs.wi.is_finite() && finite(&bs.f) && bs.pdf >= 0.0 && bs.pdf.is_finite())
+                    {
                         r.fail(Failure::NonFinite, || {
                             format!(
                                 "{}: sample wi {:?} f {:?} pdf {}",
@@ -301,21 +307,6 @@ pub fn closed(shape: &Shape) -> bool {
     }
 }
 
-/// The triangle `prim` of a mesh shape.
-fn triangle(shape: &Shape, prim: u32) -> Option<[Vec3; 3]> {
-    match &shape.kind {
-        ShapeKind::Mesh(m) => {
-            let [a, b, c] = m.indices[prim as usize];
-            Some([
-                m.positions[a as usize],
-                m.positions[b as usize],
-                m.positions[c as usize],
-            ])
-        }
-        ShapeKind::Sphere { .. } => None,
-    }
-}
-
 /// A point of the shape (spheres uniformly, meshes by triangle then uniformly within
 /// it), its outward unit normal, and a length of the order of the shape's size.
 fn shape_point(shape: &Shape, rng: &mut Rng) -> (Vec3, Vec3, f32) {
@@ -326,11 +317,11 @@ fn shape_point(shape: &Shape, rng: &mut Rng) -> (Vec3, Vec3, f32) {
         }
         ShapeKind::Mesh(m) => {
             let i = ((rng.uniform() * m.indices.len() as f32) as usize).min(m.indices.len() - 1);
-            let [a, b, c] = triangle(shape, i as u32).unwrap();
+            let [a, b, c] = m.triangle(i as u32);
             let bc = uniform_triangle(u2(rng));
             let p = bc[0] * a + bc[1] * b + bc[2] * c;
             let size = (b - a).length().max((c - a).length()).max((c - b).length());
-            (p, unit_normal([a, b, c]), size)
+            (p, unit_normal((b - a).cross(c - a), Vec3::Z), size)
         }
     }
 }
@@ -367,7 +358,6 @@ pub fn shape_case(
     );
     let label = name.clone();
     chunked(name, rays, seed, 1 << 32 | index as u64, |rng, n, r| {
-        embree::set_flush_denormals();
         let budget = r.rays + n;
         while r.rays < budget {
             shape_sample(scene, accel, offset, index, closed, rng, r, &label);
@@ -407,25 +397,22 @@ fn shape_sample(
     let Some(hit) = accel.intersect1(&crate::integrator::query(&ray)) else {
         return;
     };
-    let hit_shape = &scene.shapes[hit.geom_id as usize];
-    let material = &scene.materials[hit_shape.material as usize];
     let wl = SampledWavelengths::<LANES>::sample(WavelengthSampler::Visible, rng.uniform());
-    let it = Interaction::new(
-        &ray,
-        &hit,
-        hit_shape,
-        material,
-        0,
-        wl.lambda[0],
-        offset.is_robust(),
-    );
+    let (it, material) = scene.interaction(&ray, &hit, 0, wl.lambda[0], offset.is_robust());
+    // The classification's tolerances come from the hit point's error bound whichever
+    // offsets the rays use (with ε offsets the render leaves it zero).
+    let err = if offset.is_robust() {
+        it.p_err
+    } else {
+        scene.interaction(&ray, &hit, 0, wl.lambda[0], true).0.p_err
+    };
     let at = |what: &str| {
         format!(
             "{label}: ray {origin:?} → {dir:?} hit shape {} prim {} at {:?}: {what}",
             hit.geom_id, hit.prim_id, it.position
         )
     };
-    if !it.position.is_finite() || !it.p_err.is_finite() || !it.n_outward.is_finite() {
+    if !it.position.is_finite() || !err.is_finite() || !it.n_outward.is_finite() {
         r.fail(Failure::NonFinite, || at("non-finite interaction"));
         return;
     }
@@ -434,6 +421,13 @@ fn shape_sample(
             at(&format!("normal {:?} not unit", it.n_outward))
         });
     }
+    let left = Left {
+        scene,
+        hit: &hit,
+        it: &it,
+        err,
+        closed: closed[hit.geom_id as usize],
+    };
     let frame = it.frame();
     let wo = frame.to_local(-ray.dir);
     let ctx = BsdfContext::radiance::<LANES>();
@@ -468,74 +462,98 @@ fn shape_sample(
         }
         r.rays += 1;
         let next = accel.intersect1(&crate::integrator::query(&out));
-        let into = w.dot(it.n_outward) < 0.0;
-        match next {
-            None => {
-                let edge = triangle(hit_shape, hit.prim_id)
-                    .is_some_and(|t| near_edge(&it, t, 4.0 * it.p_err.max_element()));
-                if into && closed[hit.geom_id as usize] && !edge {
-                    r.fail(Failure::Leak, || {
-                        at(&format!(
-                            "{what} ray {w:?} left into the closed shape and escaped"
-                        ))
-                    });
-                }
-            }
-            Some(h2) => {
-                if self_hit(scene, &it, &hit, &h2, &out, into) {
-                    r.fail(Failure::SelfHit, || {
-                        at(&format!(
-                            "{what} ray {w:?} from {:?} hit shape {} prim {} at t = {:e}",
-                            out.origin, h2.geom_id, h2.prim_id, h2.t
-                        ))
-                    });
-                }
-            }
+        if let Some(kind) = left.classify(&out, next.as_ref()) {
+            r.fail(kind, || {
+                let met = next.map_or("nothing".to_string(), |h2| {
+                    format!("shape {} prim {} at t = {:e}", h2.geom_id, h2.prim_id, h2.t)
+                });
+                at(&format!("{what} ray {w:?} from {:?} met {met}", out.origin))
+            });
         }
     }
 }
 
-/// Whether `h2`, hit by the ray `out` that left `it` (the hit `h1`), is the surface it
-/// left:
-/// - spheres: the same sphere from outside, or entered from inside;
-/// - triangles: the same triangle, a coincident copy (the same three vertices, in any
-///   shape), or a triangle facing the same way in the same plane, met within a few error
-///   bounds of the origin (acne) away from the edges of the triangle left (where a
-///   neighbour in the plane, coplanar only to rounding, may be as close).
-///
-/// Not counted: a surface crossing the one left (a box standing on or sunk into a floor)
-/// met at the crease, and a nearly coplanar neighbour met further away (a quad's two
-/// halves, two walls in one plane given to six digits, are coplanar only to rounding,
-/// and a ray at cos θ = 10⁻⁷ can meet them legitimately).
-fn self_hit(scene: &Scene, it: &Interaction, h1: &Hit, h2: &Hit, out: &Ray, into: bool) -> bool {
-    let s1 = &scene.shapes[h1.geom_id as usize];
-    let s2 = &scene.shapes[h2.geom_id as usize];
-    if let (ShapeKind::Sphere { .. }, true) = (&s1.kind, h1.geom_id == h2.geom_id) {
-        // Leaving outward, a sphere cannot be met again; leaving inward, only its far
-        // side, from inside.
-        return !into || out.dir.dot(h2.ng) < 0.0;
-    }
-    let (Some(t1), Some(t2)) = (triangle(s1, h1.prim_id), triangle(s2, h2.prim_id)) else {
-        return false;
-    };
-    if h1.geom_id == h2.geom_id && h1.prim_id == h2.prim_id {
-        return true;
-    }
-    if t2.iter().all(|v| t1.contains(v)) {
-        return true;
-    }
-    let n2 = unit_normal(t2);
-    let reach = 16.0 * it.p_err.max_element();
-    n2.dot(it.n_outward) > 1.0 - 1e-4
-        && n2.dot(t2[0] - it.position).abs() <= reach
-        && (out.at(h2.t) - it.position).length() <= reach
-        && !near_edge(it, t1, reach)
+/// A surface point rays left, for classifying where they went.
+struct Left<'a> {
+    scene: &'a Scene,
+    hit: &'a Hit,
+    it: &'a Interaction,
+    /// The hit point's error bound.
+    err: Vec3,
+    /// Whether the shape left encloses a volume.
+    closed: bool,
 }
 
-/// A triangle's unit normal, safe for slivers.
-fn unit_normal(t: [Vec3; 3]) -> Vec3 {
-    let n = (t[1] - t[0]).cross(t[2] - t[0]);
-    (n / n.abs().max_element()).normalize()
+impl Left<'_> {
+    /// The failure, if any, of the ray `out` that left this point and met `next`:
+    ///
+    /// - **self-hit**: it met the surface it left: the same triangle, a coincident copy
+    ///   (the same three vertices, in any shape), a triangle facing the same way in the
+    ///   same plane within a few error bounds of the origin (acne; away from the edges
+    ///   of the triangle left, where a neighbour in the plane, coplanar only to rounding,
+    ///   may be as close), the same sphere after leaving it outward, or the same closed
+    ///   shape from the side it should not be on (entering a sphere it left inward;
+    ///   meeting a closed mesh from inside after leaving it outward: the origin was
+    ///   inside);
+    /// - **leak**: it left into a closed shape and got out without meeting the shape
+    ///   from inside: it escaped the scene, or (for a sphere) met something outside it.
+    ///   Hits within the error bound of an edge are exempt: there a ray may pass on
+    ///   either side of the neighbouring face.
+    ///
+    /// Not counted: a surface crossing the one left (a box standing on or sunk into a
+    /// floor) met at the crease, a nearly coplanar neighbour met further away (a quad's
+    /// two halves, two walls in one plane given to six digits, meet at cos θ = 10⁻⁷
+    /// legitimately), and, for a closed mesh left inward, another shape met first (it may
+    /// be inside the mesh: heron cannot tell without a point-in-mesh test).
+    fn classify(&self, out: &Ray, next: Option<&Hit>) -> Option<Failure> {
+        let (scene, h1, it) = (self.scene, self.hit, self.it);
+        let s1 = &scene.shapes[h1.geom_id as usize];
+        let into = out.dir.dot(it.n_outward) < 0.0;
+        let t1 = match &s1.kind {
+            ShapeKind::Mesh(m) => Some(m.triangle(h1.prim_id)),
+            ShapeKind::Sphere { .. } => None,
+        };
+        let edge = t1.is_some_and(|t| near_edge(it, t, 4.0 * self.err.max_element()));
+        let Some(h2) = next else {
+            return (into && self.closed && !edge).then_some(Failure::Leak);
+        };
+        let same = h1.geom_id == h2.geom_id;
+        // Leaving outward, through the shape's outside; inward, from its inside.
+        let from_inside = out.dir.dot(h2.ng) > 0.0;
+        if let ShapeKind::Sphere { center, radius } = &s1.kind {
+            return if same {
+                (!into || !from_inside).then_some(Failure::SelfHit)
+            } else if into {
+                // Something met first must be inside the sphere.
+                let x = out.at(h2.t);
+                let inside = (x - *center).length() <= *radius + 4.0 * self.err.max_element();
+                (!inside).then_some(Failure::Leak)
+            } else {
+                None
+            };
+        }
+        let t1 = t1?;
+        if same && self.closed && !into && from_inside && !edge {
+            return Some(Failure::SelfHit);
+        }
+        let ShapeKind::Mesh(m2) = &scene.shapes[h2.geom_id as usize].kind else {
+            return None;
+        };
+        if same && h1.prim_id == h2.prim_id {
+            return Some(Failure::SelfHit);
+        }
+        let t2 = m2.triangle(h2.prim_id);
+        if t2.iter().all(|v| t1.contains(v)) {
+            return Some(Failure::SelfHit);
+        }
+        let n2 = unit_normal((t2[1] - t2[0]).cross(t2[2] - t2[0]), Vec3::ZERO);
+        let reach = 16.0 * self.err.max_element();
+        let acne = n2.dot(it.n_outward) > 1.0 - 1e-4
+            && n2.dot(t2[0] - it.position).abs() <= reach
+            && (out.at(h2.t) - it.position).length() <= reach
+            && !near_edge(it, t1, reach);
+        acne.then_some(Failure::SelfHit)
+    }
 }
 
 /// Whether the hit lies within `tol` of an edge of its triangle, where a ray may pass

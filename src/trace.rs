@@ -9,7 +9,7 @@
 //! others (Lambertian, glossy, rough) absorb; a miss escapes.
 use crate::accel::embree::{self, RayQuery};
 use crate::bsdf::{BsdfContext, LobeFlags};
-use crate::geometry::{Interaction, Ray};
+use crate::geometry::Ray;
 use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
 use crate::{HeronError, Result};
@@ -126,23 +126,13 @@ pub fn trace(
                 truncated: false,
             });
         };
-        let shape = &scene.shapes[hit.geom_id as usize];
-        let material = &scene.materials[shape.material as usize];
-        let it = Interaction::new(
-            &ray,
-            &hit,
-            shape,
-            material,
-            depth,
-            lambda_nm,
-            offset.is_robust(),
-        );
+        let (it, material) = scene.interaction(&ray, &hit, depth, lambda_nm, offset.is_robust());
         let wo = -ray.dir;
         let mut ev = TraceEvent {
             kind: EventKind::Absorb,
             position: arr(it.position),
             normal: Some(arr(it.normal)),
-            material: Some(scene.material_names[shape.material as usize].clone()),
+            material: Some(scene.material_names[it.material as usize].clone()),
             n_i: Some(1.0),
             n_t: Some(1.0),
             incoming: arr(ray.dir),

@@ -4,12 +4,13 @@
 //!   gold sphere, a block standing on the floor, an area light) rendered at scales 1e-4,
 //!   1e-2, 1, 1e2 and 1e4 and, at scale 1, moved 10³ away from the origin, under every
 //!   integrator with robust ray offsets. Every image must match the scale-1 image of the
-//!   same seed to within the noise of the reference (the RMSE between two seeds, /√2),
-//!   and its mean to within 3 standard errors: acne darkens, leaks brighten, either
+//!   same seed to within half the noise of the reference (the RMSE between two seeds,
+//!   /√2), and its mean to within 3 standard errors: acne darkens, leaks brighten, either
 //!   shifts the mean. The seed's fixed ε at scale 1e-4 must fail the same check (so the
 //!   check can fail).
 //! * **Edge cases** through `heron::stress` (the code behind `heron stress`): at least
-//!   10⁷ rays per case, zero non-finite values (directions, BSDF values, pdfs,
+//!   10⁷ rays per case, spread over the case's materials or shapes (a shape's rays are
+//!   those aimed at it and the three that leave each hit), zero non-finite values (directions, BSDF values, pdfs,
 //!   throughput weights, interactions), every direction unit length to 1e-5, zero
 //!   self-intersections and zero leaks: grazing incidence down to cos θ = 1e-7, the
 //!   total-internal-reflection edge (|cos²θt| ≤ 1e-7), indices 1.0–4.0, roughness 0–1,
@@ -191,10 +192,9 @@ fn compare(img: &[f32], reference: &[f32], other_seed: &[f32]) -> (f64, f64) {
 
 #[test]
 fn scaled_and_moved_scenes_render_the_same_under_every_integrator() {
-    let cases: [(f32, Vec3); 6] = [
+    let cases: [(f32, Vec3); 5] = [
         (1e-4, Vec3::ZERO),
         (1e-2, Vec3::ZERO),
-        (1.0, Vec3::ZERO),
         (1e2, Vec3::ZERO),
         (1e4, Vec3::ZERO),
         (1.0, Vec3::splat(1e3)),
@@ -224,7 +224,7 @@ fn scaled_and_moved_scenes_render_the_same_under_every_integrator() {
             );
             worst = worst.max(r);
             assert!(
-                r < 1.0 && m < 3.0,
+                r < 0.5 && m < 3.0,
                 "{}, scale {s:e}, moved {o}: RMSE {r:.3} × the reference's noise, mean {m:.2} SE away\n{report}",
                 kind.name()
             );
@@ -245,7 +245,7 @@ fn the_seeds_fixed_epsilon_fails_the_same_check_at_scale_1e_4() {
     let (r, m) = compare(&image(&tiny, kind, 1), &reference, &other);
     // The negation of the check the robust offsets pass.
     assert!(
-        !(r < 1.0 && m < 3.0),
+        !(r < 0.5 && m < 3.0),
         "ε = 1e-4 in a box 2e-4 wide should fail: RMSE {r:.2} × noise, mean {m:.2} SE"
     );
 }
@@ -294,11 +294,11 @@ fn material_cases(scene: &Scene, regimes: &[Incidence], seed: u64) -> Vec<CaseRe
     out
 }
 
-/// Runs every shape case of `scene` with `offset`, dividing `RAYS` among the shapes.
-fn shape_cases(scene: &Scene, offset: RayOffset, seed: u64) -> Vec<CaseReport> {
+/// Runs every shape case of `scene` with `offset`, dividing `rays` among the shapes.
+fn shape_cases(scene: &Scene, offset: RayOffset, rays: u64, seed: u64) -> Vec<CaseReport> {
     let device = embree::Device::new("").unwrap();
     let accel = build_accel(scene, &device).unwrap();
-    let each = RAYS.div_ceil(scene.shapes.len() as u64);
+    let each = rays.div_ceil(scene.shapes.len() as u64);
     let closed = stress::closed_shapes(scene);
     (0..scene.shapes.len())
         .map(|i| stress::shape_case(scene, &accel, offset, &closed, i, each, seed))
@@ -491,7 +491,9 @@ fn spheres(dir: &Path) -> Scene {
         (Vec3::ZERO, 1e-6f32, "glass"),
         (Vec3::new(0.0, 0.0, 1e-3), 2e-9, "rough"),
         (Vec3::new(1e3, 0.0, 0.0), 1e-3, "glass"),
-        (Vec3::new(0.0, -1e6, 0.0), 1e6, "rough"),
+        // Below the others, not through them: a ground-like sphere whose surface
+        // crossed the tiny ones would hide their leaks.
+        (Vec3::new(0.0, -1e6 - 10.0, 0.0), 1e6, "rough"),
         (Vec3::splat(1e4), 1e4, "glass"),
         (Vec3::new(-3.0, 0.0, 0.0), 1e-4, "white"),
     ] {
@@ -531,7 +533,7 @@ fn thin_slabs() {
     let dir = tempfile::tempdir().unwrap();
     assert_clean(
         "thin slabs",
-        &shape_cases(&slabs(dir.path()), RayOffset::Robust, 21),
+        &shape_cases(&slabs(dir.path()), RayOffset::Robust, RAYS, 21),
     );
 }
 
@@ -540,7 +542,7 @@ fn tiny_and_huge_spheres() {
     let dir = tempfile::tempdir().unwrap();
     assert_clean(
         "tiny and huge spheres",
-        &shape_cases(&spheres(dir.path()), RayOffset::Robust, 22),
+        &shape_cases(&spheres(dir.path()), RayOffset::Robust, RAYS, 22),
     );
 }
 
@@ -549,7 +551,7 @@ fn coincident_and_degenerate_triangles() {
     let dir = tempfile::tempdir().unwrap();
     assert_clean(
         "coincident and degenerate triangles",
-        &shape_cases(&triangles(dir.path()), RayOffset::Robust, 23),
+        &shape_cases(&triangles(dir.path()), RayOffset::Robust, RAYS, 23),
     );
 }
 
@@ -561,11 +563,7 @@ fn the_seeds_epsilon_self_intersects_and_leaks_on_the_same_shapes() {
     let eps = RayOffset::Epsilon(1e-4);
     let mut found = (0, 0);
     for scene in [slabs(dir.path()), spheres(dir.path())] {
-        let device = embree::Device::new("").unwrap();
-        let accel = build_accel(&scene, &device).unwrap();
-        let closed = stress::closed_shapes(&scene);
-        for i in 0..scene.shapes.len() {
-            let r = stress::shape_case(&scene, &accel, eps, &closed, i, 200_000, 24);
+        for r in shape_cases(&scene, eps, 600_000, 24) {
             found.0 += r.self_hits;
             found.1 += r.leaks;
         }

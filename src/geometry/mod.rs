@@ -18,6 +18,19 @@ pub struct Mesh {
     pub indices: Vec<[u32; 3]>,
 }
 
+impl Mesh {
+    /// The vertices of triangle `prim` (Embree's primID).
+    #[inline]
+    pub fn triangle(&self, prim: u32) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[prim as usize];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+}
+
 #[derive(Clone, Debug)]
 pub enum ShapeKind {
     Sphere { center: Vec3, radius: f32 },

@@ -35,7 +35,7 @@ use super::{query, Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::film::Splats;
-use crate::geometry::{Interaction, Ray, SpawnPoint};
+use crate::geometry::{Ray, SpawnPoint};
 use crate::light::Light;
 use crate::math::Frame;
 use crate::sampler::Sampler;
@@ -340,13 +340,9 @@ impl<'a, const N: usize> Bdpt<'a, N> {
                 }
                 break;
             };
-            let shape = &scene.shapes[hit.geom_id as usize];
-            let material = &scene.materials[shape.material as usize];
-            let it = Interaction::new(
+            let (it, material) = scene.interaction(
                 &ray,
                 &hit,
-                shape,
-                material,
                 bounces as u32,
                 self.wl.lambda[0],
                 self.ctx.offset.is_robust(),
@@ -359,7 +355,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             v.n = it.n_outward;
             v.wo = -ray.dir;
             v.frame = it.frame();
-            v.material = shape.material;
+            v.material = it.material;
             v.light = scene.shape_light[hit.geom_id as usize];
             v.ended = ended;
             v.pdf_fwd = convert_density(pdf_fwd, &path[bounces], &v);
@@ -438,10 +434,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         v.delta = light.is_delta();
         path[0] = v;
         let beta = le.l * (cos / (pmf * le.pdf_pos * le.pdf_dir));
-        let ray = match light {
-            Light::Area(_) => self.ctx.offset.spawn(&v.spawn_point(), le.dir),
-            _ => Ray::new(le.origin, le.dir, 0.0, f32::INFINITY),
-        };
+        let ray = self.ctx.offset.spawn(&le.spawn_point(), le.dir);
         let n = self.random_walk(
             ray,
             None,

@@ -22,7 +22,7 @@
 use super::{occluded, query, Context, TraceCounters};
 use crate::bsdf::{BsdfContext, TransportMode};
 use crate::film::Splats;
-use crate::geometry::{Interaction, Ray, SpawnPoint};
+use crate::geometry::SpawnPoint;
 use crate::light::Light;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -64,14 +64,7 @@ pub fn radiance<const N: usize>(
     let cos_l = le.normal.map_or(1.0, |n| n.dot(le.dir).abs());
     // Rays leave a light's surface as they leave any surface; other lights' origins are
     // in free space.
-    let light_point = match (light, le.normal) {
-        (Light::Area(_), Some(n)) => SpawnPoint {
-            p: le.origin,
-            err: le.origin_err,
-            n,
-        },
-        _ => SpawnPoint::free(le.origin),
-    };
+    let light_point = le.spawn_point();
     let eye = SpawnPoint::free(cam.eye);
 
     // An emitting surface seen by the camera: the light's own vertex.
@@ -91,10 +84,7 @@ pub fn radiance<const N: usize>(
     // the throughput with where it started, so that a scene scaled by 1e-4 is not
     // cut short (tests/stability.rs).
     let beta_start = beta.max_value();
-    let mut ray = match light {
-        Light::Area(_) => ctx.offset.spawn(&light_point, le.dir),
-        _ => Ray::new(le.origin, le.dir, 0.0, f32::INFINITY),
-    };
+    let mut ray = ctx.offset.spawn(&light_point, le.dir);
     let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(TransportMode::Importance);
     let mut depth = 0u32;
     loop {
@@ -102,17 +92,8 @@ pub fn radiance<const N: usize>(
         let Some(hit) = ctx.accel.intersect1(&query(&ray)) else {
             break;
         };
-        let shape = &scene.shapes[hit.geom_id as usize];
-        let material = &scene.materials[shape.material as usize];
-        let it = Interaction::new(
-            &ray,
-            &hit,
-            shape,
-            material,
-            depth,
-            wl.lambda[0],
-            ctx.offset.is_robust(),
-        );
+        let (it, material) =
+            scene.interaction(&ray, &hit, depth, wl.lambda[0], ctx.offset.is_robust());
         // The path has scattered `depth` times before this vertex; scattering here
         // toward the camera is one more.
         if depth == settings.max_depth {

@@ -22,7 +22,7 @@
 use super::{occluded, query, Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::BsdfContext;
-use crate::geometry::{Interaction, Ray};
+use crate::geometry::Ray;
 use crate::light::{Light, SurfacePoint};
 use crate::math::warp::power_heuristic;
 use crate::sampler::Sampler;
@@ -84,17 +84,8 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
             }
             break;
         };
-        let shape = &scene.shapes[hit.geom_id as usize];
-        let material = &scene.materials[shape.material as usize];
-        let it = Interaction::new(
-            &ray,
-            &hit,
-            shape,
-            material,
-            depth,
-            wl.lambda[0],
-            ctx.offset.is_robust(),
-        );
+        let (it, material) =
+            scene.interaction(&ray, &hit, depth, wl.lambda[0], ctx.offset.is_robust());
         let wo = -ray.dir;
 
         // Emission of an area light the path has reached.

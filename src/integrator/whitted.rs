@@ -67,17 +67,8 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
             }
             break;
         };
-        let shape = &scene.shapes[hit.geom_id as usize];
-        let material = &scene.materials[shape.material as usize];
-        let mut it = Interaction::new(
-            &ray,
-            &hit,
-            shape,
-            material,
-            depth,
-            wl.lambda[0],
-            ctx.offset.is_robust(),
-        );
+        let (mut it, material) =
+            scene.interaction(&ray, &hit, depth, wl.lambda[0], ctx.offset.is_robust());
         let wo = -ray.dir;
         if on(K, EMITTERS) {
             let emitter = scene.shape_light[hit.geom_id as usize];

@@ -55,6 +55,23 @@ pub struct LightLiSample<const N: usize> {
     pub p_err: Vec3,
 }
 
+impl<const N: usize> LightLeSample<N> {
+    /// Where the emitted ray starts: on an area light's surface (with its error bound),
+    /// else a point in free space (point and spot lights, the disk of a light at
+    /// infinity, which is no surface of the scene).
+    #[inline]
+    pub fn spawn_point(&self) -> SpawnPoint {
+        match self.normal {
+            Some(n) if self.origin_err != Vec3::ZERO => SpawnPoint {
+                p: self.origin,
+                err: self.origin_err,
+                n,
+            },
+            _ => SpawnPoint::free(self.origin),
+        }
+    }
+}
+
 impl<const N: usize> LightLiSample<N> {
     /// The sampled point as the far end of a shadow ray.
     #[inline]

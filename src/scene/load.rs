@@ -43,11 +43,11 @@ use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Reads, parses and validates the scene file at `path` (meshes are resolved relative to
-/// it). Every error names the file, the key path and what was expected.
 /// The smallest sphere radius accepted, relative to the centre's largest coordinate.
 pub const MIN_RELATIVE_RADIUS: f32 = 1e-6;
 
+/// Reads, parses and validates the scene file at `path` (meshes are resolved relative to
+/// it). Every error names the file, the key path and what was expected.
 pub fn load_scene(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| scene_error(path, format!("cannot read the scene file: {e}")))?;

@@ -8,9 +8,10 @@ pub mod load;
 pub use features::Features;
 pub use load::load_scene;
 
+use crate::accel::embree::Hit;
 use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::geometry::{RayOffset, Shape};
+use crate::geometry::{Interaction, Ray, RayOffset, Shape};
 use crate::integrator::IntegratorKind;
 use crate::light::sampler::LightSamplerKind;
 use crate::light::{Light, LightSampler, SceneBounds};
@@ -55,7 +56,13 @@ impl OffsetMode {
             "auto" => Ok(OffsetMode::Auto),
             "epsilon" => Ok(OffsetMode::Epsilon),
             "robust" => Ok(OffsetMode::Robust),
-            other => Err(format!("expected auto, epsilon or robust, got {other:?}")),
+            other => {
+                let (last, rest) = Self::NAMES.split_last().unwrap();
+                Err(format!(
+                    "expected {} or {last}, got {other:?}",
+                    rest.join(", ")
+                ))
+            }
         }
     }
 }
@@ -190,6 +197,24 @@ impl Scene {
             bounds,
             light_sampler,
         }
+    }
+
+    /// The interaction record of `hit` (of `ray`) and the material there; `lambda` is
+    /// the path's hero wavelength, `robust` whether the render's offsets need the hit
+    /// point's error bound ([`Interaction::new`]).
+    #[inline(always)]
+    pub fn interaction(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        depth: u32,
+        lambda: f32,
+        robust: bool,
+    ) -> (Interaction, &Material) {
+        let shape = &self.shapes[hit.geom_id as usize];
+        let material = &self.materials[shape.material as usize];
+        let it = Interaction::new(ray, hit, shape, material, depth, lambda, robust);
+        (it, material)
     }
 
     /// Radiance arriving along a ray that leaves the scene in direction `dir`: the
