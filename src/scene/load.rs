@@ -55,9 +55,19 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 /// messages and its folder is where relative mesh paths start.
 pub fn load_scene_from_str(text: &str, path: &Path) -> Result<Scene> {
     let file = parse_scene_file(text).map_err(|m| scene_error(path, m))?;
-    let mut scene = build(path, file)?;
+    let mut scene = build(path, file, SkyTables::Build)?;
     scene.source_sha256 = crate::provenance::sha256_hex(text.as_bytes());
     Ok(scene)
+}
+
+/// Whether [`build`] tabulates a `[sky]` model. Tabulating a physical sky takes seconds
+/// (it is the model's evaluation, not the file's reading), so the fuzzing harness
+/// ([`crate::fuzzing`]) checks the `[sky]` table and constructs its model but leaves
+/// `Scene::sky` empty.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SkyTables {
+    Build,
+    Skip,
 }
 
 /// Stages 1 and 2: TOML text to [`SceneFile`]. The error is the one-line message.
@@ -414,7 +424,7 @@ fn friendly(path: &[Seg], msg: &str) -> String {
 // ---------------------------------------------------------------------------------------
 // Stage 3: building the scene
 
-fn build(path: &Path, file: SceneFile) -> Result<Scene> {
+pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Result<Scene> {
     let err = |m: String| scene_error(path, m);
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     // Every file the scene reads besides itself (meshes, tables), for provenance.
@@ -684,9 +694,13 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     }
 
     let sky = match &file.sky {
-        Some(sf) => Some(std::sync::Arc::new(
-            build_sky(sf, &lights, &background).map_err(err)?,
-        )),
+        Some(sf) => {
+            let plan = plan_sky(sf, &lights, &background).map_err(err)?;
+            match sky_tables {
+                SkyTables::Build => Some(std::sync::Arc::new(plan.tabulate())),
+                SkyTables::Skip => None,
+            }
+        }
         None => None,
     };
 
@@ -899,12 +913,35 @@ fn build_material(
     })
 }
 
-/// Builds and tabulates the `[sky]` model with the scene's first sun light.
-fn build_sky(
+/// The `[sky]` model, checked and constructed with the scene's first sun light, before
+/// its (slow) tabulation.
+struct SkyPlan {
+    model: String,
+    sky: crate::sky::Sky,
+    sun_dir: Vec3,
+    factor: DenseSpectrum,
+    replaces_background: bool,
+}
+
+impl SkyPlan {
+    /// Tabulates the model over (θ, λ) for rendering.
+    fn tabulate(self) -> super::SceneSky {
+        super::SceneSky {
+            table: crate::sky::table::SkyTable::build(&self.sky),
+            model: self.model,
+            sun_dir: self.sun_dir,
+            factor: self.factor,
+            replaces_background: self.replaces_background,
+        }
+    }
+}
+
+/// Checks `[sky]` and constructs its model with the scene's first sun light.
+fn plan_sky(
     sf: &super::file::SkyFile,
     lights: &[Light],
     background: &DenseSpectrum,
-) -> std::result::Result<super::SceneSky, String> {
+) -> std::result::Result<SkyPlan, String> {
     use crate::sky::{AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky};
     let sun = lights.iter().find_map(|l| match l {
         Light::Sun(s) => Some(s),
@@ -994,9 +1031,9 @@ fn build_sky(
         }
     };
     let scale = sf.scale.map_or(1.0, |s| s.0);
-    Ok(super::SceneSky {
+    Ok(SkyPlan {
         model: model.to_string(),
-        table: crate::sky::table::SkyTable::build(&sky),
+        sky,
         sun_dir: -sun.direction,
         factor: if physical {
             sun.irradiance.scaled(scale)
@@ -1075,10 +1112,36 @@ fn build_mesh(
     }
 
     let mesh_path: PathBuf = base_dir.join(&m.file);
-    let merr = |msg: String| scene_error(&mesh_path, format!("{at}.file: {msg}"));
-    let text = std::fs::read_to_string(&mesh_path)
-        .map_err(|e| merr(format!("cannot read the mesh file: {e}")))?;
-    let groups = obj::parse_obj(&text).map_err(merr)?;
+    let text = std::fs::read_to_string(&mesh_path).map_err(|e| {
+        scene_error(
+            &mesh_path,
+            format!("{at}.file: cannot read the mesh file: {e}"),
+        )
+    })?;
+    mesh_shapes(
+        &text,
+        scene_path,
+        &mesh_path,
+        at,
+        m,
+        &group_material,
+        default_material,
+    )
+}
+
+/// The shapes of mesh entry `m` (at key path `at`) from the text of its OBJ file
+/// `mesh_path`, with the materials of its groups already looked up.
+pub(crate) fn mesh_shapes(
+    text: &str,
+    scene_path: &Path,
+    mesh_path: &Path,
+    at: &str,
+    m: &MeshFile,
+    group_material: &BTreeMap<&str, u32>,
+    default_material: Option<u32>,
+) -> Result<Vec<Shape>> {
+    let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
+    let groups = obj::parse_obj(text).map_err(merr)?;
 
     for g in m.groups.keys() {
         if !groups.iter().any(|x| &x.name == g) {
@@ -1090,7 +1153,7 @@ fn build_mesh(
             names.dedup();
             let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(g.clone())]);
             return Err(scene_error(
-                &mesh_path,
+                mesh_path,
                 format!(
                     "{at}.{gk}: no object or group named {g:?} in the mesh (it has: {})",
                     names.join(", ")
