@@ -477,6 +477,16 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[render]\nlight_sampler = \"bvh\"\n",
      &["render.light_sampler: expected power or uniform, got \"bvh\""]),
     ("", "[render]\nrr_depth = -1\n", &["render.rr_depth: "]),
+    // Finite numbers whose spectra overflow f32 (found while writing the fuzzing harness's
+    // checks, fuzz/regressions/scene_toml).
+    ("", "[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = 3e38\n",
+     &["lights[0].intensity: expected an emission whose spectrum is finite in f32, got 3e38, which overflows at "]),
+    ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nemission = { spectrum = \"A\", scale = 3e38 }\n",
+     &["shapes[0].emission: expected an emission whose spectrum is finite in f32, got { scale = 3e38, spectrum = \"A\" }, which overflows at "]),
+    ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1\nangular_radius = 1e-30\n",
+     &["lights[0]: the sun's radiance (irradiance / solid angle of the disk) overflows f32 with angular_radius = 1e-30 degrees and irradiance up to 1.19"]),
+    ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 0\nangular_radius = 1e-30\n",
+     &["lights[0]: the sun's radiance"]),
     // Top level
     ("shapes = 3\n", "", &["shapes: expected an array of tables (write [[shapes]]), got 3"]),
     ("lights = { type = \"point\" }\n", "", &["lights: expected an array of tables (write [[lights]]), got a table"]),

@@ -584,6 +584,13 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
                     )));
                 }
                 let mut sun = SunLight::new(s.direction.unit(), s.irradiance.spectrum(), deg.to_radians());
+                if !sun.radiance.values().iter().all(|v| v.is_finite()) {
+                    return Err(err(format!(
+                        "lights[{i}]: the sun's radiance (irradiance / solid angle of the disk) overflows f32 with angular_radius = {} degrees and irradiance up to {}; expected a larger angular_radius or a smaller irradiance",
+                        super::file::fmt_f32(deg),
+                        super::file::fmt_f32(sun.irradiance.max_value())
+                    )));
+                }
                 if let Some(p) = &s.portal {
                     let (o, e1, e2) = (p.origin.0, p.edge1.0, p.edge2.0);
                     if is_degenerate(o, o + e1, o + e2) {
