@@ -535,6 +535,12 @@ fn bad_cameras() {
          "camera: up must not be parallel to the view direction"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nd = 0\nresolution = [4, 4]\n",
          "camera.d: expected a positive finite number, got 0"),
+        // Ray directions overflowed (zero vectors) at d = 1e20; the image area the light
+        // tracers divide by was infinite at d = 1e-20.
+        ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nd = 1e20\nresolution = [4, 4]\n",
+         "camera.d: expected a camera constant in [1e-6, 1e6] (a vertical field of view from about 180° down to 1e-6 rad), got 1e20"),
+        ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nd = 1e-20\nresolution = [4, 4]\n",
+         "camera.d: expected a camera constant in [1e-6, 1e6]"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 0, 0]\nresolution = [4, 4]\n",
          "camera.up: expected a non-zero vector"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\nfov = 40\n",

@@ -719,11 +719,20 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
             fmt_points(&[c.look_at.0])
         )));
     }
+    let d = c.d.map_or(1.0, |d| d.0);
+    if !(crate::camera::D_MIN..=crate::camera::D_MAX).contains(&d) {
+        return Err(err(format!(
+            "camera.d: expected a camera constant in [{:e}, {:e}] (a vertical field of view from about 180° down to 1e-6 rad), got {}",
+            crate::camera::D_MIN,
+            crate::camera::D_MAX,
+            super::file::fmt_f32(d)
+        )));
+    }
     let camera = Camera::new(
         c.eye.0,
         c.look_at.0,
         c.up.map_or(Vec3::Y, |u| u.unit()),
-        c.d.map_or(1.0, |d| d.0),
+        d,
         c.resolution.width,
         c.resolution.height,
     )
