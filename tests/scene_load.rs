@@ -487,6 +487,17 @@ const BAD: &[(&str, &str, &[&str])] = &[
      &["lights[0]: the sun's radiance (irradiance / solid angle of the disk) overflows f32 with angular_radius = 1e-30 degrees and irradiance up to 1.19"]),
     ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 0\nangular_radius = 1e-30\n",
      &["lights[0]: the sun's radiance"]),
+    // Finite coordinates whose products or extent overflow f32 (fuzz/regressions/scene_toml).
+    ("", "[[shapes]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [3e19, 0, 0], [0, 3e19, 0]]\nmaterial = \"glass\"\n",
+     &["shapes[0].vertices: expected a triangle whose edges' cross product is finite in f32 (coordinates within about ±1e19), got [[0, 0, 0], [3e19, 0, 0], [0, 3e19, 0]]"]),
+    ("", "[[shapes]]\ntype = \"quad\"\norigin = [0, 0, 0]\nedge1 = [3e19, 0, 0]\nedge2 = [0, 3e19, 0]\nmaterial = \"glass\"\n",
+     &["shapes[0]: expected edge1 and edge2 whose cross product is finite in f32"]),
+    ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1\nportal = { origin = [0, 0, 0], edge1 = [3e19, 0, 0], edge2 = [0, 0, 3e19] }\n",
+     &["lights[0].portal: expected a portal whose corners and edges' cross product are finite in f32"]),
+    ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [-3e38, 0, 0]\nradius = 1\nmaterial = \"glass\"\n[[shapes]]\ntype = \"sphere\"\ncenter = [3e38, 0, 0]\nradius = 1\nmaterial = \"glass\"\n",
+     &["shapes[1]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from [-3e38, -1, -1] to [3e38, 1, 1] with this one"]),
+    ("", "[[shapes]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nsize = 2e38\nmaterial = \"glass\"\n",
+     &["shapes[0]: expected shapes whose bounding sphere is finite in f32"]),
     // Top level
     ("shapes = 3\n", "", &["shapes: expected an array of tables (write [[shapes]]), got 3"]),
     ("lights = { type = \"point\" }\n", "", &["lights: expected an array of tables (write [[lights]]), got a table"]),
@@ -674,6 +685,10 @@ fn mesh_errors_name_the_mesh_file_and_the_key_path() {
          &["shapes[1].file: line 4: expected a face with at least 3 vertices"]),
         (Some("v 0 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n"),
          &["shapes[1].file: cannot parse the OBJ file"]),
+        // Dropped as "degenerate" before (its cross product overflows f32), so the mesh
+        // silently lost it.
+        (Some("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 3e19 0 0\nv 0 0 3e19\nf 1 2 3\nf 1 4 5\n"),
+         &["shapes[1].file: a triangle of object \"unnamed_object\" is too large for f32 after scale 1 and translate [0, 0, 0]"]),
     ];
     for (obj, wants) in cases {
         let _ = std::fs::remove_file(&mesh_path);

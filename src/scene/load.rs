@@ -499,6 +499,12 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
             ShapeFile::Triangle(t) => {
                 let material = resolve(&at, s)?;
                 let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
+                if cross_overflows(v[0], v[1], v[2]) {
+                    return Err(err(format!(
+                        "{at}.vertices: expected a triangle whose edges' cross product is finite in f32 (coordinates within about ±1e19), got {}",
+                        fmt_points(&v)
+                    )));
+                }
                 if is_degenerate(v[0], v[1], v[2]) {
                     return Err(err(format!(
                         "{at}.vertices: expected a triangle with non-zero area, got collinear vertices {}",
@@ -537,6 +543,13 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
                         "{at}: expected a quad with finite corners, got origin + edges overflowing f32"
                     )));
                 }
+                if cross_overflows(v[0], v[1], v[3]) {
+                    return Err(err(format!(
+                        "{at}: expected edge1 and edge2 whose cross product is finite in f32 (coordinates within about ±1e19), got {} and {}",
+                        fmt_points(&[e1]),
+                        fmt_points(&[e2])
+                    )));
+                }
                 if is_degenerate(v[0], v[1], v[3]) {
                     return Err(err(format!(
                         "{at}: expected edge1 and edge2 spanning a non-zero area, got parallel edges {} and {}",
@@ -558,6 +571,22 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
             }
         }
         shape_entry.resize(shapes.len(), i);
+    }
+
+    // The bounding sphere (the lights at infinity start their paths on it) must be
+    // finite; the first shape that makes it overflow is named.
+    let mut bbox = EMPTY_BOX;
+    for (k, shape) in shapes.iter().enumerate() {
+        bbox = grow_box(bbox, shape);
+        let b = box_sphere(bbox);
+        if !(b.center.is_finite() && b.radius.is_finite()) {
+            return Err(err(format!(
+                "shapes[{}]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from {} to {} with this one",
+                shape_entry[k],
+                fmt_points(&[bbox.0]),
+                fmt_points(&[bbox.1])
+            )));
+        }
     }
 
     // Lights, in file order.
@@ -593,6 +622,14 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
                 }
                 if let Some(p) = &s.portal {
                     let (o, e1, e2) = (p.origin.0, p.edge1.0, p.edge2.0);
+                    if cross_overflows(o, o + e1, o + e2) || !(o + e1 + e2).is_finite() {
+                        return Err(err(format!(
+                            "lights[{i}].portal: expected a portal whose corners and edges' cross product are finite in f32 (coordinates within about ±1e19), got origin {} and edges {} and {}",
+                            fmt_points(&[o]),
+                            fmt_points(&[e1]),
+                            fmt_points(&[e2])
+                        )));
+                    }
                     if is_degenerate(o, o + e1, o + e2) {
                         return Err(err(format!(
                             "lights[{i}].portal: expected edge1 and edge2 spanning a non-zero area, got {} and {}",
@@ -758,28 +795,46 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
 /// The sphere around the shapes' bounding box (a unit sphere at the origin for a scene
 /// without shapes).
 pub fn scene_bounds(shapes: &[Shape]) -> crate::light::SceneBounds {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    let mut b = EMPTY_BOX;
     for s in shapes {
-        match &s.kind {
-            ShapeKind::Sphere { center, radius } => {
-                lo = lo.min(*center - Vec3::splat(*radius));
-                hi = hi.max(*center + Vec3::splat(*radius));
-            }
-            ShapeKind::Mesh(m) => {
-                for p in &m.positions {
-                    lo = lo.min(*p);
-                    hi = hi.max(*p);
-                }
+        b = grow_box(b, s);
+    }
+    box_sphere(b)
+}
+
+/// A bounding box (lo, hi); lo > hi when empty.
+type Box3 = (Vec3, Vec3);
+
+const EMPTY_BOX: Box3 = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+
+/// `b` grown to hold shape `s`.
+fn grow_box((mut lo, mut hi): Box3, s: &Shape) -> Box3 {
+    match &s.kind {
+        ShapeKind::Sphere { center, radius } => {
+            lo = lo.min(*center - Vec3::splat(*radius));
+            hi = hi.max(*center + Vec3::splat(*radius));
+        }
+        ShapeKind::Mesh(m) => {
+            for p in &m.positions {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
             }
         }
     }
+    (lo, hi)
+}
+
+/// The sphere around box `b` (a unit sphere at the origin for an empty box).
+fn box_sphere((lo, hi): Box3) -> crate::light::SceneBounds {
     if !(lo.x <= hi.x) {
         return crate::light::SceneBounds {
             center: Vec3::ZERO,
             radius: 1.0,
         };
     }
-    let center = 0.5 * (lo + hi);
+    // Not 0.5 (lo + hi), which overflows for a shape near ±3e38 (the same value
+    // elsewhere: halving is exact).
+    let center = 0.5 * lo + 0.5 * hi;
     crate::light::SceneBounds {
         center,
         radius: (0.5 * (hi - lo).length()).max(1e-6),
@@ -1078,6 +1133,12 @@ fn mesh_shape(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, material: u32) -> Sh
     }
 }
 
+/// Whether the cross product of the edges b − a and c − a (twice the area, and the normal
+/// Embree and the lights compute) overflows f32: coordinates beyond about ±1e19.
+fn cross_overflows(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    !(b - a).cross(c - a).is_finite()
+}
+
 /// Zero area up to f32 rounding: |e1 × e2| ≤ ε |e1| |e2| (the angle between the edges is
 /// below about 1e-7 rad), or a zero-length edge.
 fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
@@ -1091,7 +1152,10 @@ fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
 fn fmt_points(v: &[Vec3]) -> String {
     let p: Vec<String> = v
         .iter()
-        .map(|p| format!("[{}, {}, {}]", p.x, p.y, p.z))
+        .map(|p| {
+            let f = super::file::fmt_f32;
+            format!("[{}, {}, {}]", f(p.x), f(p.y), f(p.z))
+        })
         .collect();
     if p.len() == 1 {
         p[0].clone()
@@ -1224,9 +1288,19 @@ pub(crate) fn mesh_shapes(
             let p = tri.map(|i| g.positions[i as usize] * scale + translate);
             if p.iter().any(|x| !x.is_finite()) {
                 return Err(merr(format!(
-                    "a vertex of object {:?} is not finite after scale {scale} and translate {}",
+                    "a vertex of object {:?} is not finite after scale {} and translate {}",
                     g.name,
+                    super::file::fmt_f32(scale),
                     fmt_points(&[translate])
+                )));
+            }
+            if cross_overflows(p[0], p[1], p[2]) {
+                return Err(merr(format!(
+                    "a triangle of object {:?} is too large for f32 after scale {} and translate {}: expected its edges' cross product to be finite (coordinates within about ±1e19), got {}",
+                    g.name,
+                    super::file::fmt_f32(scale),
+                    fmt_points(&[translate]),
+                    fmt_points(&p)
                 )));
             }
             // Zero-area triangles are never hit; they are dropped.
