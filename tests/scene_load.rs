@@ -494,8 +494,8 @@ const BAD: &[(&str, &str, &[&str])] = &[
      &["shapes[0]: expected edge1 and edge2 whose cross product is finite in f32"]),
     ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1\nportal = { origin = [0, 0, 0], edge1 = [3e19, 0, 0], edge2 = [0, 0, 3e19] }\n",
      &["lights[0].portal: expected a portal whose corners and edges' cross product are finite in f32"]),
-    ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [-3e38, 0, 0]\nradius = 1\nmaterial = \"glass\"\n[[shapes]]\ntype = \"sphere\"\ncenter = [3e38, 0, 0]\nradius = 1\nmaterial = \"glass\"\n",
-     &["shapes[1]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from [-3e38, -1, -1] to [3e38, 1, 1] with this one"]),
+    ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\n[[shapes]]\ntype = \"triangle\"\nvertices = [[1e20, 0, 0], [1e20, 1, 0], [1e20, 0, 1]]\nmaterial = \"glass\"\n",
+     &["shapes[1]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from [-1, -1, -1] to [1e20, 1, 1] with this one"]),
     ("", "[[shapes]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nsize = 2e38\nmaterial = \"glass\"\n",
      &["shapes[0]: expected shapes whose bounding sphere is finite in f32"]),
     // Top level
