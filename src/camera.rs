@@ -25,6 +25,13 @@ pub struct CameraWiSample {
     pub raster: (f32, f32),
 }
 
+/// Smallest camera constant d (a vertical field of view just under 180°).
+pub const D_MIN: f32 = 1e-6;
+/// Largest camera constant d (a vertical field of view of 1e-6 rad). Far beyond it the ray
+/// directions d·v + … overflow f32 when normalised (d ≳ 1.8e19), and the image area
+/// aspect/d² that the light-tracing integrators divide by goes to zero.
+pub const D_MAX: f32 = 1e6;
+
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub eye: Vec3,
@@ -41,8 +48,8 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// Fails with a description when the view direction is zero or parallel to `up`, or
-    /// when d or the resolution is not positive.
+    /// Fails with a description when the view direction is zero or parallel to `up`,
+    /// when d is outside [`D_MIN`, `D_MAX`] or when the resolution is not positive.
     pub fn new(
         eye: Vec3,
         look_at: Vec3,
@@ -52,16 +59,20 @@ impl Camera {
         height: u32,
     ) -> Result<Camera, String> {
         let fwd = look_at - eye;
-        if fwd.length_squared() == 0.0 || !fwd.is_finite() {
+        if fwd == Vec3::ZERO || !fwd.is_finite() {
             return Err("eye and look_at must be distinct finite points".into());
         }
-        if !(d > 0.0 && d.is_finite()) {
-            return Err(format!("camera constant d must be positive, got {d}"));
+        if !(D_MIN..=D_MAX).contains(&d) {
+            return Err(format!(
+                "expected a camera constant d in [{D_MIN:e}, {D_MAX:e}] (a vertical field of view from about 180° down to 1e-6 rad), got {d}"
+            ));
         }
         if width == 0 || height == 0 {
             return Err("resolution must be at least 1x1".into());
         }
-        let v = fwd.normalize();
+        // Scaled by its largest component first, so that eye and look_at 1e-23 apart
+        // (whose squared distance underflows f32) still give a unit axis.
+        let v = (fwd / fwd.abs().max_element()).normalize();
         let b1 = v.cross(up);
         if b1.length_squared() < 1e-12 {
             return Err("up must not be parallel to the view direction".into());
@@ -185,6 +196,30 @@ mod tests {
             40,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn axis_is_unit_for_close_points_and_d_is_bounded() {
+        // eye and look_at 3e-23 apart: the squared distance underflows f32, and the axis
+        // came out with length 0.8 before it was scaled first (found while writing the
+        // scene_toml fuzz harness's camera check).
+        let c = Camera::new(Vec3::new(3e-23, 0.0, 0.0), Vec3::ZERO, Vec3::Y, 1.0, 4, 3).unwrap();
+        assert!(
+            (c.forward() - Vec3::NEG_X).length() < 1e-6,
+            "{}",
+            c.forward()
+        );
+        for d in [D_MIN, 1.0, D_MAX] {
+            let c = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, d, 4, 3).unwrap();
+            let w = c.direction(0.0, 0.0);
+            assert!((w.length() - 1.0).abs() < 1e-6, "d = {d}: {w}");
+            let we = c.we(c.forward());
+            assert!(we.is_finite() && we > 0.0, "d = {d}: We = {we}");
+        }
+        for d in [D_MIN * 0.5, D_MAX * 2.0, 1e20] {
+            let e = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, d, 4, 3).unwrap_err();
+            assert!(e.contains("camera constant d in [1e-6, 1e6]"), "{e}");
+        }
     }
 
     #[test]

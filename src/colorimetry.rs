@@ -9,8 +9,9 @@
 //! them are ignored). Blank lines and lines whose first non-blank character is `#` are
 //! skipped. The first remaining line is a header, and skipped, when its first field is
 //! not a number. At least two rows; wavelengths finite and strictly increasing (as f32);
-//! values finite (as f32). Any other line is an error naming the file, the line number and
-//! what was expected.
+//! values finite (as f32); and the table interpolated onto the 1 nm grid (below) finite
+//! too. Any other line is an error naming the file, the line number and what was
+//! expected.
 //!
 //! The rows are turned into heron's 1 nm table over 360–830 nm by
 //! [`DenseSpectrum::from_table`], as every spectral CSV of a scene is, the way
@@ -202,9 +203,9 @@ impl SpectrumCsv {
     /// Parses `text`; `path` only names the file in error messages.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
         let rows = parse_columns(text, path, &["wavelength_nm", "value"])?;
-        Ok(SpectrumCsv {
-            samples: rows.iter().map(|r| (r[0], r[1])).collect(),
-        })
+        let samples: Vec<(f32, f32)> = rows.iter().map(|r| (r[0], r[1])).collect();
+        interpolate_column(path, "value", &samples)?;
+        Ok(SpectrumCsv { samples })
     }
 
     /// The distribution on heron's 1 nm grid over 360–830 nm
@@ -290,6 +291,31 @@ pub fn parse_columns(text: &str, path: &Path, columns: &[&str]) -> Result<Vec<Ve
         )));
     }
     Ok(rows)
+}
+
+/// The column `(wavelength, value)` rows of `path` on heron's 1 nm grid
+/// ([`DenseSpectrum::from_table`]), which must be finite: rows whose wavelengths or values
+/// are near the end of f32's range can make Sprague's or the spline's overshoot between
+/// them overflow (e.g. a row at 1e38 nm after rows 20 nm apart).
+pub fn interpolate_column(
+    path: &Path,
+    column: &str,
+    samples: &[(f32, f32)],
+) -> Result<DenseSpectrum> {
+    let dense = DenseSpectrum::from_table(samples);
+    if let Some((i, v)) = dense
+        .values()
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !v.is_finite())
+    {
+        return Err(HeronError::Invalid(format!(
+            "{}: {column}: the rows interpolated onto the 1 nm grid give {v} at {} nm; expected wavelengths and values small enough that the interpolation stays finite in f32",
+            path.display(),
+            LAMBDA_MIN + i as f32
+        )));
+    }
+    Ok(dense)
 }
 
 fn quote(s: &str) -> String {
@@ -393,6 +419,10 @@ mod tests {
         assert!(e("").contains("found 0"));
         // A second non-numeric line is not a header.
         assert!(e("a,b\nc,d\n").contains("line 2: wavelength (nm): expected a number"));
+        // Found by fuzzing: finite rows whose not-a-knot spline overflows f32 between
+        // 530 nm and 1e38 nm.
+        assert!(e("500,1\n511,3\n530,2\n1e38,2\n")
+            .contains("t.csv: value: the rows interpolated onto the 1 nm grid give inf at 531 nm"));
     }
 
     #[test]

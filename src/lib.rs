@@ -14,6 +14,8 @@ pub mod colorimetry;
 pub mod converge;
 pub mod error;
 pub mod film;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod geometry;
 pub mod integrator;
 pub mod light;

@@ -481,6 +481,27 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [5e3, 0, 0]\nradius = 1e-4\nmaterial = \"glass\"\n",
      &["shapes[0].radius: expected at least 1e-6 × the centre's largest coordinate (5000)"]),
     ("", "[render]\nrr_depth = -1\n", &["render.rr_depth: "]),
+    // Finite numbers whose spectra overflow f32 (found while writing the fuzzing harness's
+    // checks, fuzz/regressions/scene_toml).
+    ("", "[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = 3e38\n",
+     &["lights[0].intensity: expected an emission whose spectrum is finite in f32, got 3e38, which overflows at "]),
+    ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nemission = { spectrum = \"A\", scale = 3e38 }\n",
+     &["shapes[0].emission: expected an emission whose spectrum is finite in f32, got { scale = 3e38, spectrum = \"A\" }, which overflows at "]),
+    ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1\nangular_radius = 1e-30\n",
+     &["lights[0]: the sun's radiance (irradiance / solid angle of the disk) overflows f32 with angular_radius = 1e-30 degrees and irradiance up to 1.19"]),
+    ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 0\nangular_radius = 1e-30\n",
+     &["lights[0]: the sun's radiance"]),
+    // Finite coordinates whose products or extent overflow f32 (fuzz/regressions/scene_toml).
+    ("", "[[shapes]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [3e19, 0, 0], [0, 3e19, 0]]\nmaterial = \"glass\"\n",
+     &["shapes[0].vertices: expected a triangle whose edges' cross product is finite in f32 (coordinates within about ±1e19), got [[0, 0, 0], [3e19, 0, 0], [0, 3e19, 0]]"]),
+    ("", "[[shapes]]\ntype = \"quad\"\norigin = [0, 0, 0]\nedge1 = [3e19, 0, 0]\nedge2 = [0, 3e19, 0]\nmaterial = \"glass\"\n",
+     &["shapes[0]: expected edge1 and edge2 whose cross product is finite in f32"]),
+    ("", "[[lights]]\ntype = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1\nportal = { origin = [0, 0, 0], edge1 = [3e19, 0, 0], edge2 = [0, 0, 3e19] }\n",
+     &["lights[0].portal: expected a portal whose corners and edges' cross product are finite in f32"]),
+    ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\n[[shapes]]\ntype = \"triangle\"\nvertices = [[1e20, 0, 0], [1e20, 1, 0], [1e20, 0, 1]]\nmaterial = \"glass\"\n",
+     &["shapes[1]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from [-1, -1, -1] to [1e20, 1, 1] with this one"]),
+    ("", "[[shapes]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nsize = 2e38\nmaterial = \"glass\"\n",
+     &["shapes[0]: expected shapes whose bounding sphere is finite in f32"]),
     // Top level
     ("shapes = 3\n", "", &["shapes: expected an array of tables (write [[shapes]]), got 3"]),
     ("lights = { type = \"point\" }\n", "", &["lights: expected an array of tables (write [[lights]]), got a table"]),
@@ -529,6 +550,12 @@ fn bad_cameras() {
          "camera: up must not be parallel to the view direction"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nd = 0\nresolution = [4, 4]\n",
          "camera.d: expected a positive finite number, got 0"),
+        // Ray directions overflowed (zero vectors) at d = 1e20; the image area the light
+        // tracers divide by was infinite at d = 1e-20.
+        ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nd = 1e20\nresolution = [4, 4]\n",
+         "camera.d: expected a camera constant in [1e-6, 1e6] (a vertical field of view from about 180° down to 1e-6 rad), got 1e20"),
+        ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nd = 1e-20\nresolution = [4, 4]\n",
+         "camera.d: expected a camera constant in [1e-6, 1e6]"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 0, 0]\nresolution = [4, 4]\n",
          "camera.up: expected a non-zero vector"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\nfov = 40\n",
@@ -662,6 +689,10 @@ fn mesh_errors_name_the_mesh_file_and_the_key_path() {
          &["shapes[1].file: line 4: expected a face with at least 3 vertices"]),
         (Some("v 0 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n"),
          &["shapes[1].file: cannot parse the OBJ file"]),
+        // Dropped as "degenerate" before (its cross product overflows f32), so the mesh
+        // silently lost it.
+        (Some("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 3e19 0 0\nv 0 0 3e19\nf 1 2 3\nf 1 4 5\n"),
+         &["shapes[1].file: a triangle of object \"unnamed_object\" is too large for f32 after scale 1 and translate [0, 0, 0]"]),
     ];
     for (obj, wants) in cases {
         let _ = std::fs::remove_file(&mesh_path);

@@ -598,12 +598,26 @@ fn show_into(v: &toml::Value, s: &mut String) {
     }
 }
 
-/// TOML's spelling of a float (`nan`, `inf`, `-inf`, else Rust's shortest form).
-fn fmt_f64(x: f64) -> String {
+/// [`fmt_f64`] of an f32, in its own shortest form (`1e-30`, not `1.0000000031710769e-30`).
+pub(crate) fn fmt_f32(x: f32) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-5..1e16).contains(&x.abs()) {
+        format!("{x:e}")
+    } else if x.is_finite() {
+        format!("{x}")
+    } else {
+        fmt_f64(x as f64)
+    }
+}
+
+/// TOML's spelling of a float (`nan`, `inf`, `-inf`, else Rust's shortest form, with an
+/// exponent when very large or small: `3e38`, not 39 digits).
+pub(crate) fn fmt_f64(x: f64) -> String {
     if x.is_nan() {
         "nan".into()
     } else if x.is_infinite() {
         if x > 0.0 { "inf" } else { "-inf" }.into()
+    } else if x != 0.0 && !(1e-5..1e16).contains(&x.abs()) {
+        format!("{x:e}")
     } else {
         format!("{x}")
     }
@@ -959,13 +973,23 @@ impl<'de> Deserialize<'de> for Emission {
             Colour::Named { scale, .. } => *scale >= 0.0,
             _ => c.rgb().is_some_and(|x| x.iter().all(|&x| x >= 0.0)),
         };
-        if ok {
-            Ok(Emission(c))
-        } else {
-            Err(D::Error::custom(format!(
+        if !ok {
+            return Err(D::Error::custom(format!(
                 "expected an emission with every component (or the scale) >= 0, got {}",
                 show(&v)
-            )))
+            )));
         }
+        // Near f32's largest number, the spectrum (the colour times D65 at Y = 1, or
+        // the named spectrum times the scale) overflows.
+        let e = Emission(c);
+        let s = e.spectrum();
+        if let Some(i) = s.values().iter().position(|x| !x.is_finite()) {
+            return Err(D::Error::custom(format!(
+                "expected an emission whose spectrum is finite in f32, got {}, which overflows at {} nm",
+                show(&v),
+                crate::spectrum::LAMBDA_MIN + i as f32
+            )));
+        }
+        Ok(e)
     }
 }

@@ -58,9 +58,19 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 /// messages and its folder is where relative mesh paths start.
 pub fn load_scene_from_str(text: &str, path: &Path) -> Result<Scene> {
     let file = parse_scene_file(text).map_err(|m| scene_error(path, m))?;
-    let mut scene = build(path, file)?;
+    let mut scene = build(path, file, SkyTables::Build)?;
     scene.source_sha256 = crate::provenance::sha256_hex(text.as_bytes());
     Ok(scene)
+}
+
+/// Whether [`build`] tabulates a `[sky]` model. Tabulating a physical sky takes seconds
+/// (it is the model's evaluation, not the file's reading), so the fuzzing harness
+/// ([`crate::fuzzing`]) checks the `[sky]` table and constructs its model but leaves
+/// `Scene::sky` empty.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SkyTables {
+    Build,
+    Skip,
 }
 
 /// Stages 1 and 2: TOML text to [`SceneFile`]. The error is the one-line message.
@@ -417,7 +427,7 @@ fn friendly(path: &[Seg], msg: &str) -> String {
 // ---------------------------------------------------------------------------------------
 // Stage 3: building the scene
 
-fn build(path: &Path, file: SceneFile) -> Result<Scene> {
+pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Result<Scene> {
     let err = |m: String| scene_error(path, m);
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     // Every file the scene reads besides itself (meshes, tables), for provenance.
@@ -505,6 +515,12 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
             ShapeFile::Triangle(t) => {
                 let material = resolve(&at, s)?;
                 let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
+                if cross_overflows(v[0], v[1], v[2]) {
+                    return Err(err(format!(
+                        "{at}.vertices: expected a triangle whose edges' cross product is finite in f32 (coordinates within about ±1e19), got {}",
+                        fmt_points(&v)
+                    )));
+                }
                 if is_degenerate(v[0], v[1], v[2]) {
                     return Err(err(format!(
                         "{at}.vertices: expected a triangle with non-zero area, got collinear vertices {}",
@@ -543,6 +559,13 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                         "{at}: expected a quad with finite corners, got origin + edges overflowing f32"
                     )));
                 }
+                if cross_overflows(v[0], v[1], v[3]) {
+                    return Err(err(format!(
+                        "{at}: expected edge1 and edge2 whose cross product is finite in f32 (coordinates within about ±1e19), got {} and {}",
+                        fmt_points(&[e1]),
+                        fmt_points(&[e2])
+                    )));
+                }
                 if is_degenerate(v[0], v[1], v[3]) {
                     return Err(err(format!(
                         "{at}: expected edge1 and edge2 spanning a non-zero area, got parallel edges {} and {}",
@@ -564,6 +587,22 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
             }
         }
         shape_entry.resize(shapes.len(), i);
+    }
+
+    // The bounding sphere (the lights at infinity start their paths on it) must be
+    // finite; the first shape that makes it overflow is named.
+    let mut bbox = EMPTY_BOX;
+    for (k, shape) in shapes.iter().enumerate() {
+        bbox = grow_box(bbox, shape);
+        let b = box_sphere(bbox);
+        if !(b.center.is_finite() && b.radius.is_finite()) {
+            return Err(err(format!(
+                "shapes[{}]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from {} to {} with this one",
+                shape_entry[k],
+                fmt_points(&[bbox.0]),
+                fmt_points(&[bbox.1])
+            )));
+        }
     }
 
     // Lights, in file order.
@@ -590,8 +629,23 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
                     )));
                 }
                 let mut sun = SunLight::new(s.direction.unit(), s.irradiance.spectrum(), deg.to_radians());
+                if !sun.radiance.values().iter().all(|v| v.is_finite()) {
+                    return Err(err(format!(
+                        "lights[{i}]: the sun's radiance (irradiance / solid angle of the disk) overflows f32 with angular_radius = {} degrees and irradiance up to {}; expected a larger angular_radius or a smaller irradiance",
+                        super::file::fmt_f32(deg),
+                        super::file::fmt_f32(sun.irradiance.max_value())
+                    )));
+                }
                 if let Some(p) = &s.portal {
                     let (o, e1, e2) = (p.origin.0, p.edge1.0, p.edge2.0);
+                    if cross_overflows(o, o + e1, o + e2) || !(o + e1 + e2).is_finite() {
+                        return Err(err(format!(
+                            "lights[{i}].portal: expected a portal whose corners and edges' cross product are finite in f32 (coordinates within about ±1e19), got origin {} and edges {} and {}",
+                            fmt_points(&[o]),
+                            fmt_points(&[e1]),
+                            fmt_points(&[e2])
+                        )));
+                    }
                     if is_degenerate(o, o + e1, o + e2) {
                         return Err(err(format!(
                             "lights[{i}].portal: expected edge1 and edge2 spanning a non-zero area, got {} and {}",
@@ -704,9 +758,13 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
     }
 
     let sky = match &file.sky {
-        Some(sf) => Some(std::sync::Arc::new(
-            build_sky(sf, &lights, &background).map_err(err)?,
-        )),
+        Some(sf) => {
+            let plan = plan_sky(sf, &lights, &background).map_err(err)?;
+            match sky_tables {
+                SkyTables::Build => Some(std::sync::Arc::new(plan.tabulate())),
+                SkyTables::Skip => None,
+            }
+        }
         None => None,
     };
 
@@ -718,11 +776,20 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
             fmt_points(&[c.look_at.0])
         )));
     }
+    let d = c.d.map_or(1.0, |d| d.0);
+    if !(crate::camera::D_MIN..=crate::camera::D_MAX).contains(&d) {
+        return Err(err(format!(
+            "camera.d: expected a camera constant in [{:e}, {:e}] (a vertical field of view from about 180° down to 1e-6 rad), got {}",
+            crate::camera::D_MIN,
+            crate::camera::D_MAX,
+            super::file::fmt_f32(d)
+        )));
+    }
     let camera = Camera::new(
         c.eye.0,
         c.look_at.0,
         c.up.map_or(Vec3::Y, |u| u.unit()),
-        c.d.map_or(1.0, |d| d.0),
+        d,
         c.resolution.width,
         c.resolution.height,
     )
@@ -748,28 +815,46 @@ fn build(path: &Path, file: SceneFile) -> Result<Scene> {
 /// The sphere around the shapes' bounding box (a unit sphere at the origin for a scene
 /// without shapes).
 pub fn scene_bounds(shapes: &[Shape]) -> crate::light::SceneBounds {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    let mut b = EMPTY_BOX;
     for s in shapes {
-        match &s.kind {
-            ShapeKind::Sphere { center, radius } => {
-                lo = lo.min(*center - Vec3::splat(*radius));
-                hi = hi.max(*center + Vec3::splat(*radius));
-            }
-            ShapeKind::Mesh(m) => {
-                for p in &m.positions {
-                    lo = lo.min(*p);
-                    hi = hi.max(*p);
-                }
+        b = grow_box(b, s);
+    }
+    box_sphere(b)
+}
+
+/// A bounding box (lo, hi); lo > hi when empty.
+type Box3 = (Vec3, Vec3);
+
+const EMPTY_BOX: Box3 = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+
+/// `b` grown to hold shape `s`.
+fn grow_box((mut lo, mut hi): Box3, s: &Shape) -> Box3 {
+    match &s.kind {
+        ShapeKind::Sphere { center, radius } => {
+            lo = lo.min(*center - Vec3::splat(*radius));
+            hi = hi.max(*center + Vec3::splat(*radius));
+        }
+        ShapeKind::Mesh(m) => {
+            for p in &m.positions {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
             }
         }
     }
+    (lo, hi)
+}
+
+/// The sphere around box `b` (a unit sphere at the origin for an empty box).
+fn box_sphere((lo, hi): Box3) -> crate::light::SceneBounds {
     if !(lo.x <= hi.x) {
         return crate::light::SceneBounds {
             center: Vec3::ZERO,
             radius: 1.0,
         };
     }
-    let center = 0.5 * (lo + hi);
+    // Not 0.5 (lo + hi), which overflows for a shape near ±3e38 (the same value
+    // elsewhere: halving is exact).
+    let center = 0.5 * lo + 0.5 * hi;
     crate::light::SceneBounds {
         center,
         radius: (0.5 * (hi - lo).length()).max(1e-6),
@@ -919,12 +1004,35 @@ fn build_material(
     })
 }
 
-/// Builds and tabulates the `[sky]` model with the scene's first sun light.
-fn build_sky(
+/// The `[sky]` model, checked and constructed with the scene's first sun light, before
+/// its (slow) tabulation.
+struct SkyPlan {
+    model: String,
+    sky: crate::sky::Sky,
+    sun_dir: Vec3,
+    factor: DenseSpectrum,
+    replaces_background: bool,
+}
+
+impl SkyPlan {
+    /// Tabulates the model over (θ, λ) for rendering.
+    fn tabulate(self) -> super::SceneSky {
+        super::SceneSky {
+            table: crate::sky::table::SkyTable::build(&self.sky),
+            model: self.model,
+            sun_dir: self.sun_dir,
+            factor: self.factor,
+            replaces_background: self.replaces_background,
+        }
+    }
+}
+
+/// Checks `[sky]` and constructs its model with the scene's first sun light.
+fn plan_sky(
     sf: &super::file::SkyFile,
     lights: &[Light],
     background: &DenseSpectrum,
-) -> std::result::Result<super::SceneSky, String> {
+) -> std::result::Result<SkyPlan, String> {
     use crate::sky::{AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky};
     let sun = lights.iter().find_map(|l| match l {
         Light::Sun(s) => Some(s),
@@ -1014,9 +1122,9 @@ fn build_sky(
         }
     };
     let scale = sf.scale.map_or(1.0, |s| s.0);
-    Ok(super::SceneSky {
+    Ok(SkyPlan {
         model: model.to_string(),
-        table: crate::sky::table::SkyTable::build(&sky),
+        sky,
         sun_dir: -sun.direction,
         factor: if physical {
             sun.irradiance.scaled(scale)
@@ -1045,6 +1153,12 @@ fn mesh_shape(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, material: u32) -> Sh
     }
 }
 
+/// Whether the cross product of the edges b − a and c − a (twice the area, and the normal
+/// Embree and the lights compute) overflows f32: coordinates beyond about ±1e19.
+fn cross_overflows(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    !(b - a).cross(c - a).is_finite()
+}
+
 /// Zero area up to f32 rounding: |e1 × e2| ≤ ε |e1| |e2| (the angle between the edges is
 /// below about 1e-7 rad), or a zero-length edge.
 fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
@@ -1058,7 +1172,10 @@ fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
 fn fmt_points(v: &[Vec3]) -> String {
     let p: Vec<String> = v
         .iter()
-        .map(|p| format!("[{}, {}, {}]", p.x, p.y, p.z))
+        .map(|p| {
+            let f = super::file::fmt_f32;
+            format!("[{}, {}, {}]", f(p.x), f(p.y), f(p.z))
+        })
         .collect();
     if p.len() == 1 {
         p[0].clone()
@@ -1095,10 +1212,36 @@ fn build_mesh(
     }
 
     let mesh_path: PathBuf = base_dir.join(&m.file);
-    let merr = |msg: String| scene_error(&mesh_path, format!("{at}.file: {msg}"));
-    let text = std::fs::read_to_string(&mesh_path)
-        .map_err(|e| merr(format!("cannot read the mesh file: {e}")))?;
-    let groups = obj::parse_obj(&text).map_err(merr)?;
+    let text = std::fs::read_to_string(&mesh_path).map_err(|e| {
+        scene_error(
+            &mesh_path,
+            format!("{at}.file: cannot read the mesh file: {e}"),
+        )
+    })?;
+    mesh_shapes(
+        &text,
+        scene_path,
+        &mesh_path,
+        at,
+        m,
+        &group_material,
+        default_material,
+    )
+}
+
+/// The shapes of mesh entry `m` (at key path `at`) from the text of its OBJ file
+/// `mesh_path`, with the materials of its groups already looked up.
+pub(crate) fn mesh_shapes(
+    text: &str,
+    scene_path: &Path,
+    mesh_path: &Path,
+    at: &str,
+    m: &MeshFile,
+    group_material: &BTreeMap<&str, u32>,
+    default_material: Option<u32>,
+) -> Result<Vec<Shape>> {
+    let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
+    let groups = obj::parse_obj(text).map_err(merr)?;
 
     for g in m.groups.keys() {
         if !groups.iter().any(|x| &x.name == g) {
@@ -1110,7 +1253,7 @@ fn build_mesh(
             names.dedup();
             let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(g.clone())]);
             return Err(scene_error(
-                &mesh_path,
+                mesh_path,
                 format!(
                     "{at}.{gk}: no object or group named {g:?} in the mesh (it has: {})",
                     names.join(", ")
@@ -1165,9 +1308,19 @@ fn build_mesh(
             let p = tri.map(|i| g.positions[i as usize] * scale + translate);
             if p.iter().any(|x| !x.is_finite()) {
                 return Err(merr(format!(
-                    "a vertex of object {:?} is not finite after scale {scale} and translate {}",
+                    "a vertex of object {:?} is not finite after scale {} and translate {}",
                     g.name,
+                    super::file::fmt_f32(scale),
                     fmt_points(&[translate])
+                )));
+            }
+            if cross_overflows(p[0], p[1], p[2]) {
+                return Err(merr(format!(
+                    "a triangle of object {:?} is too large for f32 after scale {} and translate {}: expected its edges' cross product to be finite (coordinates within about ±1e19), got {}",
+                    g.name,
+                    super::file::fmt_f32(scale),
+                    fmt_points(&[translate]),
+                    fmt_points(&p)
                 )));
             }
             // Zero-area triangles are never hit; they are dropped.

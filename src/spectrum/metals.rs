@@ -7,8 +7,7 @@
 //! for irregular ones, as colour-science), and the interpolated table must keep n > 0
 //! and k ≥ 0.
 use crate::bsdf::ComplexIor;
-use crate::colorimetry::parse_columns;
-use crate::spectrum::DenseSpectrum;
+use crate::colorimetry::{interpolate_column, parse_columns};
 use crate::{HeronError, Result};
 use std::path::Path;
 use std::sync::OnceLock;
@@ -45,8 +44,8 @@ pub fn parse_nk(text: &str, path: &Path) -> Result<ComplexIor> {
     let n: Vec<(f32, f32)> = rows.iter().map(|r| (r[0], r[1])).collect();
     let k: Vec<(f32, f32)> = rows.iter().map(|r| (r[0], r[2])).collect();
     let ior = ComplexIor {
-        n: DenseSpectrum::from_table(&n),
-        k: DenseSpectrum::from_table(&k),
+        n: interpolate_column(path, "n", &n)?,
+        k: interpolate_column(path, "k", &k)?,
     };
     // A spline can overshoot between rows; the interpolated table must stay physical.
     for (i, (&nv, &kv)) in ior.n.values().iter().zip(ior.k.values()).enumerate() {
