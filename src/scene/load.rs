@@ -499,9 +499,10 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
                 let reach = sp.center.0.abs().max_element();
                 if sp.radius.0 < MIN_RELATIVE_RADIUS * reach {
                     return Err(err(format!(
-                        "{at}.radius: expected at least {MIN_RELATIVE_RADIUS:e} × the centre's largest coordinate ({reach}), i.e. {:e}, got {}: a smaller sphere is below float precision where it is",
+                        "{at}.radius: expected at least {MIN_RELATIVE_RADIUS:e} × the centre's largest coordinate ({}), i.e. {:e}, got {}: a smaller sphere is below float precision where it is",
+                        super::file::fmt_f32(reach),
                         MIN_RELATIVE_RADIUS * reach,
-                        sp.radius.0
+                        super::file::fmt_f32(sp.radius.0)
                     )));
                 }
                 shapes.push(Shape {
