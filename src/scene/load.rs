@@ -862,6 +862,20 @@ fn box_sphere((lo, hi): Box3) -> crate::light::SceneBounds {
     }
 }
 
+/// The refractive-index model a scene file's `ior` value describes (a number, a catalogue
+/// name, `{ sellmeier = .. }`, `{ cauchy = .. }` or `{ table = "file.csv" }`, read
+/// relative to `base_dir`), checked as the loader checks it; the error is the loader's
+/// message after `at` (the key path it names). For the Python module's `heron.ior`.
+pub fn ior_from_value(
+    at: &str,
+    value: toml::Value,
+    base_dir: &Path,
+) -> std::result::Result<Ior, String> {
+    use serde::Deserialize as _;
+    let spec = IorSpec::deserialize(value).map_err(|e| format!("{at}: {}", e.message()))?;
+    build_ior(at, &spec, base_dir, &mut Vec::new())
+}
+
 /// The refractive-index model of `spec`; a table file is read relative to `base_dir`.
 fn build_ior(
     at: &str,
