@@ -496,6 +496,42 @@ def test_ctrl_c_stops_a_render():
     assert p.stdout.splitlines() == ["interrupted", "rendered again 1 (64, 64, 3)"], p.stdout
 
 
+def test_render_releases_the_gil():
+    """While one thread renders, another runs Python code. With a switch interval of
+    100 s, a thread keeps the GIL until it blocks or releases it: if `render` held it,
+    the main thread could not run before the rendering thread had finished and set
+    `done`, and would count nothing; since `render` releases it, the main thread counts
+    to 100 000 while the render is still going (a path-traced 32×24 image at 256 spp)."""
+    import threading
+
+    scene = heron.Scene.from_dict(tomllib.loads(SMALL_SCENE))
+    inside = threading.Event()
+    done = threading.Event()
+    result = {}
+
+    def render():
+        inside.set()
+        try:
+            result["r"] = scene.render(spp=256, integrator="path", threads=1)
+        finally:
+            done.set()
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(100.0)
+    try:
+        t = threading.Thread(target=render)
+        t.start()
+        inside.wait()
+        count, target = 0, 100_000
+        while not done.is_set() and count < target:
+            count += 1
+        t.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert result["r"].spp == 256
+    assert count == target, f"counted only {count} while render ran"
+
+
 # --------------------------------------------------------------------------- example
 
 
