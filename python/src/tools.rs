@@ -147,7 +147,7 @@ pub fn sky_profile<'py>(
         let sky = profile::build_sky(&req).map_err(|e| lib_err(e, RENAMES))?;
         let (rows, cols) = (thetas.len(), lambdas.len());
         let table = py.detach(|| profile::profile_table(&sky, &lambdas, &thetas));
-        Ok(table.into_pyarray(py).reshape([rows, cols])?)
+        table.into_pyarray(py).reshape([rows, cols])
     })
 }
 
