@@ -4,7 +4,7 @@
 //! associative, so a sum carried in sample order gives different bits from the same
 //! samples summed in two halves and added. Sharded renders (`--shard K/N`, `heron
 //! merge`) must give the bytes of one render whatever N and the order of the parts, so
-//! every contribution is rounded once, on its own, to a fixed-point integer with 64
+//! every contribution is rounded once, on its own, to a fixed-point integer with 62
 //! fractional bits, and the integers are added with wrapping arithmetic, which is
 //! associative and commutative exactly. The sum is the same whichever way the samples
 //! are grouped; it is converted to f64 once, when the image is made.
@@ -12,10 +12,10 @@
 //! Range: a contribution must have |v| < 2⁴⁰ (≈ 1.1·10¹²; radiance of the sun's disk is
 //! ~2·10⁴ W m⁻² sr⁻¹ nm⁻¹) to be added; larger ones are counted with the non-finite
 //! samples and left out. A total of up to 2²³ such contributions to one pixel stays
-//! below 2⁶³, the range of the i128 sum, so wrapping can only occur past 8 million
-//! samples of the largest values in one pixel. Resolution: 2⁻⁶⁴ ≈ 5.4·10⁻²⁰, with
-//! rounding to nearest, so a contribution of 10⁻⁹ keeps 35 bits (the f32 it came from
-//! has 24).
+//! below 2⁶⁵, the range of the i128 sum, so wrapping can only occur past 8 million
+//! samples of the largest values in one pixel. Resolution: 2⁻⁶² ≈ 2.2·10⁻¹⁹ (values
+//! are truncated toward zero, so a contribution of 10⁻⁹ keeps 32 bits; the f32 it came
+//! from has 24).
 //!
 //! The idea is that of exact accumulators for reproducible summation (Kulisch's long
 //! accumulator; Demmel & Nguyen 2015, "Parallel reproducible summation", IEEE Trans.
@@ -23,38 +23,30 @@
 //! range.
 
 /// Fractional bits of a fixed-point sum.
-pub const FRAC_BITS: i32 = 64;
+pub const FRAC_BITS: i32 = 62;
 
 /// Contributions must be smaller than this in magnitude (2⁴⁰).
 pub const LIMIT: f32 = (1u64 << 40) as f32;
 
-/// `v` in fixed point, rounded to the nearest multiple of 2⁻⁶⁴ (ties away from zero);
-/// None when `v` is not finite or |v| ≥ 2⁴⁰.
+/// `v` in fixed point, truncated toward zero to a multiple of 2⁻⁶²; None when `v` is not
+/// finite or |v| ≥ 2⁴⁰.
+///
+/// Branch-free but for the range check: the integer part and the fraction of `v` (both
+/// exact in f64, since v has 24 significant bits and |v| < 2⁴⁰) become two i64s by
+/// truncating conversions, the fraction scaled by 2⁶² first (exact, a power of two).
+/// A bit-level shift of the significand by the exponent cost three times as many
+/// instructions (callgrind).
 #[inline]
 pub fn to_fixed(v: f32) -> Option<i128> {
-    let bits = v.to_bits();
-    let exp = ((bits >> 23) & 0xff) as i32;
-    // Zero and subnormals (< 2⁻¹²⁶) round to 0.
-    if exp == 0 {
-        return Some(0);
-    }
-    // 2⁴⁰ has biased exponent 167; 255 is infinity or NaN.
-    if exp >= 167 {
+    // False for NaN too.
+    if !(v.abs() < LIMIT) {
         return None;
     }
-    let m = ((bits & 0x7f_ffff) | 0x80_0000) as i128;
-    // v = m · 2^(exp − 150), so v · 2⁶⁴ = m · 2^(exp − 86).
-    let shift = exp - 86;
-    let mag = if shift >= 0 {
-        m << shift
-    } else if shift > -64 {
-        let s = -shift;
-        (m + (1 << (s - 1))) >> s
-    } else {
-        // Below 2⁻⁶⁶: rounds to 0 (m < 2²⁴ and the shift is at least 64).
-        0
-    };
-    Some(if bits >> 31 != 0 { -mag } else { mag })
+    let x = v as f64;
+    let int = x as i64;
+    let frac = x - int as f64;
+    let lo = (frac * (FRAC_BITS as f64).exp2()) as i64;
+    Some(((int as i128) << FRAC_BITS) + lo as i128)
 }
 
 /// All of `values` in fixed point, or None if any is out of range.
@@ -90,12 +82,16 @@ mod tests {
             let f = to_fixed(v).unwrap();
             assert_eq!(to_f64(f), v as f64, "{v}");
         }
-        // Rounded to nearest below the resolution.
-        assert_eq!(to_fixed(1.5 * 2f32.powi(-64)), Some(2));
-        assert_eq!(to_fixed(-1.5 * 2f32.powi(-64)), Some(-2));
-        assert_eq!(to_fixed(0.49 * 2f32.powi(-64)), Some(0));
+        // Truncated toward zero below the resolution, symmetrically.
+        let r = 2f32.powi(-FRAC_BITS);
+        assert_eq!(to_fixed(1.5 * r), Some(1));
+        assert_eq!(to_fixed(-1.5 * r), Some(-1));
+        assert_eq!(to_fixed(0.49 * r), Some(0));
         assert_eq!(to_fixed(1e-30), Some(0));
         assert_eq!(to_fixed(f32::MIN_POSITIVE / 4.0), Some(0));
+        // Integer and fraction parts meet exactly.
+        assert_eq!(to_fixed(-2.75), Some(-(11i128 << (FRAC_BITS - 2))));
+        assert_eq!(to_fixed(3.0e9 + 256.0), Some(3_000_000_256i128 << FRAC_BITS));
     }
 
     #[test]
