@@ -64,14 +64,14 @@ print_logs() {
 
 # Kill the daemon whose pid is in FILE (if it is still that daemon), wait for it to exit.
 stop_pid() {
-  local file=$1 name=$2 pid i
+  local file=$1 name=$2 pid
   [ -f "$file" ] || return 0
   pid=$(cat "$file")
   [ -n "$pid" ] || return 0
   # Only signal the process if it is still the program we started (pids are reused).
   if [ -r "/proc/$pid/comm" ] && grep -q "^$name" "/proc/$pid/comm"; then
     kill -TERM "$pid" 2>/dev/null || true
-    for i in $(seq 1 50); do
+    for _ in $(seq 1 50); do
       [ -e "/proc/$pid" ] || break
       sleep 0.2
     done
@@ -88,7 +88,7 @@ start() {
   need_tools
   local dir=${1:-}
   if [ -z "$dir" ]; then
-    dir=$(mktemp -d /tmp/heron-slurm.XXXXXX)
+    dir=$(mktemp -d "${TMPDIR:-/tmp}/heron-slurm.XXXXXX")
   else
     mkdir -p "$dir"
     [ -z "$(ls -A "$dir")" ] || die "$dir is not empty"
@@ -178,8 +178,8 @@ EOF
   setsid slurmd -D -N "$host" -f "$SLURM_CONF" >"$dir/log/slurmd.out" 2>&1 </dev/null &
   echo $! >"$dir/slurmd.daemon.pid"
 
-  local state="" i
-  for i in $(seq 1 $((START_TIMEOUT * 2))); do
+  local state=""
+  for _ in $(seq 1 $((START_TIMEOUT * 2))); do
     for d in slurmctld slurmd; do
       if ! kill -0 "$(cat "$dir/$d.daemon.pid")" 2>/dev/null; then
         print_logs "$dir" >&2
@@ -226,8 +226,7 @@ stop() {
   # Cancel what is still queued or running, so no job step outlives slurmd.
   if [ -f "$dir/slurmctld.daemon.pid" ] && kill -0 "$(cat "$dir/slurmctld.daemon.pid")" 2>/dev/null; then
     scancel --full --quiet --user=root 2>/dev/null || true
-    local i
-    for i in $(seq 1 $((STOP_TIMEOUT * 2))); do
+    for _ in $(seq 1 $((STOP_TIMEOUT * 2))); do
       [ -z "$(squeue --noheader --format=%i --states=PD,R,CG,S 2>/dev/null)" ] && break
       sleep 0.5
     done
