@@ -1,16 +1,23 @@
 #!/usr/bin/env bash
 # Creates the project's Python environment <repo>/.venv (git-ignored) with exactly the
 # pinned packages of tests/python/requirements.txt: colour-science and friends for the
-# colour checks in tests/python and for scripts/gen_spectra.py, and Mitsuba 3 (with
-# Dr.Jit), the reference renderer for the path tracer comparison tests and benchmarks.
+# colour checks in tests/python and for scripts/gen_spectra.py, Mitsuba 3 (with
+# Dr.Jit), the reference renderer for the path tracer comparison tests and benchmarks,
+# and maturin; then builds heron's Python module `heron` (python/, PyO3) with that
+# maturin and installs it into .venv.
 #
 # Idempotent: .venv/.requirements.sha256 records the sha256 of the requirements file the
-# environment was built from; when it matches, nothing is done. When it differs (or the
-# environment is broken) .venv is removed and built again, so no package of an older
-# requirements file is left behind.
+# environment was built from; when it matches, the packages are left as they are. When
+# it differs (or the environment is broken) .venv is removed and built again, so no
+# package of an older requirements file is left behind. The module is built every time
+# (in release, into target/python; a no-op cargo build when nothing changed) and
+# installed when its wheel differs from the one installed (.venv/.heron-wheel.sha256):
+# maturin writes wheels with fixed timestamps, so unchanged sources give the same bytes.
 #
-# Downloads nothing except through pip (from PyPI, or pip's configured find-links).
-# Needs python3 >= 3.11 with the venv module (Debian: apt-get install python3-venv).
+# Downloads nothing except through pip (from PyPI, or pip's configured find-links) and
+# cargo (the module's crates, pinned by python/Cargo.lock, from crates.io).
+# Needs python3 >= 3.11 with the venv module (Debian: apt-get install python3-venv), a
+# Rust toolchain (cargo), and Embree as heron itself does (scripts/setup.sh).
 #
 # Environment: PYTHON (default python3) picks the interpreter that creates the venv.
 set -euo pipefail
@@ -39,9 +46,44 @@ fi
 
 want="$("$PYTHON" -c 'import hashlib, sys; print(hashlib.sha256(open(sys.argv[1], "rb").read()).hexdigest())' "$REQ")"
 
+# heron's own module, built and installed after the packages (see the top).
+install_module() {
+    local wheels="$ROOT/target/python/wheels" wheel have sha
+    local wheel_stamp="$VENV/.heron-wheel.sha256"
+    if ! command -v cargo >/dev/null 2>&1; then
+        die "cargo not found: the Python module heron (python/) is built from Rust; install a Rust toolchain (1.80 or newer)"
+    fi
+    log "building the Python module heron (python/, maturin build --release, into target/python)"
+    rm -rf "$wheels"
+    # A target directory of its own: the module's crate has other dependencies (PyO3)
+    # and its own release profile, and must not disturb the root crate's target/release.
+    if ! CARGO_TARGET_DIR="$ROOT/target/python" "$VENV/bin/maturin" build --release --locked \
+        --manifest-path "$ROOT/python/Cargo.toml" --interpreter "$VENV/bin/python" \
+        --out "$wheels"; then
+        die "maturin could not build the Python module (see cargo's message above)"
+    fi
+    wheel="$(ls "$wheels"/heron-*.whl)"
+    sha="$("$VENV/bin/python" -c 'import hashlib, sys; print(hashlib.sha256(open(sys.argv[1], "rb").read()).hexdigest())' "$wheel")"
+    have="$(cat "$wheel_stamp" 2>/dev/null || true)"
+    if [ "$have" = "$sha" ] && "$VENV/bin/python" -c 'import heron' >/dev/null 2>&1; then
+        log "the installed module heron is this build's (wheel sha256 ${sha:0:12}…)"
+        return
+    fi
+    rm -f "$wheel_stamp"
+    if ! "$VENV/bin/python" -m pip install --no-deps --force-reinstall --no-index "$wheel"; then
+        die "pip could not install $wheel"
+    fi
+    if ! "$VENV/bin/python" -c 'import heron; heron.ior("water", [589.0])'; then
+        die "the module heron does not import after installing $wheel (see the traceback above)"
+    fi
+    echo "$sha" >"$wheel_stamp"
+    log "installed the module heron ($(basename "$wheel")); try: .venv/bin/python -c 'import heron; help(heron)'"
+}
+
 if [ -f "$STAMP" ] && [ "$(cat "$STAMP")" = "$want" ] \
     && "$VENV/bin/python" -c 'import sys' >/dev/null 2>&1; then
-    log "$VENV is up to date with tests/python/requirements.txt (sha256 ${want:0:12}…); nothing to do"
+    log "$VENV is up to date with tests/python/requirements.txt (sha256 ${want:0:12}…)"
+    install_module
     exit 0
 fi
 
@@ -88,6 +130,10 @@ if ! "$VENV/bin/python" -c 'import colour, numpy, scipy, OpenEXR, OpenImageIO, P
 import mitsuba as mi; mi.set_variant("scalar_spectral")' ; then
     die "the installed packages do not import (see the traceback above)"
 fi
+if ! "$VENV/bin/maturin" --version >/dev/null; then
+    die "maturin does not run (see the message above)"
+fi
 
 echo "$want" >"$STAMP"
+install_module
 log "done: $("$VENV/bin/python" -c 'import colour; print("colour-science", colour.__version__)'); run the checks with: .venv/bin/python -m pytest tests/python"

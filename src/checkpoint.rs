@@ -1,39 +1,90 @@
-//! Checkpoints of a render in progress (`heron render --checkpoint FILE`, `--resume FILE`).
+//! The film's state as a file: checkpoints of a render in progress (`heron render
+//! --checkpoint FILE`, `--resume FILE`) and the parts of a sharded render (`heron render
+//! --shard K/N -o part.heronfilm`, `heron merge`).
 //!
-//! A render runs in passes of samples (`render.rs`); after a pass the film's running
-//! sums are complete for the samples so far. A checkpoint holds those sums, the passes
-//! done and the settings that determine the image, so a render killed at any moment
-//! (even with `kill -9`: the file is written to a temporary name and renamed, so it is
-//! always a whole checkpoint) resumes where the last checkpoint left it, and finishes
-//! with the same bytes as a render that was never interrupted: every pixel's sums are
-//! accumulated in sample order across passes.
+//! A render runs in passes of samples (`render.rs`); after a pass the film's sums are
+//! complete for the samples so far. The state holds those sums (fixed point, so that
+//! they do not depend on how the samples were grouped: `film/fixed.rs`), the passes done
+//! and the settings that determine the image. A render killed at any moment (even with
+//! `kill -9`: the file is written to a temporary name and renamed) resumes where the
+//! last checkpoint left it and finishes with the same bytes as a render never
+//! interrupted; and the parts of a sharded render add up, in any order, to the sums of
+//! one render with all the samples.
 //!
-//! File layout: the line `heron-checkpoint 1`, a line of JSON with the settings key,
+//! File layout: the line `heron-film 1`; a line of JSON with `settings` (the settings
+//! key), `shard` ([K, N] or null), `width`, `height`, `anySplat` and `xyzChannels`;
 //! then little-endian binary: passes done, samples per pixel done (u32 each), camera and
-//! shadow rays and non-finite samples (u64 each), then the arrays XYZ sums (f64, 3 per
-//! pixel), spectral bin sums (f64), finite-sample counts (u32 per pixel), splatted XYZ
-//! (f64, 3 per pixel) and splatted bins (f64).
+//! shadow rays and non-finite samples (u64 each), the four array lengths (u64), then
+//! XYZ sums (i128, 3 per pixel), splatted XYZ (i128, 3 per pixel), spectral bin sums
+//! (i128), splatted bins (i128) and finite-sample counts (u32 per pixel).
+use crate::film::fixed::to_f64;
+use crate::film::{Film, SpectralBins};
 use crate::{HeronError, Result};
 use std::path::Path;
 
-const MAGIC: &str = "heron-checkpoint 1\n";
+const MAGIC: &str = "heron-film 1\n";
+const OLD_MAGIC: &str = "heron-checkpoint 1\n";
 
-/// The film's running state after some passes.
+/// Shard `index` of `count`: its share of every pixel's sample indices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl Shard {
+    /// Parses `K/N` (0 ≤ K < N).
+    pub fn parse(s: &str) -> std::result::Result<Shard, String> {
+        let bad = || format!("expected K/N with 0 <= K < N (e.g. 0/4), got {s:?}");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let index: u32 = k.trim().parse().map_err(|_| bad())?;
+        let count: u32 = n.trim().parse().map_err(|_| bad())?;
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The sample indices of this shard out of `spp`: the contiguous range
+    /// [⌊K·spp/N⌋, ⌊(K+1)·spp/N⌋). Contiguous ranges keep the Sobol' points of a
+    /// pixel in their order, and the shards together are exactly 0..spp.
+    pub fn samples(&self, spp: u32) -> std::ops::Range<u32> {
+        let at = |k: u32| (k as u64 * spp as u64 / self.count as u64) as u32;
+        at(self.index)..at(self.index + 1)
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// The film's unnormalised state after some passes.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Checkpoint {
     /// The settings that determine the image, as a JSON object (see `render.rs`); a
-    /// resume must match it key by key.
+    /// resume, and every part of a merge, must match it key by key.
     pub key: serde_json::Map<String, serde_json::Value>,
+    /// The shard this film holds (None: all the samples).
+    pub shard: Option<Shard>,
+    pub width: u32,
+    pub height: u32,
+    /// Whether splats count in the image (the integrator splats, or a sample splatted).
+    pub any_splat: bool,
+    /// Whether the EXR made from this film has the X, Y, Z channels (`--xyz`).
+    pub xyz_channels: bool,
     pub passes_done: u32,
+    /// Samples per pixel held (of this shard's range).
     pub spp_done: u32,
     pub rays: u64,
     pub shadow_rays: u64,
     pub nonfinite: u64,
-    pub sum_xyz: Vec<[f64; 3]>,
-    pub sum_bins: Vec<f64>,
+    pub sum_xyz: Vec<[i128; 3]>,
+    pub sum_bins: Vec<i128>,
     pub good: Vec<u32>,
-    pub splat: Vec<[f64; 3]>,
-    pub splat_bins: Vec<f64>,
+    pub splat: Vec<[i128; 3]>,
+    pub splat_bins: Vec<i128>,
 }
 
 fn err(path: &Path, message: impl Into<String>) -> HeronError {
@@ -48,11 +99,15 @@ impl Checkpoint {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut b = Vec::new();
         b.extend_from_slice(MAGIC.as_bytes());
-        b.extend_from_slice(
-            serde_json::Value::Object(self.key.clone())
-                .to_string()
-                .as_bytes(),
-        );
+        let header = serde_json::json!({
+            "settings": serde_json::Value::Object(self.key.clone()),
+            "shard": self.shard.map(|s| [s.index, s.count]),
+            "width": self.width,
+            "height": self.height,
+            "anySplat": self.any_splat,
+            "xyzChannels": self.xyz_channels,
+        });
+        b.extend_from_slice(header.to_string().as_bytes());
         b.push(b'\n');
         for v in [self.passes_done, self.spp_done] {
             b.extend_from_slice(&v.to_le_bytes());
@@ -82,38 +137,85 @@ impl Checkpoint {
 
     /// Reads a checkpoint; every error names the file and what was wrong.
     pub fn read(path: &Path) -> Result<Checkpoint> {
-        let bytes = std::fs::read(path)
-            .map_err(|e| err(path, format!("cannot read the checkpoint: {e}")))?;
-        Self::from_bytes(&bytes).map_err(|m| err(path, format!("not a heron checkpoint: {m}")))
+        Self::read_as(path, "checkpoint")
+    }
+
+    /// Reads a film file; errors call it `what` ("checkpoint", "film file").
+    pub fn read_as(path: &Path, what: &str) -> Result<Checkpoint> {
+        let bytes =
+            std::fs::read(path).map_err(|e| err(path, format!("cannot read the {what}: {e}")))?;
+        Self::from_bytes(&bytes).map_err(|m| err(path, format!("not a heron {what}: {m}")))
     }
 
     fn from_bytes(bytes: &[u8]) -> std::result::Result<Checkpoint, String> {
+        if bytes.starts_with(OLD_MAGIC.as_bytes()) {
+            return Err(
+                "it was written by an older heron (heron-checkpoint 1); render again".into(),
+            );
+        }
         let rest = bytes
             .strip_prefix(MAGIC.as_bytes())
-            .ok_or("expected the first line \"heron-checkpoint 1\"")?;
+            .ok_or("expected the first line \"heron-film 1\"")?;
         let nl = rest
             .iter()
             .position(|&c| c == b'\n')
-            .ok_or("no settings line")?;
-        let key = match serde_json::from_slice(&rest[..nl]) {
-            Ok(serde_json::Value::Object(m)) => m,
-            _ => return Err("the settings line is not a JSON object".into()),
+            .ok_or("no header line")?;
+        let header: serde_json::Value =
+            serde_json::from_slice(&rest[..nl]).map_err(|_| "the header line is not JSON")?;
+        let bad = |k: &str| format!("the header's {k:?} is missing or of the wrong type");
+        let key = match header.get("settings") {
+            Some(serde_json::Value::Object(m)) => m.clone(),
+            _ => return Err(bad("settings")),
         };
+        let u32_of = |k: &str| -> std::result::Result<u32, String> {
+            header
+                .get(k)
+                .and_then(|v| v.as_u64())
+                .and_then(|v| u32::try_from(v).ok())
+                .ok_or_else(|| bad(k))
+        };
+        let bool_of = |k: &str| {
+            header
+                .get(k)
+                .and_then(|v| v.as_bool())
+                .ok_or_else(|| bad(k))
+        };
+        let shard = match header.get("shard") {
+            Some(serde_json::Value::Null) => None,
+            Some(v) => {
+                let s: [u32; 2] = serde_json::from_value(v.clone()).map_err(|_| bad("shard"))?;
+                if s[1] == 0 || s[0] >= s[1] {
+                    return Err(bad("shard"));
+                }
+                Some(Shard {
+                    index: s[0],
+                    count: s[1],
+                })
+            }
+            None => return Err(bad("shard")),
+        };
+        let (width, height) = (u32_of("width")?, u32_of("height")?);
+        let (any_splat, xyz_channels) = (bool_of("anySplat")?, bool_of("xyzChannels")?);
         let mut r = Reader { b: &rest[nl + 1..] };
         let passes_done = r.u32()?;
         let spp_done = r.u32()?;
         let (rays, shadow_rays, nonfinite) = (r.u64()?, r.u64()?, r.u64()?);
         let (n_xyz, n_bins, n_splat, n_splat_bins) = (r.len()?, r.len()?, r.len()?, r.len()?);
-        let mut triples = |n: usize| -> std::result::Result<Vec<[f64; 3]>, String> {
-            (0..n).map(|_| Ok([r.f64()?, r.f64()?, r.f64()?])).collect()
+        if n_xyz as u64 != width as u64 * height as u64 || n_splat != n_xyz {
+            return Err(format!("its arrays do not fit its {width}x{height} image"));
+        }
+        let mut triples = |n: usize| -> std::result::Result<Vec<[i128; 3]>, String> {
+            (0..n)
+                .map(|_| Ok([r.i128()?, r.i128()?, r.i128()?]))
+                .collect()
         };
         let sum_xyz = triples(n_xyz)?;
         let splat = triples(n_splat)?;
         let sum_bins = (0..n_bins)
-            .map(|_| r.f64())
+            .map(|_| r.i128())
             .collect::<std::result::Result<_, _>>()?;
         let splat_bins = (0..n_splat_bins)
-            .map(|_| r.f64())
+            .map(|_| r.i128())
             .collect::<std::result::Result<_, _>>()?;
         let good = (0..n_xyz)
             .map(|_| r.u32())
@@ -123,6 +225,11 @@ impl Checkpoint {
         }
         Ok(Checkpoint {
             key,
+            shard,
+            width,
+            height,
+            any_splat,
+            xyz_channels,
             passes_done,
             spp_done,
             rays,
@@ -136,11 +243,11 @@ impl Checkpoint {
         })
     }
 
-    /// Writes the checkpoint atomically: a temporary file in the same folder, renamed.
+    /// Writes the file atomically: a temporary file in the same folder, renamed.
     pub fn write(&self, path: &Path) -> Result<()> {
         let bytes = self.to_bytes();
         crate::film::Staged::write(path, |tmp| {
-            std::fs::write(tmp, &bytes).map_err(|e| format!("cannot write the checkpoint: {e}"))
+            std::fs::write(tmp, &bytes).map_err(|e| format!("cannot write the film state: {e}"))
         })?
         .commit()
     }
@@ -148,22 +255,221 @@ impl Checkpoint {
     /// None if `key` matches this checkpoint's settings, else the first key that differs
     /// as "key: checkpoint value, this render value".
     pub fn mismatch(&self, key: &serde_json::Map<String, serde_json::Value>) -> Option<String> {
+        self.differs(key, "in the checkpoint", "in this render")
+    }
+
+    /// The first setting in which this film and `key` differ, as "key: A <mine>, B <theirs>".
+    fn differs(
+        &self,
+        key: &serde_json::Map<String, serde_json::Value>,
+        mine: &str,
+        theirs: &str,
+    ) -> Option<String> {
+        // The provenance's settings first (in their order: spp before the pass size it
+        // implies), then the rest by name.
+        let rank = |k: &str| crate::provenance::KEYS.iter().position(|&p| p == k);
         let mut names: Vec<&String> = self.key.keys().chain(key.keys()).collect();
-        names.sort();
+        names.sort_by(|a, b| match (rank(a), rank(b)) {
+            (Some(x), Some(y)) => x.cmp(&y),
+            (Some(_), None) => std::cmp::Ordering::Less,
+            (None, Some(_)) => std::cmp::Ordering::Greater,
+            (None, None) => a.cmp(b),
+        });
         names.dedup();
         names.into_iter().find_map(|k| {
             let (a, b) = (self.key.get(k), key.get(k));
             (a != b).then(|| {
                 let show =
                     |v: Option<&serde_json::Value>| v.map_or("(none)".into(), |v| v.to_string());
-                format!(
-                    "{k}: {} in the checkpoint, {} in this render",
-                    show(a),
-                    show(b)
-                )
+                format!("{k}: {} {mine}, {} {theirs}", show(a), show(b))
             })
         })
     }
+
+    /// The samples per pixel this film should hold when complete: its shard's share of
+    /// the render's spp (all of it without a shard).
+    pub fn spp_expected(&self) -> Option<u32> {
+        let spp: u32 = self.key.get("spp")?.as_str()?.parse().ok()?;
+        Some(match self.shard {
+            Some(s) => s.samples(spp).len() as u32,
+            None => spp,
+        })
+    }
+
+    /// The image: each pixel's mean over its finite samples, plus the splats divided by
+    /// the samples per pixel (a splat estimates the whole image per pixel sample).
+    pub fn film(&self) -> Film {
+        let npix = self.sum_xyz.len();
+        let nb = self.sum_bins.len().checked_div(npix).unwrap_or(0);
+        let inv = |n: u32| if n > 0 { 1.0 / n as f64 } else { 0.0 };
+        let inv_spp = 1.0 / self.spp_done.max(1) as f64;
+        let any_splat = self.any_splat;
+        let mean = |sum: i128, n: u32, splat: Option<i128>| -> f32 {
+            let v = to_f64(sum) * inv(n);
+            match splat {
+                Some(s) if any_splat => (v + to_f64(s) * inv_spp) as f32,
+                _ => v as f32,
+            }
+        };
+        let xyz = (0..npix)
+            .map(|i| {
+                std::array::from_fn(|j| {
+                    mean(self.sum_xyz[i][j], self.good[i], Some(self.splat[i][j]))
+                })
+            })
+            .collect();
+        let spectral = (nb > 0).then(|| {
+            let data = (0..npix * nb)
+                .map(|j| {
+                    mean(
+                        self.sum_bins[j],
+                        self.good[j / nb],
+                        self.splat_bins.get(j).copied(),
+                    )
+                })
+                .collect();
+            (SpectralBins { count: nb }, data)
+        });
+        Film {
+            width: self.width,
+            height: self.height,
+            xyz,
+            spectral,
+        }
+    }
+
+    /// Adds another part's sums and counts to this one's. Integer sums, so the result
+    /// does not depend on the order of the parts.
+    fn add(&mut self, o: &Checkpoint) {
+        let add3 = |a: &mut [i128; 3], b: &[i128; 3]| {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.wrapping_add(*y);
+            }
+        };
+        for (a, b) in self.sum_xyz.iter_mut().zip(&o.sum_xyz) {
+            add3(a, b);
+        }
+        for (a, b) in self.splat.iter_mut().zip(&o.splat) {
+            add3(a, b);
+        }
+        for (a, b) in self.sum_bins.iter_mut().zip(&o.sum_bins) {
+            *a = a.wrapping_add(*b);
+        }
+        for (a, b) in self.splat_bins.iter_mut().zip(&o.splat_bins) {
+            *a = a.wrapping_add(*b);
+        }
+        for (a, b) in self.good.iter_mut().zip(&o.good) {
+            *a += b;
+        }
+        self.any_splat |= o.any_splat;
+        self.passes_done += o.passes_done;
+        self.spp_done += o.spp_done;
+        self.rays += o.rays;
+        self.shadow_rays += o.shadow_rays;
+        self.nonfinite += o.nonfinite;
+    }
+}
+
+/// Merges the parts of a sharded render (`heron merge`): every shard K/N of one render
+/// exactly once, each complete. The result is the film of one render with all the
+/// samples, bit for bit, in whatever order the parts come. Errors name the part.
+pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
+    let (first_path, first) = parts
+        .first()
+        .ok_or_else(|| HeronError::Invalid("merge: expected at least one film file".into()))?;
+    let shard_of = |p: &Path, c: &Checkpoint| -> Result<Shard> {
+        Ok(c.shard.unwrap_or(Shard { index: 0, count: 1 })).and_then(|s| {
+            if c.shard.is_none() && parts.len() > 1 {
+                Err(err(
+                    p,
+                    "holds a whole render, not a shard (made without --shard)",
+                ))
+            } else {
+                Ok(s)
+            }
+        })
+    };
+    let n = shard_of(first_path, first)?.count;
+    let mut owner: Vec<Option<&Path>> = vec![None; n as usize];
+    for (p, c) in parts {
+        let s = shard_of(p, c)?;
+        if s.count != n {
+            return Err(err(
+                p,
+                format!(
+                    "is shard {s}, but {} is a shard of {n}: the parts come from different splits",
+                    first_path.display()
+                ),
+            ));
+        }
+        if let Some(m) = c.differs(&first.key, "here", &format!("in {}", first_path.display())) {
+            return Err(err(p, format!("is from another render ({m})")));
+        }
+        if (c.width, c.height, c.sum_bins.len(), c.splat_bins.len())
+            != (
+                first.width,
+                first.height,
+                first.sum_bins.len(),
+                first.splat_bins.len(),
+            )
+            || c.xyz_channels != first.xyz_channels
+        {
+            return Err(err(
+                p,
+                format!("its film does not fit {}'s", first_path.display()),
+            ));
+        }
+        let want = c
+            .spp_expected()
+            .ok_or_else(|| err(p, "its settings have no spp"))?;
+        if c.spp_done != want {
+            return Err(err(
+                p,
+                format!(
+                    "shard {s} is incomplete: it holds {} of its {want} samples per pixel (finish it with heron render --resume {})",
+                    c.spp_done,
+                    p.display()
+                ),
+            ));
+        }
+        if let Some(q) = owner[s.index as usize] {
+            return Err(err(p, format!("is shard {s}, and so is {}", q.display())));
+        }
+        owner[s.index as usize] = Some(p);
+    }
+    let missing: Vec<String> = owner
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.is_none())
+        .map(|(k, _)| format!("{k}/{n}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(HeronError::Invalid(format!(
+            "merge: missing shard{} {} (no part given holds {})",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", "),
+            if missing.len() > 1 { "them" } else { "it" }
+        )));
+    }
+    let mut total = Checkpoint {
+        shard: None,
+        passes_done: 0,
+        spp_done: 0,
+        rays: 0,
+        shadow_rays: 0,
+        nonfinite: 0,
+        any_splat: false,
+        sum_xyz: vec![[0; 3]; first.sum_xyz.len()],
+        splat: vec![[0; 3]; first.splat.len()],
+        sum_bins: vec![0; first.sum_bins.len()],
+        splat_bins: vec![0; first.splat_bins.len()],
+        good: vec![0; first.good.len()],
+        ..first.clone()
+    };
+    for (_, c) in parts {
+        total.add(c);
+    }
+    Ok(total)
 }
 
 struct Reader<'a> {
@@ -185,8 +491,8 @@ impl Reader<'_> {
     fn u64(&mut self) -> std::result::Result<u64, String> {
         Ok(u64::from_le_bytes(self.take()?))
     }
-    fn f64(&mut self) -> std::result::Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take()?))
+    fn i128(&mut self) -> std::result::Result<i128, String> {
+        Ok(i128::from_le_bytes(self.take()?))
     }
     /// An array length, bounded by what is left of the file (so a corrupt length cannot
     /// ask for an absurd allocation).
@@ -209,15 +515,20 @@ mod tests {
         key.insert("spp".into(), 64.into());
         let c = Checkpoint {
             key,
+            shard: Some(Shard { index: 1, count: 3 }),
+            width: 2,
+            height: 1,
+            any_splat: true,
+            xyz_channels: true,
             passes_done: 3,
             spp_done: 12,
             rays: 5,
             shadow_rays: 6,
             nonfinite: 1,
-            sum_xyz: vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.5]],
-            sum_bins: vec![0.25; 4],
+            sum_xyz: vec![[1, -2, 3 << 90], [4, 5, i128::MIN]],
+            sum_bins: vec![7; 4],
             good: vec![12, 11],
-            splat: vec![[0.5; 3]; 2],
+            splat: vec![[-9; 3]; 2],
             splat_bins: vec![],
         };
         let b = c.to_bytes();
@@ -232,5 +543,26 @@ mod tests {
             "spp: 64 in the checkpoint, 128 in this render"
         );
         assert_eq!(c.mismatch(&c.key), None);
+    }
+
+    #[test]
+    fn shards_split_the_samples_exactly() {
+        for spp in [1u32, 2, 5, 16, 1000, u32::MAX] {
+            for n in [1u32, 2, 3, 7, 64] {
+                let mut next = 0u32;
+                for k in 0..n {
+                    let r = Shard { index: k, count: n }.samples(spp);
+                    assert_eq!(r.start, next, "spp {spp}, shard {k}/{n}");
+                    assert!(r.len() as u64 * n as u64 <= spp as u64 + n as u64);
+                    next = r.end;
+                }
+                assert_eq!(next, spp);
+            }
+        }
+        assert_eq!(Shard::parse("2/5"), Ok(Shard { index: 2, count: 5 }));
+        for bad in ["5/5", "1/0", "-1/3", "1", "a/b", "1/2/3"] {
+            let e = Shard::parse(bad).unwrap_err();
+            assert!(e.contains("expected K/N"), "{bad}: {e}");
+        }
     }
 }

@@ -3,7 +3,7 @@
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
 use heron::film::{exr::stage_exr, png::stage_png};
-use heron::render::{render, RenderOptions};
+use heron::render::{render_state, RenderOptions};
 use heron::scene::load_scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -22,8 +22,13 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview.
+    /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview, or (with -o
+    /// FILE.heronfilm, e.g. one shard of a render) to a film file for heron merge.
     Render(RenderArgs),
+    /// Merge the film files of a sharded render (heron render --shard K/N -o
+    /// part-K.heronfilm) into its EXR and PNG: byte-identical to one heron render with all
+    /// the samples, whatever the number of shards and the order of the parts.
+    Merge(MergeArgs),
     /// Follow one ray at one wavelength through a scene and print its events as JSON.
     Trace(TraceArgs),
     /// Run time against error: render a reference, then each (lanes, spp) setting, and
@@ -312,9 +317,14 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 struct RenderArgs {
     /// Scene file (TOML).
     scene: PathBuf,
-    /// Output EXR path; the PNG preview goes next to it with the extension .png.
+    /// Output EXR path; the PNG preview goes next to it with the extension .png. A path
+    /// ending in .heronfilm writes the film's unnormalised sums instead (for heron merge).
     #[arg(short, long)]
     output: PathBuf,
+    /// Render shard K of N (0 ≤ K < N): sample indices ⌊K·spp/N⌋ to ⌊(K+1)·spp/N⌋ − 1 of
+    /// every pixel, into a .heronfilm file; heron merge adds the N parts up.
+    #[arg(long, value_name = "K/N", value_parser = heron::checkpoint::Shard::parse)]
+    shard: Option<heron::checkpoint::Shard>,
     /// Samples per pixel (overrides the scene's render.spp).
     #[arg(long)]
     spp: Option<u32>,
@@ -397,6 +407,19 @@ struct RenderArgs {
     quiet: bool,
 }
 
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// The film files of every shard K/N of one render, in any order.
+    #[arg(required = true, num_args = 1..)]
+    parts: Vec<PathBuf>,
+    /// Output EXR path; the PNG preview goes next to it with the extension .png.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Do not write the PNG preview.
+    #[arg(long)]
+    no_png: bool,
+}
+
 fn parse_lanes(s: &str) -> std::result::Result<usize, String> {
     match s {
         "1" => Ok(1),
@@ -444,6 +467,7 @@ fn main() {
     };
     let result = match cli.command {
         Command::Render(args) => cmd_render(args),
+        Command::Merge(args) => cmd_merge(args),
         Command::Trace(args) => cmd_trace(args),
         Command::Converge(args) => cmd_converge(args),
         Command::Bench(BenchCommand::Traversal(args)) => cmd_bench_traversal(args),
@@ -464,21 +488,38 @@ fn main() {
     }
 }
 
-fn cmd_render(args: RenderArgs) -> Result<()> {
-    let exr_path = args.output;
-    if exr_path.extension().and_then(|e| e.to_str()) != Some("exr") {
+/// Checks that `path` ends in one of `exts` and that its folder exists; returns the
+/// extension.
+fn check_output(path: &Path, exts: &[&str]) -> Result<String> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !exts.contains(&ext) {
+        let want: Vec<String> = exts.iter().map(|e| format!(".{e}")).collect();
         bail!(
-            "--output {}: expected a path ending in .exr",
-            exr_path.display()
+            "--output {}: expected a path ending in {}",
+            path.display(),
+            want.join(" or ")
         );
     }
-    let dir = exr_path.parent().filter(|p| !p.as_os_str().is_empty());
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
     if let Some(d) = dir {
         if !d.is_dir() {
             bail!(
                 "--output {}: folder {} does not exist",
-                exr_path.display(),
+                path.display(),
                 d.display()
+            );
+        }
+    }
+    Ok(ext.to_string())
+}
+
+fn cmd_render(args: RenderArgs) -> Result<()> {
+    let exr_path = args.output;
+    let to_film = check_output(&exr_path, &["exr", "heronfilm"])? == "heronfilm";
+    if let Some(s) = args.shard {
+        if !to_film {
+            bail!(
+                "--shard {s}: expected --output to end in .heronfilm (a shard is a part for heron merge, not an image)"
             );
         }
     }
@@ -540,6 +581,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if let Some(r) = &args.resume {
         opts.resume = Some(Arc::new(heron::checkpoint::Checkpoint::read(r)?));
     }
+    opts.shard = args.shard;
     // Ctrl-C finishes the current pass and writes what it has (status 130); a second
     // Ctrl-C exits at once.
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -561,29 +603,28 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
             b.set_position(done);
         }));
     }
-    let (film, stats) = render(&scene, &opts)?;
+    let (mut state, stats) = render_state(&scene, &opts)?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    // Both files are staged first and renamed into place together: an error in either
-    // leaves neither behind.
-    let channels = heron::film::exr::ExrChannels {
-        xyz: args.xyz,
-        spectral: args.spectral_bins.is_some(),
-    };
-    let provenance = heron::provenance::Provenance::of_render(&scene, &opts, stats.spp);
-    let exr = stage_exr(&film, &exr_path, channels, &provenance)?;
-    let png = if args.no_png {
-        None
+    state.xyz_channels = args.xyz;
+    let film = state.film();
+    if to_film {
+        // The sums as they are: heron merge (or --resume, if the render stopped early)
+        // carries on from them.
+        state.write(&exr_path)?;
     } else {
-        Some(stage_png(&film, &exr_path.with_extension("png"))?)
-    };
-    exr.commit()?;
-    if let Some(p) = png {
-        p.commit()?;
+        // From the settings key, as heron merge does: the same header either way (the
+        // key records what ran, e.g. no packets for light tracing).
+        let provenance = heron::provenance::Provenance::from_key(&state.key, stats.spp)
+            .expect("the settings key holds the provenance");
+        write_image(&film, &exr_path, &state, &provenance, args.no_png)?;
     }
+    let shard = args
+        .shard
+        .map_or(String::new(), |s| format!(" (shard {s})"));
     eprintln!(
-        "{}: {}x{} at {} spp, {} lanes, {}, {} (kernel {}) in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
+        "{}{shard}: {}x{} at {} spp, {} lanes, {}, {} (kernel {}) in {:.3} s: {} rays ({} camera/continued, {} shadow), {:.2} Mrays/s, {} non-finite samples",
         display(&exr_path),
         film.width,
         film.height,
@@ -621,12 +662,21 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         } else {
             "time limit reached"
         };
+        let want = opts
+            .shard
+            .map_or(opts.spp, |s| s.samples(opts.spp).len() as u32);
+        // A film file is a checkpoint too.
+        let resume = match &opts.checkpoint {
+            Some((c, _)) => Some(c.as_path()),
+            None if to_film => Some(exr_path.as_path()),
+            None => None,
+        };
         eprintln!(
-            "{why}: the image holds {} of {} spp per pixel{}",
+            "{why}: the {} holds {} of {want} spp per pixel{}",
+            if to_film { "film" } else { "image" },
             stats.spp,
-            opts.spp,
-            match &opts.checkpoint {
-                Some((c, _)) => format!("; continue with --resume {}", display(c)),
+            match resume {
+                Some(c) => format!("; continue with --resume {}", display(c)),
                 None => String::new(),
             }
         );
@@ -637,6 +687,70 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if args.check_finite && stats.nonfinite > 0 {
         std::process::exit(3);
     }
+    Ok(())
+}
+
+/// Writes the EXR and (unless `no_png`) the PNG of `film`. Both files are staged first
+/// and renamed into place together: an error in either leaves neither behind.
+fn write_image(
+    film: &heron::film::Film,
+    exr_path: &Path,
+    state: &heron::checkpoint::Checkpoint,
+    provenance: &heron::provenance::Provenance,
+    no_png: bool,
+) -> Result<()> {
+    let channels = heron::film::exr::ExrChannels {
+        xyz: state.xyz_channels,
+        spectral: film.spectral.is_some(),
+    };
+    let exr = stage_exr(film, exr_path, channels, provenance)?;
+    let png = if no_png {
+        None
+    } else {
+        Some(stage_png(film, &exr_path.with_extension("png"))?)
+    };
+    exr.commit()?;
+    if let Some(p) = png {
+        p.commit()?;
+    }
+    Ok(())
+}
+
+fn cmd_merge(args: MergeArgs) -> Result<()> {
+    check_output(&args.output, &["exr"])?;
+    let parts = args
+        .parts
+        .iter()
+        .map(|p| {
+            Ok((
+                p.clone(),
+                heron::checkpoint::Checkpoint::read_as(p, "film file")?,
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let total = heron::checkpoint::merge(&parts)?;
+    let provenance = heron::provenance::Provenance::from_key(&total.key, total.spp_done)
+        .ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}: not a heron film file: its settings lack the provenance",
+                display(&parts[0].0)
+            )
+        })?;
+    let film = total.film();
+    write_image(&film, &args.output, &total, &provenance, args.no_png)?;
+    eprintln!(
+        "{}: merged {} part{}: {}x{} at {} spp, {} rays ({} camera/continued, {} shadow), {} non-finite samples",
+        display(&args.output),
+        parts.len(),
+        if parts.len() == 1 { "" } else { "s" },
+        film.width,
+        film.height,
+        total.spp_done,
+        total.rays + total.shadow_rays,
+        total.rays,
+        total.shadow_rays,
+        total.nonfinite
+    );
     Ok(())
 }
 

@@ -48,7 +48,48 @@ pub fn hash_inputs(
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Provenance(pub Vec<(&'static str, String)>);
 
+/// The provenance keys, in the order [`Provenance::of_render`] writes them.
+pub const KEYS: [&str; 14] = [
+    "version",
+    "scene",
+    "sceneSha256",
+    "inputs",
+    "integrator",
+    "sampler",
+    "spp",
+    "seed",
+    "lanes",
+    "wavelengths",
+    "maxDepth",
+    "offset",
+    "packets",
+    "spectralBins",
+];
+
 impl Provenance {
+    /// The provenance a film's settings key holds (the key of `render.rs` contains every
+    /// provenance entry), with `spp` samples per pixel: what `heron merge` writes, the
+    /// same as the one render with all the samples would.
+    pub fn from_key(
+        key: &serde_json::Map<String, serde_json::Value>,
+        spp: u32,
+    ) -> Option<Provenance> {
+        KEYS.iter()
+            .map(|&k| {
+                let v = key.get(k)?.as_str()?;
+                Some((
+                    k,
+                    if k == "spp" {
+                        spp.to_string()
+                    } else {
+                        v.to_string()
+                    },
+                ))
+            })
+            .collect::<Option<Vec<_>>>()
+            .map(Provenance)
+    }
+
     /// What `scene` rendered with `opts` to `spp` samples per pixel records.
     pub fn of_render(scene: &Scene, opts: &RenderOptions, spp: u32) -> Provenance {
         let name = scene
@@ -85,5 +126,36 @@ impl Provenance {
             ("packets", opts.packets.to_string()),
             ("spectralBins", opts.spectral_bins.to_string()),
         ])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load::load_scene_from_str;
+
+    /// `from_key` must rebuild exactly what `of_render` writes, in its order, or a
+    /// merged EXR's header would differ from the one render's.
+    #[test]
+    fn the_settings_key_rebuilds_the_provenance() {
+        let scene = load_scene_from_str(
+            "[camera]\neye = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nresolution = [8, 8]\n",
+            std::path::Path::new("p.toml"),
+        )
+        .unwrap();
+        let opts = RenderOptions::from_scene(&scene);
+        let p = Provenance::of_render(&scene, &opts, 7);
+        let names: Vec<&str> = p.0.iter().map(|(k, _)| *k).collect();
+        assert_eq!(names, KEYS);
+        let key: serde_json::Map<String, serde_json::Value> =
+            Provenance::of_render(&scene, &opts, opts.spp)
+                .0
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v.into()))
+                .collect();
+        assert_eq!(Provenance::from_key(&key, 7), Some(p));
+        let mut partial = key.clone();
+        partial.remove("seed");
+        assert_eq!(Provenance::from_key(&partial, 7), None);
     }
 }

@@ -9,8 +9,9 @@
 //! a list per tile, in the order they were made, and added to the film tile by tile in
 //! tile order, pass by pass. So the image is bit-identical whatever the thread count.
 use crate::accel::embree::{self, RayQuery};
-use crate::checkpoint::Checkpoint;
-use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
+use crate::checkpoint::{Checkpoint, Shard};
+use crate::film::fixed::{to_fixed, to_fixed3};
+use crate::film::{bins_of_sample, xyz_of_sample, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{self, Context, IntegratorKind, TraceCounters};
 use crate::sampler::{Sampler, SamplerKind};
@@ -51,6 +52,8 @@ pub struct RenderOptions {
     pub checkpoint: Option<(std::path::PathBuf, Duration)>,
     /// Continue from this checkpoint (made with the same settings).
     pub resume: Option<std::sync::Arc<Checkpoint>>,
+    /// Render only this shard's share of the sample indices (`Shard::samples`).
+    pub shard: Option<Shard>,
     /// Stop at the first pass boundary after this long.
     pub time_limit: Option<Duration>,
     /// Stop at the next pass boundary once this is set (SIGINT).
@@ -76,6 +79,7 @@ impl RenderOptions {
             kernel: KernelChoice::Auto,
             checkpoint: None,
             resume: None,
+            shard: None,
             time_limit: None,
             stop: None,
             progress: None,
@@ -190,6 +194,13 @@ impl<'s> Renderer<'s> {
 
     /// Renders the image; returns the film and statistics.
     pub fn render(&self, opts: &RenderOptions) -> Result<(Film, RenderStats)> {
+        let (state, stats) = self.render_state(opts)?;
+        Ok((state.film(), stats))
+    }
+
+    /// Renders and returns the film's unnormalised state (sums and counts), which a
+    /// shard writes to its film file.
+    pub fn render_state(&self, opts: &RenderOptions) -> Result<(Checkpoint, RenderStats)> {
         let pool = {
             let mut cached = self.pool.lock().unwrap_or_else(|e| e.into_inner());
             match &*cached {
@@ -210,12 +221,17 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<(Film, RenderStats)
     Renderer::with_threads(scene, opts.threads)?.render(opts)
 }
 
+/// Renders `scene`; returns the film's unnormalised state and statistics.
+pub fn render_state(scene: &Scene, opts: &RenderOptions) -> Result<(Checkpoint, RenderStats)> {
+    Renderer::with_threads(scene, opts.threads)?.render_state(opts)
+}
+
 fn render_with(
     scene: &Scene,
     accel: &embree::Scene,
     pool: &rayon::ThreadPool,
     opts: &RenderOptions,
-) -> Result<(Film, RenderStats)> {
+) -> Result<(Checkpoint, RenderStats)> {
     let kind = opts.integrator;
     let ctx = Context {
         scene,
@@ -249,9 +265,9 @@ fn render_with(
     };
     let mut opts = opts.clone();
     opts.packets &= kind.uses_camera_rays();
-    let (film, mut stats) = render_passes(&ctx, pool, &opts, pass, &integrate)?;
+    let (state, mut stats) = render_passes(&ctx, pool, &opts, pass, &integrate)?;
     stats.kernel = k;
-    Ok((film, stats))
+    Ok((state, stats))
 }
 
 /// The settings that determine a render's image, which a checkpoint must match to be
@@ -295,16 +311,17 @@ pub(crate) enum SampleFn {
     Eight(SampleFnN<8>),
 }
 
-/// Renders `spp` samples per pixel in passes of `pass_spp` samples (a pass boundary only
-/// matters to splats, whose lists are kept per tile for one pass; one pass when the
-/// integrator does not splat).
+/// Renders `spp` samples per pixel (or the shard's share of them) in passes of
+/// `pass_spp` samples; returns the film's unnormalised state. Pass boundaries are where
+/// a render may checkpoint or stop, and they bound the splat lists kept per tile; the
+/// sums are exact (`film/fixed.rs`), so passes, shards and threads do not change them.
 pub(crate) fn render_passes(
     ctx: &Context,
     pool: &rayon::ThreadPool,
     opts: &RenderOptions,
     pass_spp: u32,
     integrate: &(dyn Fn(Lanes) -> SampleFn + Sync),
-) -> Result<(Film, RenderStats)> {
+) -> Result<(Checkpoint, RenderStats)> {
     if opts.spp == 0 {
         return Err(HeronError::Invalid("spp must be at least 1".into()));
     }
@@ -326,15 +343,14 @@ pub(crate) fn render_passes(
         .flat_map(|ty| (0..tw).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     let pass_spp = pass_spp.clamp(1, opts.spp);
-    let passes: Vec<(u32, u32)> = (0..opts.spp)
+    let range = opts.shard.map_or(0..opts.spp, |s| s.samples(opts.spp));
+    let passes: Vec<(u32, u32)> = range
+        .clone()
         .step_by(pass_spp as usize)
-        .map(|s0| (s0, (s0 + pass_spp).min(opts.spp)))
+        .map(|s0| (s0, (s0 + pass_spp).min(range.end)))
         .collect();
     let n_work = tiles.len() as u64 * passes.len() as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
-    let bins = (opts.spectral_bins > 0).then_some(SpectralBins {
-        count: opts.spectral_bins,
-    });
     let npix = (cam.width * cam.height) as usize;
     let nb = opts.spectral_bins;
     // Unnormalised sums over the whole render: XYZ and bins per pixel, finite samples per
@@ -347,10 +363,17 @@ pub(crate) fn render_passes(
                     "--resume: the checkpoint was made with other settings ({m})"
                 )));
             }
+            if c.shard != opts.shard {
+                let show = |s: Option<Shard>| s.map_or("no shard".into(), |s| format!("shard {s}"));
+                return Err(HeronError::Invalid(format!(
+                    "--resume: the checkpoint holds {}, this render {}",
+                    show(c.shard),
+                    show(opts.shard)
+                )));
+            }
             let splat_len = if kind_splats(opts) { npix * nb } else { 0 };
-            if c.sum_xyz.len() != npix
+            if (c.width, c.height) != (cam.width, cam.height)
                 || c.sum_bins.len() != npix * nb
-                || c.splat.len() != npix
                 || c.splat_bins.len() != splat_len
                 || c.passes_done as usize > passes.len()
             {
@@ -362,11 +385,17 @@ pub(crate) fn render_passes(
         }
         None => Checkpoint {
             key: key.clone(),
-            sum_xyz: vec![[0.0f64; 3]; npix],
-            sum_bins: vec![0.0f64; npix * nb],
+            shard: opts.shard,
+            width: cam.width,
+            height: cam.height,
+            // Splats count when the integrator splats (a resumed render or a shard may
+            // add none itself), or when any sample splatted.
+            any_splat: kind_splats(opts),
+            sum_xyz: vec![[0; 3]; npix],
+            sum_bins: vec![0; npix * nb],
             good: vec![0u32; npix],
-            splat: vec![[0.0f64; 3]; npix],
-            splat_bins: vec![0.0f64; if kind_splats(opts) { npix * nb } else { 0 }],
+            splat: vec![[0; 3]; npix],
+            splat_bins: vec![0; if kind_splats(opts) { npix * nb } else { 0 }],
             ..Default::default()
         },
     };
@@ -380,21 +409,17 @@ pub(crate) fn render_passes(
         first_pass as u64 * tiles.len() as u64,
         std::sync::atomic::Ordering::Relaxed,
     );
-    // Splats count when the integrator splats (a resumed render may add none itself),
-    // or when any sample splatted.
-    let mut any_splat = kind_splats(opts);
     let start = Instant::now();
     let mut last_checkpoint = Instant::now();
     for &(s0, s1) in &passes[first_pass..] {
-        let sums = &state;
         let results: Vec<TileResult> = pool.install(|| {
             tiles
                 .par_iter()
                 .map(|&(x0, y0)| {
                     let r = match &sample {
-                        SampleFn::One(f) => render_tile::<1>(ctx, opts, x0, y0, s0..s1, f, sums),
-                        SampleFn::Four(f) => render_tile::<4>(ctx, opts, x0, y0, s0..s1, f, sums),
-                        SampleFn::Eight(f) => render_tile::<8>(ctx, opts, x0, y0, s0..s1, f, sums),
+                        SampleFn::One(f) => render_tile::<1>(ctx, opts, x0, y0, s0..s1, f),
+                        SampleFn::Four(f) => render_tile::<4>(ctx, opts, x0, y0, s0..s1, f),
+                        SampleFn::Eight(f) => render_tile::<8>(ctx, opts, x0, y0, s0..s1, f),
                     };
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     if let Some(p) = &opts.progress {
@@ -411,22 +436,35 @@ pub(crate) fn render_passes(
                         ((t.y0 + y) * cam.width + t.x0 + x) as usize,
                         (y * t.w + x) as usize,
                     );
-                    // The tile started from these sums and carried them on in sample
-                    // order.
-                    state.sum_xyz[dst] = t.xyz[src];
-                    state.good[dst] = t.good[src];
-                    state.sum_bins[dst * nb..(dst + 1) * nb]
-                        .copy_from_slice(&t.spectral[src * nb..(src + 1) * nb]);
+                    for j in 0..3 {
+                        state.sum_xyz[dst][j] = state.sum_xyz[dst][j].wrapping_add(t.xyz[src][j]);
+                    }
+                    state.good[dst] += t.good[src];
+                    for (a, b) in state.sum_bins[dst * nb..(dst + 1) * nb]
+                        .iter_mut()
+                        .zip(&t.spectral[src * nb..(src + 1) * nb])
+                    {
+                        *a = a.wrapping_add(*b);
+                    }
                 }
             }
             for &(p, c) in &t.splats.list {
-                any_splat = true;
-                for (a, b) in state.splat[p as usize].iter_mut().zip(c) {
-                    *a += b as f64;
+                state.any_splat = true;
+                match to_fixed3(c) {
+                    Some(f) => {
+                        for (a, b) in state.splat[p as usize].iter_mut().zip(f) {
+                            *a = a.wrapping_add(b);
+                        }
+                    }
+                    None => state.nonfinite += 1,
                 }
             }
             for &(p, k, v) in &t.splats.spectral {
-                state.splat_bins[p as usize * nb + k as usize] += v as f64;
+                // A splat too large for the film was counted with its XYZ above.
+                if let Some(f) = to_fixed(v) {
+                    let a = &mut state.splat_bins[p as usize * nb + k as usize];
+                    *a = a.wrapping_add(f);
+                }
             }
             state.rays += t.counters.rays;
             state.shadow_rays += t.counters.shadow_rays;
@@ -434,8 +472,8 @@ pub(crate) fn render_passes(
             stats.first_nonfinite = stats.first_nonfinite.or(t.first_nonfinite);
         }
         state.passes_done += 1;
-        state.spp_done = s1;
-        let last = s1 == opts.spp;
+        state.spp_done = s1 - range.start;
+        let last = s1 == range.end;
         let stop = opts
             .stop
             .as_ref()
@@ -459,53 +497,7 @@ pub(crate) fn render_passes(
     stats.counters.rays = state.rays - rays0;
     stats.counters.shadow_rays = state.shadow_rays - shadow0;
     stats.nonfinite = state.nonfinite;
-    let (sum_xyz, sum_bins, good, splat, splat_bins) = (
-        &state.sum_xyz,
-        &state.sum_bins,
-        &state.good,
-        &state.splat,
-        &state.splat_bins,
-    );
-    // Non-finite samples are left out and counted: a pixel's mean is over its finite
-    // samples. Splats are estimates of the whole image per sample, so they are divided
-    // by the number of samples per pixel.
-    let inv = |n: u32| if n > 0 { 1.0 / n as f64 } else { 0.0 };
-    let inv_spp = 1.0 / state.spp_done.max(1) as f64;
-    let xyz = (0..npix)
-        .map(|i| {
-            let k = inv(good[i]);
-            let mut c = [0.0f32; 3];
-            for j in 0..3 {
-                let v = sum_xyz[i][j] * k;
-                c[j] = if any_splat {
-                    (v + splat[i][j] * inv_spp) as f32
-                } else {
-                    v as f32
-                };
-            }
-            c
-        })
-        .collect();
-    let spectral = bins.map(|b| {
-        let data = (0..npix * nb)
-            .map(|j| {
-                let v = sum_bins[j] * inv(good[j / nb]);
-                if any_splat {
-                    (v + splat_bins[j] * inv_spp) as f32
-                } else {
-                    v as f32
-                }
-            })
-            .collect();
-        (b, data)
-    });
-    let film = Film {
-        width: cam.width,
-        height: cam.height,
-        xyz,
-        spectral,
-    };
-    Ok((film, stats))
+    Ok((state, stats))
 }
 
 struct TileResult {
@@ -513,10 +505,10 @@ struct TileResult {
     y0: u32,
     w: u32,
     h: u32,
-    /// Per pixel: sums of XYZ and of the spectral bins over the finite samples, and
-    /// their count.
-    xyz: Vec<[f64; 3]>,
-    spectral: Vec<f64>,
+    /// Per pixel: sums of XYZ and of the spectral bins over the finite samples of this
+    /// pass (fixed point), and their count.
+    xyz: Vec<[i128; 3]>,
+    spectral: Vec<i128>,
     good: Vec<u32>,
     splats: Splats,
     counters: TraceCounters,
@@ -531,7 +523,6 @@ fn render_tile<const N: usize>(
     y0: u32,
     samples: std::ops::Range<u32>,
     sample_fn: &SampleFnN<N>,
-    sums: &Checkpoint,
 ) -> TileResult {
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
@@ -540,19 +531,9 @@ fn render_tile<const N: usize>(
         count: opts.spectral_bins,
     };
     let nb = opts.spectral_bins;
-    // Each pixel carries on from the sums of the passes before, so its samples are added
-    // in sample order whatever the passes are.
-    let mut xyz = Vec::with_capacity((w * h) as usize);
-    let mut spectral = Vec::with_capacity((w * h) as usize * nb);
-    let mut good = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let g = ((y0 + y) * cam.width + x0 + x) as usize;
-            xyz.push(sums.sum_xyz[g]);
-            spectral.extend_from_slice(&sums.sum_bins[g * nb..(g + 1) * nb]);
-            good.push(sums.good[g]);
-        }
-    }
+    let mut xyz = vec![[0i128; 3]; (w * h) as usize];
+    let mut spectral = vec![0i128; (w * h) as usize * nb];
+    let mut good = vec![0u32; (w * h) as usize];
     let mut counters = TraceCounters::default();
     let mut nonfinite = 0u64;
     let mut first_nonfinite = None;
@@ -606,18 +587,31 @@ fn render_tile<const N: usize>(
                         &mut splats,
                     );
                     let i = (y * w + xs + k as u32) as usize;
-                    if !l.is_finite() {
+                    // A sample whose radiance is not finite, or too large for the film's
+                    // fixed-point sums (film/fixed.rs), is left out and counted.
+                    let c = if l.is_finite() {
+                        to_fixed3(xyz_of_sample(&l, &wls[k]))
+                    } else {
+                        None
+                    };
+                    let b = match c {
+                        Some(_) if nb > 0 => bins_of_sample(&bins, &l, &wls[k]).map(Some),
+                        Some(_) => Some(None),
+                        None => None,
+                    };
+                    let (Some(c), Some(b)) = (c, b) else {
                         nonfinite += 1;
                         first_nonfinite = first_nonfinite.or(Some((x0 + xs + k as u32, y0 + y, s)));
                         continue;
-                    }
-                    let c = xyz_of_sample(&l, &wls[k]);
+                    };
                     for j in 0..3 {
-                        xyz[i][j] += c[j] as f64;
+                        xyz[i][j] = xyz[i][j].wrapping_add(c[j]);
                     }
-                    if bins.count > 0 {
-                        let b = bins.count;
-                        add_to_bins(&bins, &mut spectral[i * b..(i + 1) * b], &l, &wls[k]);
+                    if let Some(b) = b {
+                        for (bin, v) in b {
+                            let a = &mut spectral[i * nb + bin];
+                            *a = a.wrapping_add(v);
+                        }
                     }
                     good[i] += 1;
                 }
@@ -689,7 +683,10 @@ mod tests {
             o.spp = 64;
             o.lanes = 4;
             o.threads = threads;
-            render_passes(&ctx, &pool, &o, pass, &integrate).unwrap().0
+            render_passes(&ctx, &pool, &o, pass, &integrate)
+                .unwrap()
+                .0
+                .film()
         };
         let a = run(1, 16);
         assert!(
@@ -698,14 +695,7 @@ mod tests {
         );
         let mean = a.xyz.iter().map(|c| c[1] as f64).sum::<f64>() / a.xyz.len() as f64;
         assert!((mean - 1.0).abs() < 0.02, "mean splatted Y {mean}");
-        // Passes only regroup the same splats: the same image up to summation order.
-        let b = run(2, 64);
-        let worst = a
-            .xyz
-            .iter()
-            .zip(&b.xyz)
-            .map(|(x, y)| (x[1] - y[1]).abs())
-            .fold(0.0f32, f32::max);
-        assert!(worst < 1e-5, "{worst}");
+        // Passes only regroup the same splats, and the sums are exact: the same bytes.
+        assert!(a == run(2, 64), "splats depend on the pass size");
     }
 }

@@ -5,6 +5,7 @@
 //! Monte Carlo estimate of XYZ = ∫ L x̄ dλ / ∫ ȳ dλ (a constant L = 1 has Y = 1).
 //! Lanes with pdf 0 (terminated wavelengths) add nothing.
 pub mod exr;
+pub mod fixed;
 pub mod png;
 
 use crate::spectrum::cie::cie1931;
@@ -52,21 +53,26 @@ impl SpectralBins {
     }
 }
 
-/// Adds one sample's lanes to spectral bins: each lane adds L(λ)/(N p(λ) Δλ_bin), the
-/// estimate of the bin's mean spectral radiance.
+/// One sample's lanes as spectral-bin contributions: lane i adds L(λᵢ)/(N p(λᵢ) Δλ_bin),
+/// the estimate of the bin's mean spectral radiance, in fixed point (`fixed.rs`), as
+/// (bin, value) with value 0 for lanes that add nothing. None if any is out of range.
 #[inline]
-pub fn add_to_bins<const N: usize>(
+pub fn bins_of_sample<const N: usize>(
     bins: &SpectralBins,
-    out: &mut [f64],
     l: &SampledSpectrum<N>,
     wl: &SampledWavelengths<N>,
-) {
+) -> Option<[(usize, i128); N]> {
     let w = 1.0 / (N as f32 * bins.width());
-    for i in 0..N {
+    let mut out = [(0usize, 0i128); N];
+    for (i, o) in out.iter_mut().enumerate() {
         if wl.pdf[i] > 0.0 && l.0[i] != 0.0 {
-            out[bins.index(wl.lambda[i])] += (l.0[i] * w / wl.pdf[i]) as f64;
+            *o = (
+                bins.index(wl.lambda[i]),
+                fixed::to_fixed(l.0[i] * w / wl.pdf[i])?,
+            );
         }
     }
+    Some(out)
 }
 
 /// Contributions an integrator makes to pixels other than the one it samples (light

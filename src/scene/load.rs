@@ -862,6 +862,20 @@ fn box_sphere((lo, hi): Box3) -> crate::light::SceneBounds {
     }
 }
 
+/// The refractive-index model a scene file's `ior` value describes (a number, a catalogue
+/// name, `{ sellmeier = .. }`, `{ cauchy = .. }` or `{ table = "file.csv" }`, read
+/// relative to `base_dir`), checked as the loader checks it; the error is the loader's
+/// message after `at` (the key path it names). For the Python module's `heron.ior`.
+pub fn ior_from_value(
+    at: &str,
+    value: toml::Value,
+    base_dir: &Path,
+) -> std::result::Result<Ior, String> {
+    use serde::Deserialize as _;
+    let spec = IorSpec::deserialize(value).map_err(|e| format!("{at}: {}", e.message()))?;
+    build_ior(at, &spec, base_dir, &mut Vec::new())
+}
+
 /// The refractive-index model of `spec`; a table file is read relative to `base_dir`.
 fn build_ior(
     at: &str,
@@ -1352,4 +1366,37 @@ pub(crate) fn mesh_shapes(
         .filter(|p| !p.indices.is_empty())
         .map(|p| mesh_shape(p.positions, p.indices, p.material))
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ior_from_value_reads_a_scene_files_ior() {
+        let eval = |v: toml::Value| ior_from_value("ior", v, Path::new("")).map(|i| i.eval(500.0));
+        assert_eq!(eval(toml::Value::Float(1.5)), Ok(1.5));
+        let named = crate::spectrum::ior::named("N-BK7").unwrap().eval(500.0);
+        assert_eq!(eval(toml::Value::String("N-BK7".into())), Ok(named));
+        let cauchy: toml::Value = toml::from_str::<toml::Table>("cauchy = [1.5, 0.0042]")
+            .unwrap()
+            .into();
+        let n = eval(cauchy).unwrap();
+        assert!((n - (1.5 + 0.0042 / 0.25)).abs() < 1e-6, "{n}");
+        // The loader's messages, after the key path given.
+        let e = eval(toml::Value::String("BK7".into())).unwrap_err();
+        assert!(
+            e.starts_with("ior: unknown refractive-index model \"BK7\", expected one of"),
+            "{e}"
+        );
+        let e = eval(toml::Value::Float(-1.0)).unwrap_err();
+        assert_eq!(e, "ior: expected a positive finite number, got -1");
+        // A Cauchy model below 1 in the visible is refused as in a scene.
+        let low: toml::Value = toml::from_str::<toml::Table>("cauchy = [0.5, 0.0]")
+            .unwrap()
+            .into();
+        assert!(eval(low)
+            .unwrap_err()
+            .starts_with("ior: expected a refractive index ≥ 1"));
+    }
 }

@@ -189,22 +189,37 @@ pub fn profile_csv(req: &ProfileRequest) -> Result<String> {
     let lambdas = parse_lambdas(&req.lambdas)?;
     let thetas = angles(req.from_deg, req.to_deg, req.step_deg)?;
     let sky = build_sky(req)?;
-    if let Sky::Mie(m) = &sky {
-        m.prepare(&lambdas);
-    }
+    let table = profile_table(&sky, &lambdas, &thetas);
     let mut out = String::from("theta_deg");
     for l in &lambdas {
         write!(out, ",{l}nm").unwrap();
     }
     out.push('\n');
-    for &t in &thetas {
+    for (&t, row) in thetas.iter().zip(table.chunks(lambdas.len().max(1))) {
         write!(out, "{t}").unwrap();
-        for &l in &lambdas {
-            write!(out, ",{:.6e}", sky.profile(t.to_radians(), l)).unwrap();
+        for v in row {
+            write!(out, ",{v:.6e}").unwrap();
         }
         out.push('\n');
     }
     Ok(out)
+}
+
+/// The radiance of `sky` at each angle of `thetas_deg` (degrees from the antisolar
+/// point) and wavelength of `lambdas` (nm, checked by [`parse_lambdas`]), row-major:
+/// `thetas_deg.len()` rows of `lambdas.len()` values. The numbers of `heron sky
+/// profile` and of the Python module's `heron.sky_profile`.
+pub fn profile_table(sky: &Sky, lambdas: &[f32], thetas_deg: &[f64]) -> Vec<f32> {
+    if let Sky::Mie(m) = sky {
+        m.prepare(lambdas);
+    }
+    let mut out = Vec::with_capacity(thetas_deg.len() * lambdas.len());
+    for &t in thetas_deg {
+        for &l in lambdas {
+            out.push(sky.profile(t.to_radians(), l));
+        }
+    }
+    out
 }
 
 /// `heron sky mie-phase`: S₁, S₂ of a sphere of real index `m` and size parameter `x` at

@@ -1,0 +1,183 @@
+"""heron: a physically faithful spectral ray tracer for optics research, from Python.
+
+Scenes are heron's TOML scene files (``load_scene``) or the same schema as a dict
+(``Scene.from_dict``); ``Scene.render`` returns numpy arrays (linear sRGB, CIE XYZ,
+spectral bins) equal bit for bit to the EXR ``heron render`` writes for the same
+settings. ``trace``, ``sky_profile``, ``color`` and ``ior`` are the CLI's ``heron trace``,
+``heron sky profile``, ``heron color`` and the scene files' refractive indices.
+
+Bad input raises ``HeronError`` (a ``ValueError``) with the CLI's one-line message; where
+the CLI names a flag (``--lanes``) the message names the argument (``lanes``).
+"""
+
+import os
+from typing import Any, Literal, Mapping, Optional, Sequence, TypedDict, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Numbers = Union[float, Sequence[float], npt.NDArray[np.floating[Any]]]
+_Path = Union[str, os.PathLike[str]]
+
+class HeronError(ValueError):
+    """Bad input (a scene key, an argument, a file): the heron CLI's one-line message."""
+
+class Scene:
+    """A loaded, validated heron scene (immutable; render it as often as you like)."""
+
+    @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> "Scene":
+        """A scene from a dict with the schema of heron's TOML scene files.
+
+        The dict becomes TOML text and goes through the same loader as a file, so the
+        checks and error messages are the loader's; they name the file ``<dict>``.
+        Relative paths (meshes, tables) start at the current directory.
+        """
+    @property
+    def width(self) -> int:
+        """Image width in pixels."""
+    @property
+    def height(self) -> int:
+        """Image height in pixels."""
+    @property
+    def spp(self) -> int:
+        """The scene's ``[render] spp`` (the default of ``render``)."""
+    @property
+    def seed(self) -> int:
+        """The scene's ``[render] seed`` (the default of ``render``)."""
+    @property
+    def integrator(self) -> str:
+        """The scene's integrator (``[render] integrator``, default whitted)."""
+    @property
+    def materials(self) -> list[str]:
+        """The material names, in the order of the file."""
+    def render(
+        self,
+        spp: Optional[int] = None,
+        seed: Optional[int] = None,
+        lanes: Literal[1, 4, 8] = 8,
+        integrator: Optional[Literal["whitted", "path", "lighttrace", "bdpt"]] = None,
+        wavelengths: Literal["visible", "uniform"] = "visible",
+        threads: int = 0,
+        spectral_bins: int = 0,
+        sampler: Optional[Literal["sobol", "independent"]] = None,
+        max_depth: Optional[int] = None,
+        offset: Optional[Literal["auto", "epsilon", "robust"]] = None,
+    ) -> "RenderResult":
+        """Renders the scene with ``heron render``'s options and defaults.
+
+        spp and seed default to the scene's ``[render]`` values; threads 0 is one per
+        core (the image does not depend on it); spectral_bins 0 is none, else 1-470
+        equal bins over 360-830 nm. The GIL is released while rendering; Ctrl-C stops
+        the render at its next pass boundary and raises KeyboardInterrupt.
+        """
+
+class RenderResult:
+    """The image and statistics of ``Scene.render``."""
+
+    @property
+    def rgb(self) -> npt.NDArray[np.float32]:
+        """Linear sRGB, H x W x 3 (the EXR's R, G, B), row 0 at the top."""
+    @property
+    def xyz(self) -> npt.NDArray[np.float32]:
+        """CIE 1931 XYZ, H x W x 3 (the EXR's X, Y, Z)."""
+    @property
+    def spectral(self) -> Optional[npt.NDArray[np.float32]]:
+        """Mean spectral radiance per bin, H x W x bins (the EXR's S0.* channels), or None."""
+    @property
+    def wavelengths(self) -> Optional[npt.NDArray[np.float32]]:
+        """The spectral bins' centres in nm, or None."""
+    spp: int
+    """Samples per pixel in the image."""
+    rays: int
+    """All rays traced: camera and continued rays plus shadow rays."""
+    camera_rays: int
+    """Closest-hit rays: camera rays and the rays that continue paths."""
+    shadow_rays: int
+    """Occlusion (shadow) rays."""
+    nonfinite_samples: int
+    """Samples whose radiance was NaN or infinite, left out of the image."""
+    wall_seconds: float
+    """Wall-clock seconds of the render."""
+    mrays_per_s: float
+    """Million rays per second."""
+    kernel: str
+    """The kernel that ran, as the CLI names it."""
+    integrator: str
+    """whitted, path, lighttrace or bdpt."""
+    lanes: int
+    """Wavelengths per path: 1, 4 or 8."""
+    sampler: str
+    """sobol or independent."""
+    seed: int
+    """The seed of the render."""
+    width: int
+    """Image width in pixels."""
+    height: int
+    """Image height in pixels."""
+
+def load_scene(path: _Path) -> Scene:
+    """Reads and validates a heron scene file (TOML), as ``heron render SCENE`` does."""
+
+class TraceEvent(TypedDict):
+    kind: Literal["reflect", "refract", "total-internal-reflection", "absorb", "escape"]
+    position: list[float]
+    normal: Optional[list[float]]
+    material: Optional[str]
+    n_i: Optional[float]
+    n_t: Optional[float]
+    incoming: list[float]
+    outgoing: Optional[list[float]]
+    fresnel_r: Optional[float]
+    distance: Optional[float]
+
+def trace(
+    scene: Union[Scene, _Path],
+    origin: _Numbers,
+    direction: _Numbers,
+    wavelength: float,
+    path: Optional[str] = None,
+) -> list[TraceEvent]:
+    """Follows one ray at one wavelength through a scene, as ``heron trace`` does.
+
+    path: R and T letters; at the k-th event at a surface that both reflects and
+    transmits, R reflects and T transmits (default and past the end: transmit; total
+    internal reflection forces R). "TRT" is the primary rainbow ray of a drop.
+    """
+
+def sky_profile(
+    model: Literal["constant", "aristotle", "descartes", "airy", "mie"],
+    wavelengths: _Numbers,
+    theta: _Numbers,
+    *,
+    sun_radius: float = 0.2666,
+    droplet_radius: Optional[float] = None,
+    k: Optional[Union[int, str]] = None,
+    polarisation: Optional[Literal["unpolarised", "s", "p"]] = None,
+    background: Optional[float] = None,
+) -> npt.NDArray[np.float32]:
+    """Radiance against the angle theta (degrees) from the antisolar point, as
+    ``heron sky profile``: len(theta) rows by len(wavelengths) columns."""
+
+class Color(TypedDict):
+    XYZ: list[float]
+    xy: Optional[list[float]]
+    linear_srgb: list[float]
+    observer: str
+    illuminant: str
+
+def color(
+    wavelengths: _Numbers,
+    values: _Numbers,
+    illuminant: Literal["D65", "A", "E", "none"] = "D65",
+    observer: Union[Literal["1931", "1964"], int] = "1931",
+) -> Color:
+    """XYZ, xy and linear sRGB of a spectral distribution, as ``heron color``."""
+
+def ior(
+    model: Union[str, float, Mapping[str, Any]],
+    wavelengths: _Numbers,
+) -> npt.NDArray[np.float32]:
+    """n(lambda) of a refractive-index model given as a scene file's ``ior`` value."""

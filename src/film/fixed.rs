@@ -1,0 +1,145 @@
+//! Exact sums of film contributions, independent of the order they are added in.
+//!
+//! A pixel's value is a sum of many f32 contributions. Floating-point addition is not
+//! associative, so a sum carried in sample order gives different bits from the same
+//! samples summed in two halves and added. Sharded renders (`--shard K/N`, `heron
+//! merge`) must give the bytes of one render whatever N and the order of the parts, so
+//! every contribution is rounded once, on its own, to a fixed-point integer with 64
+//! fractional bits, and the integers are added with wrapping arithmetic, which is
+//! associative and commutative exactly. The sum is the same whichever way the samples
+//! are grouped; it is converted to f64 once, when the image is made.
+//!
+//! Range: a contribution must have |v| < 2⁴⁰ (≈ 1.1·10¹²; radiance of the sun's disk is
+//! ~2·10⁴ W m⁻² sr⁻¹ nm⁻¹) to be added; larger ones are counted with the non-finite
+//! samples and left out. A total of up to 2²³ such contributions to one pixel stays
+//! below 2⁶³, the range of the i128 sum, so wrapping can only occur past 8 million
+//! samples of the largest values in one pixel. Resolution: 2⁻⁶⁴ ≈ 5.4·10⁻²⁰, with
+//! rounding to nearest, so a contribution of 10⁻⁹ keeps 35 bits (the f32 it came from
+//! has 24).
+//!
+//! The idea is that of exact accumulators for reproducible summation (Kulisch's long
+//! accumulator; Demmel & Nguyen 2015, "Parallel reproducible summation", IEEE Trans.
+//! Computers 64(7)), with a window wide enough for rendering instead of the full f32
+//! range.
+
+/// Fractional bits of a fixed-point sum.
+pub const FRAC_BITS: i32 = 64;
+
+/// Contributions must be smaller than this in magnitude (2⁴⁰).
+pub const LIMIT: f32 = (1u64 << 40) as f32;
+
+/// `v` in fixed point, rounded to the nearest multiple of 2⁻⁶⁴ (ties away from zero);
+/// None when `v` is not finite or |v| ≥ 2⁴⁰.
+#[inline]
+pub fn to_fixed(v: f32) -> Option<i128> {
+    let bits = v.to_bits();
+    let exp = ((bits >> 23) & 0xff) as i32;
+    // Zero and subnormals (< 2⁻¹²⁶) round to 0.
+    if exp == 0 {
+        return Some(0);
+    }
+    // 2⁴⁰ has biased exponent 167; 255 is infinity or NaN.
+    if exp >= 167 {
+        return None;
+    }
+    let m = ((bits & 0x7f_ffff) | 0x80_0000) as i128;
+    // v = m · 2^(exp − 150), so v · 2⁶⁴ = m · 2^(exp − 86).
+    let shift = exp - 86;
+    let mag = if shift >= 0 {
+        m << shift
+    } else if shift > -64 {
+        let s = -shift;
+        (m + (1 << (s - 1))) >> s
+    } else {
+        // Below 2⁻⁶⁶: rounds to 0 (m < 2²⁴ and the shift is at least 64).
+        0
+    };
+    Some(if bits >> 31 != 0 { -mag } else { mag })
+}
+
+/// All of `values` in fixed point, or None if any is out of range.
+#[inline]
+pub fn to_fixed3(v: [f32; 3]) -> Option<[i128; 3]> {
+    Some([to_fixed(v[0])?, to_fixed(v[1])?, to_fixed(v[2])?])
+}
+
+/// A fixed-point sum as f64 (rounded to nearest once).
+#[inline]
+pub fn to_f64(s: i128) -> f64 {
+    // Scaling by a power of two is exact.
+    s as f64 * (-FRAC_BITS as f64).exp2()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::rng::Rng;
+
+    #[test]
+    fn converts_exactly_where_the_float_fits() {
+        for v in [
+            0.0f32,
+            1.0,
+            -1.0,
+            0.5,
+            3.0e-5,
+            1234.5678,
+            -7.25e9,
+            1.0e12 - 65536.0,
+        ] {
+            let f = to_fixed(v).unwrap();
+            assert_eq!(to_f64(f), v as f64, "{v}");
+        }
+        // Rounded to nearest below the resolution.
+        assert_eq!(to_fixed(1.5 * 2f32.powi(-64)), Some(2));
+        assert_eq!(to_fixed(-1.5 * 2f32.powi(-64)), Some(-2));
+        assert_eq!(to_fixed(0.49 * 2f32.powi(-64)), Some(0));
+        assert_eq!(to_fixed(1e-30), Some(0));
+        assert_eq!(to_fixed(f32::MIN_POSITIVE / 4.0), Some(0));
+    }
+
+    #[test]
+    fn refuses_non_finite_and_too_large_values() {
+        for v in [f32::NAN, f32::INFINITY, -f32::INFINITY, LIMIT, -LIMIT, 3e38] {
+            assert_eq!(to_fixed(v), None, "{v}");
+        }
+        assert!(to_fixed(LIMIT * (1.0 - f32::EPSILON)).is_some());
+    }
+
+    /// The point of the module: any grouping and order of the same contributions gives
+    /// the same bits, which f64 sums do not.
+    #[test]
+    fn sums_do_not_depend_on_order_or_grouping() {
+        let mut rng = Rng::new(7, 11);
+        let values: Vec<f32> = (0..10_000)
+            .map(|i| {
+                let e = (rng.uniform() * 60.0 - 30.0).exp2();
+                let s = if i % 3 == 0 { -1.0 } else { 1.0 };
+                s * e * rng.uniform()
+            })
+            .collect();
+        let fixed = |v: &[f32]| {
+            v.iter()
+                .fold(0i128, |a, &x| a.wrapping_add(to_fixed(x).unwrap()))
+        };
+        let whole = fixed(&values);
+        let mut rev = values.clone();
+        rev.reverse();
+        assert_eq!(whole, fixed(&rev));
+        for parts in [2, 3, 7, 64] {
+            let chunk = values.len().div_ceil(parts);
+            let s = values
+                .chunks(chunk)
+                .map(fixed)
+                .fold(0i128, i128::wrapping_add);
+            assert_eq!(s, whole, "{parts} parts");
+        }
+        // f64 in sample order and in reverse differ for the same data (so the test
+        // above is not trivially true of any sum).
+        let f = |v: &[f32]| v.iter().fold(0f64, |a, &x| a + x as f64);
+        assert_ne!(f(&values), f(&rev));
+        // And the fixed sum is as accurate as an f64 sum here.
+        let exact: f64 = values.iter().map(|&x| x as f64).sum();
+        assert!((to_f64(whole) - exact).abs() <= 1e-9 * exact.abs().max(1.0));
+    }
+}
