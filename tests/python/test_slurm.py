@@ -159,6 +159,7 @@ def _submit(cluster: Cluster, scene, shards: int, outdir: pathlib.Path, flags) -
 
 
 def _render_reference(scene, flags, out: pathlib.Path) -> pathlib.Path:
+    out.parent.mkdir(parents=True, exist_ok=True)
     proc = _run([require_heron_bin(), "render", scene, "-o", out, *flags])
     assert proc.returncode == 0, f"reference render failed: {proc.stderr}"
     return out
@@ -302,8 +303,8 @@ def test_k8s_manifest_renders_and_merges(tmp_path):
     """deploy/k8s/render-job.yaml: a PVC, an Indexed Job of N completions whose pods
     render shard $JOB_COMPLETION_INDEX/N onto the volume, and a merge Job that waits for
     the N parts and merges them. The structure is checked, then the containers' shell
-    commands run here for every index (the volume and the image's scene folder mapped to
-    local directories, cheaper render flags), and the merged image must equal one render."""
+    commands run here for every index (the volume a temporary folder, a small scene and
+    few samples instead of the manifest's), and the merged image must equal one render."""
     docs = _load_yaml_documents(K8S_MANIFEST)
     kinds = [d["kind"] for d in docs]
     assert kinds == ["PersistentVolumeClaim", "Job", "Job"], kinds
@@ -355,8 +356,10 @@ def test_k8s_manifest_renders_and_merges(tmp_path):
         env = {k: v for k, v in os.environ.items() if not k.startswith("SLURM_")}
         env.update({k: v for k, v in _container_env(container).items() if v is not None})
         if "HERON_SCENE" in env:
+            # The image's scene exists in the repository; the run takes a smaller one.
             assert env["HERON_SCENE"].startswith("/opt/heron/"), env["HERON_SCENE"]
-            env["HERON_SCENE"] = str(REPO / env["HERON_SCENE"].removeprefix("/opt/heron/"))
+            assert (REPO / env["HERON_SCENE"].removeprefix("/opt/heron/")).is_file()
+            env["HERON_SCENE"] = str(SMALL_SCENE)
         env.update(HERON_WORK=str(work), HERON_FLAGS=shlex.join(SMALL_FLAGS),
                    PATH=f"{bindir}:{env['PATH']}", HERON_THREADS="1")
         env.update({k: str(v) for k, v in extra.items()})
@@ -374,10 +377,8 @@ def test_k8s_manifest_renders_and_merges(tmp_path):
     proc = run(merge)
     assert proc.returncode == 0, proc.stderr
     (merged,) = work.rglob("*.exr")
-    scene_name = pathlib.Path(render_env["HERON_SCENE"]).stem
-    assert merged.name == f"{scene_name}.exr"
-    ref = _render_reference(REPO / render_env["HERON_SCENE"].removeprefix("/opt/heron/"),
-                            SMALL_FLAGS, tmp_path / "ref.exr")
+    assert merged == work / render_env["HERON_RUN"] / f"{SMALL_SCENE.stem}.exr"
+    ref = _render_reference(SMALL_SCENE, SMALL_FLAGS, tmp_path / "ref.exr")
     assert merged.read_bytes() == ref.read_bytes()
 
     # The wait gives up (non-zero, naming the part) when a part never comes.
