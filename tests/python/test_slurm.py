@@ -260,6 +260,42 @@ def test_merge_sbatch_names_a_missing_part(tmp_path):
     assert out.read_bytes() == ref.read_bytes()
 
 
+def test_render_array_sbatch_continues_an_interrupted_part(tmp_path):
+    """A task stopped early (as Slurm's --signal=B:INT before a time limit does; here
+    --time-limit 0 stops after the first pass) leaves an incomplete part, which merge
+    refuses; running the task again resumes the part, and the image equals one render.
+    Bidirectional path tracing splats, so its passes are of 2^20 samples: about 5 of the
+    8 spp of this 512x384 scene."""
+    outdir = tmp_path / "parts"
+    flags = ("--spp", "8", "--seed", "5")
+    env = dict(HERON_SHARDS=1, SLURM_CPUS_ON_NODE=2)
+    proc = _render_shard(outdir, 0, 1, SLURM_SCENE, (*flags, "--time-limit", "0"), **env)
+    assert proc.returncode == 0, proc.stderr
+    held = re.search(r"time limit reached: the film holds (\d+) of 8 spp", proc.stderr)
+    assert held and 0 < int(held.group(1)) < 8, proc.stderr
+
+    out = tmp_path / "merged.exr"
+    proc = _run(["bash", SLURM_DIR / "merge.sbatch", outdir, 1, out], env=_script_env())
+    assert proc.returncode == 1 and "is incomplete" in proc.stderr, proc.stderr
+    assert not out.exists()
+
+    proc = _render_shard(outdir, 0, 1, SLURM_SCENE, flags, **env)
+    assert proc.returncode == 0, proc.stderr
+    assert f"continuing {outdir}/part-0.heronfilm" in proc.stdout, proc.stdout
+    assert f"resumed from {held.group(1)} spp" in proc.stderr, proc.stderr
+    proc = _run(["bash", SLURM_DIR / "merge.sbatch", outdir, 1, out], env=_script_env())
+    assert proc.returncode == 0, proc.stderr
+    ref = _render_reference(SLURM_SCENE, flags, tmp_path / "ref.exr")
+    assert out.read_bytes() == ref.read_bytes()
+    assert out.with_suffix(".png").read_bytes() == ref.with_suffix(".png").read_bytes()
+
+    # Another render's part in the same place is refused, not overwritten.
+    before = (outdir / "part-0.heronfilm").read_bytes()
+    proc = _render_shard(outdir, 0, 1, SLURM_SCENE, ("--spp", "8", "--seed", "6"), **env)
+    assert proc.returncode == 1 and "--resume" in proc.stderr, proc.stderr
+    assert (outdir / "part-0.heronfilm").read_bytes() == before
+
+
 def test_render_array_sbatch_refuses_a_task_beyond_n(tmp_path):
     proc = _render_shard(tmp_path, 4, 4, HERON_SHARDS=4)
     assert proc.returncode == 2
