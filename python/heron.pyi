@@ -71,7 +71,7 @@ class Scene:
         spp and seed default to the scene's ``[render]`` values; threads 0 is one per
         core (the image does not depend on it); spectral_bins 0 is none, else 1-470
         equal bins over 360-830 nm. The GIL is released while rendering; Ctrl-C stops
-        the render at its next pass boundary and raises KeyboardInterrupt.
+        the render within a row of a tile and raises KeyboardInterrupt.
         """
 
 class RenderResult:

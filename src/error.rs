@@ -13,6 +13,9 @@ pub enum HeronError {
     Io { path: PathBuf, message: String },
     #[error("{0}")]
     Invalid(String),
+    /// The render was abandoned through `RenderOptions::cancel`.
+    #[error("the render was cancelled")]
+    Cancelled,
 }
 
 pub type Result<T> = std::result::Result<T, HeronError>;

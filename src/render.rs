@@ -58,6 +58,9 @@ pub struct RenderOptions {
     pub time_limit: Option<Duration>,
     /// Stop at the next pass boundary once this is set (SIGINT).
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Abandon the render within a row of a tile once this is set (Ctrl-C in Python):
+    /// the render returns [`HeronError::Cancelled`] and no image.
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
 }
@@ -82,6 +85,7 @@ impl RenderOptions {
             shard: None,
             time_limit: None,
             stop: None,
+            cancel: None,
             progress: None,
         }
     }
@@ -429,6 +433,13 @@ pub(crate) fn render_passes(
                 })
                 .collect()
         });
+        if opts
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            return Err(HeronError::Cancelled);
+        }
         for t in results {
             for y in 0..t.h {
                 for x in 0..t.w {
@@ -552,7 +563,15 @@ fn render_tile<const N: usize>(
         tfar: f32::INFINITY,
     }; PACKET];
     let mut wls = [SampledWavelengths::<N>::sample_uniform(0.0); PACKET];
+    let cancelled = || {
+        opts.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+    };
     for y in 0..h {
+        if cancelled() {
+            break;
+        }
         for xs in (0..w).step_by(PACKET) {
             let lanes = (w - xs).min(PACKET as u32) as usize;
             let active: u8 = if lanes == PACKET {

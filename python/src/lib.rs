@@ -5,7 +5,7 @@
 //! - `Scene.render(...)` → `RenderResult`: `heron::render::render` with the options
 //!   `heron render` sets up (src/main.rs `cmd_render`), so the arrays are the numbers of
 //!   the CLI's EXR bit for bit; the GIL is released while rendering, and Ctrl-C stops the
-//!   render at its next pass boundary (`RenderOptions::stop`);
+//!   render within a row of a tile (`RenderOptions::cancel`);
 //! - `trace`, `sky_profile`, `color`, `ior`: the cores of `heron trace`, `heron sky
 //!   profile`, `heron color` (in memory) and the scene files' `ior` values.
 //!

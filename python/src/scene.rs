@@ -147,7 +147,7 @@ impl Scene {
     /// `--xyz`; S0.* with `--spectral-bins`).
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
-    /// from any other signal handler) stops the render at its next pass boundary and is
+    /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
     #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None))]
     #[allow(clippy::too_many_arguments)]
@@ -248,15 +248,17 @@ impl Scene {
 
 /// Renders on a worker thread while this thread, without the GIL, waits for it and
 /// every [`SIGNAL_POLL`] takes the GIL to run Python's signal handlers. When a handler
-/// raises (KeyboardInterrupt), the render's stop flag is set, the renderer finishes its
-/// current pass and returns, and the exception is raised.
+/// raises (KeyboardInterrupt), the render's cancel flag is set, the renderer abandons it
+/// within a row of a tile and returns, and the exception is raised.
 fn render_interruptible(
     py: Python<'_>,
     scene: Arc<heron_core::scene::Scene>,
     mut opts: RenderOptions,
 ) -> PyResult<(Film, RenderStats, RenderOptions)> {
+    // Ctrl-C abandons the render within a row of a tile (the partial image is discarded
+    // anyway).
     let stop = Arc::new(AtomicBool::new(false));
-    opts.stop = Some(stop.clone());
+    opts.cancel = Some(stop.clone());
     let (tx, rx) = mpsc::channel();
     let worker = std::thread::Builder::new()
         .name("heron-render".into())

@@ -13,8 +13,8 @@
 - `sky_profile` equals `heron sky profile`'s CSV (printed to 7 significant digits).
 - `color` equals `heron color`'s JSON.
 - `ior`: water and N-BK7 at known wavelengths; models as dicts.
-- Ctrl-C: a SIGINT during a long render raises KeyboardInterrupt at the next pass
-  boundary; the interpreter goes on and renders again.
+- Ctrl-C: a SIGINT during a long render raises KeyboardInterrupt within a row of a
+  tile; the interpreter goes on and renders again.
 - The example examples/python/descartes_sweep.py runs and its Airy peaks move towards
   Descartes' as the drops grow.
 
