@@ -15,7 +15,9 @@
 # Follow them with `squeue -j ARRAY,MERGE` or `scontrol show job ID`. If a task fails the
 # merge is cancelled (--kill-on-invalid-dep); resubmit that task alone with
 #   sbatch --array=K --export=ALL,HERON_SHARDS=N,HERON_BIN=... render-array.sbatch SCENE OUTDIR FLAGS
-# and the merge with merge.sbatch (see the top of each file).
+# and the merge with merge.sbatch (see the top of each file); a task stopped at its time
+# limit continues from the samples it wrote. Use a new OUTDIR for each render: a task
+# refuses an existing part of another render.
 #
 # Environment:
 #   HERON_BIN          heron binary (default: `heron` on this PATH), resolved to an
