@@ -14,7 +14,19 @@ cd "$(dirname "$0")/.."
 # Debian's libllvm15 it picks LLVM 15, which aborts in Dr.Jit's kernels ("LLVM ERROR: Cannot
 # select ... fminimum"). To pin it explicitly:
 # DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
-APT_PACKAGES=(libembree-dev embree-tools pkg-config gcc python3-venv python3-pip libllvm19)
+#
+# slurm-wlm (slurmctld, slurmd, the client commands; 22.05) and munge: the single-node
+# cluster tests/slurm/cluster.sh starts for tests/python/test_slurm.py, in a temporary
+# directory of its own (own munge key and socket, config through SLURM_CONF). Installing
+# them starts nothing in a container: their postinst scripts start services through
+# invoke-rc.d, which does nothing without a running init (no runlevel) or when a
+# policy-rc.d forbids it. Under systemd munge.service starts with Debian's key, which the
+# test's cluster does not use, and slurmctld and slurmd do not (their units need
+# /etc/slurm/slurm.conf, which nothing writes).
+# python3-yaml: the system Python's PyYAML, which reads deploy/k8s/render-job.yaml in
+# test_slurm.py (the pinned .venv has no YAML parser).
+APT_PACKAGES=(libembree-dev embree-tools pkg-config gcc python3-venv python3-pip libllvm19
+  slurm-wlm munge python3-yaml)
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
