@@ -91,7 +91,10 @@ mod tests {
         assert_eq!(to_fixed(f32::MIN_POSITIVE / 4.0), Some(0));
         // Integer and fraction parts meet exactly.
         assert_eq!(to_fixed(-2.75), Some(-(11i128 << (FRAC_BITS - 2))));
-        assert_eq!(to_fixed(3.0e9 + 256.0), Some(3_000_000_256i128 << FRAC_BITS));
+        assert_eq!(
+            to_fixed(3.0e9 + 256.0),
+            Some(3_000_000_256i128 << FRAC_BITS)
+        );
     }
 
     #[test]
