@@ -11,7 +11,7 @@
 use crate::accel::embree::{self, RayQuery};
 use crate::checkpoint::{Checkpoint, Shard};
 use crate::film::fixed::{to_fixed, to_fixed3};
-use crate::film::{bins_of_sample, xyz_of_sample, Film, SpectralBins, Splats};
+use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{self, Context, IntegratorKind, TraceCounters};
 use crate::sampler::{Sampler, SamplerKind};
@@ -613,24 +613,23 @@ fn render_tile<const N: usize>(
                     } else {
                         None
                     };
-                    let b = match c {
-                        Some(_) if nb > 0 => bins_of_sample(&bins, &l, &wls[k]).map(Some),
-                        Some(_) => Some(None),
-                        None => None,
-                    };
-                    let (Some(c), Some(b)) = (c, b) else {
+                    // The bins are added only when the XYZ is in range, and the XYZ
+                    // only when the bins were.
+                    let ok = c.is_some()
+                        && (nb == 0
+                            || add_to_bins(
+                                &bins,
+                                &mut spectral[i * nb..(i + 1) * nb],
+                                &l,
+                                &wls[k],
+                            ));
+                    let (Some(c), true) = (c, ok) else {
                         nonfinite += 1;
                         first_nonfinite = first_nonfinite.or(Some((x0 + xs + k as u32, y0 + y, s)));
                         continue;
                     };
                     for j in 0..3 {
                         xyz[i][j] = xyz[i][j].wrapping_add(c[j]);
-                    }
-                    if let Some(b) = b {
-                        for (bin, v) in b {
-                            let a = &mut spectral[i * nb + bin];
-                            *a = a.wrapping_add(v);
-                        }
                     }
                     good[i] += 1;
                 }

@@ -53,26 +53,36 @@ impl SpectralBins {
     }
 }
 
-/// One sample's lanes as spectral-bin contributions: lane i adds L(λᵢ)/(N p(λᵢ) Δλ_bin),
-/// the estimate of the bin's mean spectral radiance, in fixed point (`fixed.rs`), as
-/// (bin, value) with value 0 for lanes that add nothing. None if any is out of range.
+/// Adds one sample's lanes to spectral bins: lane i adds L(λᵢ)/(N p(λᵢ) Δλ_bin), the
+/// estimate of the bin's mean spectral radiance, in fixed point (`fixed.rs`). Adds
+/// nothing and returns false if any lane's value is out of the fixed-point range.
 #[inline]
-pub fn bins_of_sample<const N: usize>(
+pub fn add_to_bins<const N: usize>(
     bins: &SpectralBins,
+    out: &mut [i128],
     l: &SampledSpectrum<N>,
     wl: &SampledWavelengths<N>,
-) -> Option<[(usize, i128); N]> {
+) -> bool {
     let w = 1.0 / (N as f32 * bins.width());
-    let mut out = [(0usize, 0i128); N];
-    for (i, o) in out.iter_mut().enumerate() {
-        if wl.pdf[i] > 0.0 && l.0[i] != 0.0 {
-            *o = (
-                bins.index(wl.lambda[i]),
-                fixed::to_fixed(l.0[i] * w / wl.pdf[i])?,
-            );
+    // A select rather than a branch: an ended lane (pdf 0) adds nothing.
+    let v: [f32; N] = std::array::from_fn(|i| {
+        if wl.pdf[i] > 0.0 {
+            l.0[i] * w / wl.pdf[i]
+        } else {
+            0.0
+        }
+    });
+    if !v.iter().all(|x| x.abs() < fixed::LIMIT) {
+        return false;
+    }
+    for (i, &v) in v.iter().enumerate() {
+        if v != 0.0 {
+            let a = &mut out[bins.index(wl.lambda[i])];
+            // In range: checked above.
+            *a = a.wrapping_add(fixed::to_fixed(v).unwrap_or(0));
         }
     }
-    Some(out)
+    true
 }
 
 /// Contributions an integrator makes to pixels other than the one it samples (light
