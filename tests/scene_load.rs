@@ -155,6 +155,7 @@ fn default_scene_has_the_lecture_numbers() {
             glossy: false,
             emitters: false,
             escape: true,
+            media: false,
         }
     );
 }
@@ -189,6 +190,7 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
             glossy: false,
             emitters: false,
             escape: true,
+            media: false,
         }
     );
 
@@ -219,6 +221,7 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
             glossy: true,
             emitters: false,
             escape: true,
+            media: false,
         }
     );
 }
