@@ -586,3 +586,45 @@ fn media_are_refused_by_other_integrators_and_bad_keys_named() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn media_renders_do_not_depend_on_the_thread_count() {
+    // Free flights, phase samples and shadow rays through boundaries read the pixel
+    // sample's own random numbers only: 1 and 2 threads give the same bits.
+    let dir = temp_dir("threads");
+    let scene = load_in(
+        &dir,
+        r#"
+background = 0.5
+[camera]
+eye = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+resolution = [24, 16]
+[render]
+max_depth = 20
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+medium = { type = "mie", radius_mm = 0.002, number_density = 4e10 }
+[[lights]]
+type = "sun"
+direction = [0.3, -1.0, -0.4]
+irradiance = 2.0
+"#,
+    );
+    let bits = |threads: usize| {
+        let mut o = RenderOptions::from_scene(&scene);
+        o.integrator = IntegratorKind::Path;
+        o.spp = 8;
+        o.threads = threads;
+        let (film, _) = render(&scene, &o).unwrap();
+        film.xyz
+            .iter()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect::<Vec<u32>>()
+    };
+    assert_eq!(bits(1), bits(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}

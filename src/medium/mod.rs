@@ -10,6 +10,19 @@
 //! T(λ) = exp(−σ_t(λ) d) and free-flight sampling with the hero's σ_t has no majorant
 //! to bound (the majorant is σ_t itself; `integrator::path`).
 //!
+//! In a scene (`medium = { ... }` on a shape, `scene/file.rs`): the shape must be closed
+//! (a sphere, or a mesh whose every edge is shared by two triangles) and is either
+//! - a medium's **index-matched boundary** (no material): rays cross it without
+//!   refraction or reflection, and shadow rays continue through it; or
+//! - a **dielectric** (smooth or rough) with the medium inside (a glass of milk): the
+//!   surface refracts and reflects as any dielectric, the medium fills the inside.
+//!   Opaque materials around a medium are refused (light could never enter it).
+//!
+//! Limits, stated: the camera is outside every medium; media do not nest or overlap (a
+//! path leaving a shape's medium is in no medium, so a glass inside fog is surrounded by
+//! vacuum once the path has entered it); only the path integrator renders media (the
+//! others refuse such a scene with a one-line error).
+//!
 //! Directions: the phase functions take the angle θ between the path's propagation
 //! direction `d_in` (the ray that reached the scattering point) and the new direction;
 //! θ = 0 is forward. Being reciprocal, p is the same for light and importance.
