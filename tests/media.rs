@@ -39,6 +39,10 @@ const CHI2_TESTS: usize = 4;
 const SAMPLES: usize = 1_000_000;
 
 fn mie(radius_m: f64, absorption: bool) -> Medium {
+    mie_cut(radius_m, absorption, 0.0)
+}
+
+fn mie_cut(radius_m: f64, absorption: bool, forward_cutoff_deg: f64) -> Medium {
     Medium::LorenzMie(LorenzMieMedium::new(MieSpec {
         population: vec![PopulationNode {
             radius_m,
@@ -46,6 +50,7 @@ fn mie(radius_m: f64, absorption: bool) -> Medium {
         }],
         absorption,
         lambda_step_nm: 10.0,
+        forward_cutoff_deg,
     }))
 }
 
@@ -115,6 +120,42 @@ fn mie_table_resolves_the_forward_peak_and_normalises() {
         // Water absorbs a little: σ_s < σ_t, by less than 1e-3 for drops ≤ 0.25 mm.
         let (t, s) = (m.sigma_t.eval(700.0), m.sigma_s.eval(700.0));
         assert!(s < t && (t - s) / t < 1e-3, "σ_t = {t}, σ_s = {s}");
+    }
+}
+
+#[test]
+fn truncated_diffraction_peak_keeps_the_scattering_outside_it() {
+    // forward_cutoff (delta-M): σ_s' p' = σ_s p outside the cone, the removed fraction f
+    // leaves σ_t − σ_s alike (absorption unchanged, to f32 precision of σ_t), and for 10 µm drops the 5° cone
+    // holds the diffraction peak, about half of the scattering (Q_sca ≈ 2, half of it
+    // diffraction: van de Hulst 1957, §8.22).
+    let full = mie_cut(10e-6, true, 0.0);
+    let cut = mie_cut(10e-6, true, 5.0);
+    let d = Vec3::Z;
+    for lambda in [450.0f32, 550.0, 650.0] {
+        let wl = SampledWavelengths::<1>::new([lambda], [1.0]);
+        let (st, ss) = (full.sigma_t(&wl).0[0] as f64, full.sigma_s(&wl).0[0] as f64);
+        let (st2, ss2) = (cut.sigma_t(&wl).0[0] as f64, cut.sigma_s(&wl).0[0] as f64);
+        let f = 1.0 - ss2 / ss;
+        assert!(f > 0.4 && f < 0.65, "λ = {lambda}: f = {f}");
+        assert!(
+            ((st - ss) - (st2 - ss2)).abs() < 1e-5 * st,
+            "σ_a changed at {lambda}: {} vs {}",
+            st - ss,
+            st2 - ss2
+        );
+        for deg in [10.0f32, 42.0, 90.0, 170.0] {
+            let w = Vec3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+            let a = ss * full.phase(d, w, &wl).0[0] as f64;
+            let b = ss2 * cut.phase(d, w, &wl).0[0] as f64;
+            assert!(
+                (a / b - 1.0).abs() < 1e-4,
+                "λ = {lambda}, θ = {deg}°: {a} vs {b}"
+            );
+        }
+        // Inside the cone nothing scatters.
+        let w = Vec3::new(1f32.to_radians().sin(), 0.0, 1f32.to_radians().cos());
+        assert_eq!(cut.phase(d, w, &wl).0[0], 0.0);
     }
 }
 

@@ -342,8 +342,9 @@ pub struct MeshFile {
 /// `medium = { type = ..., ... }` on a shape: a homogeneous participating medium inside
 /// it. `type = "mie"`: water drops of `radius_mm` (monodisperse), with either
 /// `number_density` (drops per m³) or `liquid_water_content` (g/m³); optional
-/// `absorption` (default true: water's imaginary index) and `lambda_step` (nm between
-/// the Lorenz–Mie wavelength nodes, default 10). `type = "henyey-greenstein"`:
+/// `absorption` (default true: water's imaginary index), `lambda_step` (nm between
+/// the Lorenz–Mie wavelength nodes, default 10) and `forward_cutoff` (degrees, default
+/// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
 /// `sigma_a`, `sigma_s` (per scene unit) and `g` in (−1, 1). The keys are checked
 /// against the type in `load.rs`.
 #[derive(Debug, serde::Deserialize)]
@@ -361,6 +362,8 @@ pub struct MediumFile {
     pub absorption: Option<bool>,
     #[serde(default)]
     pub lambda_step: Option<PositiveNumber>,
+    #[serde(default)]
+    pub forward_cutoff: Option<NonNegativeNumber>,
     #[serde(default)]
     pub sigma_a: Option<NonNegativeNumber>,
     #[serde(default)]

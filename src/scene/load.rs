@@ -1319,6 +1319,12 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
                     "{at}.lambda_step: expected nm between wavelength nodes in [1, 50], got {step}"
                 ));
             }
+            let cutoff = m.forward_cutoff.map_or(0.0, |c| c.0 as f64);
+            if cutoff > 10.0 {
+                return Err(format!(
+                    "{at}.forward_cutoff: expected degrees in [0, 10] (the diffraction peak counted as unscattered), got {cutoff}"
+                ));
+            }
             Ok(MediumPlan::Mie(crate::medium::MieSpec {
                 population: vec![crate::medium::lorenz_mie::PopulationNode {
                     radius_m: r,
@@ -1326,6 +1332,7 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
                 }],
                 absorption: m.absorption.unwrap_or(true),
                 lambda_step_nm: step,
+                forward_cutoff_deg: cutoff,
             }))
         }
         "henyey-greenstein" => {
@@ -1337,6 +1344,7 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
                 ))
                 .or(given("absorption", m.absorption.is_some()))
                 .or(given("lambda_step", m.lambda_step.is_some()))
+                .or(given("forward_cutoff", m.forward_cutoff.is_some()))
             {
                 return Err(format!(
                     "{at}.{k}: applies to type = \"mie\", not to type = \"henyey-greenstein\""
