@@ -606,6 +606,11 @@ fn media_are_refused_by_other_integrators_and_bad_keys_named() {
             "shapes[0].medium.g: expected a mean cosine in (-1, 1)",
         ),
         (
+            r#"{ type = "mie", radius_mm = 0.5, number_density = 1, forward_cutoff = 20 }"#,
+            sphere,
+            "shapes[0].medium.forward_cutoff: expected degrees in [0, 10]",
+        ),
+        (
             r#"{ type = "henyey-greenstein" }"#,
             sphere,
             "expected sigma_a + sigma_s finite and > 0",
