@@ -113,9 +113,10 @@ mod tests {
         // Large spheres: extinction paradox, Q_ext → 2 (B&H §4.4.4).
         let s = sphere(Complex64::new(1.333, 0.0), 5000.0);
         assert!((s.q_ext - 2.0).abs() < 0.01, "Q_ext = {}", s.q_ext);
-        // Weak absorption: Q_abs ≈ (8/3) x Im(m) ... for small k, the geometric-optics
-        // limit Q_abs ≈ 4/3 · 4πk r/λ · n-ish; here just its sign and order of magnitude:
-        // absorption α = 4πk/λ over a path ~ (4/3) r gives Q_abs ~ (4/3)·2x·k·n.
+        // Weak absorption (α r ≪ 1, α = 4πk/λ): the sphere absorbs about α times its
+        // volume, times a factor of order n for the light concentrated inside it, so
+        // Q_abs = C_abs/(πr²) is of order (4/3) α r n = (4/3)·2xk·n. Checked to a factor
+        // of 3: its sign and size, which a wrong sign of Im m or a lost term would break.
         let k = 1e-6;
         let x = 1000.0;
         let s = sphere(Complex64::new(1.333, k), x);
