@@ -90,6 +90,24 @@ def main():
     write(out, "smits1999.csv", ["wavelength_nm"] + SMITS_NAMES,
           np.column_stack([wl] + [basis[n].values for n in SMITS_NAMES]))
 
+    # Water's imaginary index k(λ), Hale & Querry (1973), Table I, 350-850 nm: typed
+    # from the paper's table (not from colour-science, which has no such table). Used
+    # by the Lorenz-Mie media (src/medium/homogeneous.rs) for absorption in the drops.
+    write(out, "water_k_hale_querry1973.csv", ["wavelength_nm", "k"], WATER_K_HALE_QUERRY)
+
+
+# Hale, G. M. & Querry, M. R. (1973), "Optical constants of water in the 200-nm to
+# 200-um wavelength region", Appl. Opt. 12(3), 555-563, Table I (k at 25 C), every
+# 25 nm from 350 to 850 nm. The same digits are in the 6S radiative-transfer code's
+# `indwat` table (which lists the 350 and 450 nm rows at 345 and 445 nm).
+WATER_K_HALE_QUERRY = [
+    (350, 6.5e-9), (375, 3.5e-9), (400, 1.86e-9), (425, 1.3e-9), (450, 1.02e-9),
+    (475, 9.35e-10), (500, 1.0e-9), (525, 1.32e-9), (550, 1.96e-9), (575, 3.6e-9),
+    (600, 1.09e-8), (625, 1.39e-8), (650, 1.64e-8), (675, 2.23e-8), (700, 3.35e-8),
+    (725, 9.15e-8), (750, 1.56e-7), (775, 1.48e-7), (800, 1.25e-7), (825, 1.82e-7),
+    (850, 2.93e-7),
+]
+
 
 if __name__ == "__main__":
     main()

@@ -287,6 +287,7 @@ pub fn obj(data: &[u8]) -> Outcome {
         translate: None,
         emission: None,
         two_sided: None,
+        medium: None,
     };
     let shapes = match load::mesh_shapes(
         text,

@@ -20,6 +20,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod light;
 pub mod math;
+pub mod medium;
 pub mod provenance;
 pub mod render;
 pub mod sampler;

@@ -7,7 +7,7 @@ use heron::camera::Camera;
 use heron::integrator::IntegratorKind;
 use heron::render::{render, RenderOptions};
 use heron::scene::features::{
-    flag_names, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, SHADOWS, SPECULAR,
+    flag_names, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS, SPECULAR,
 };
 use heron::scene::{load_scene, Features, Scene};
 use std::collections::BTreeSet;
@@ -53,6 +53,10 @@ fn specialised_kernels_give_the_general_kernels_image() {
         let own = s.settings.integrator;
         let mut kinds = vec![own, IntegratorKind::Whitted, IntegratorKind::Path];
         kinds.dedup();
+        // Scenes with media render under the path tracer only (the others refuse them).
+        if Features::of(&s).media {
+            kinds = vec![IntegratorKind::Path];
+        }
         for kind in kinds {
             let (auto, k) = image(&s, kind, KernelChoice::Auto);
             let (general, g) = image(&s, kind, KernelChoice::General);
@@ -77,12 +81,13 @@ fn specialised_kernels_give_the_general_kernels_image() {
 fn a_kernel_without_a_feature_the_scene_uses_changes_the_image() {
     // Each flag matters somewhere: dropping it from the scene's own kernel changes the
     // image (so the flags switch real code, and the identity test above can fail).
-    let cases: [(&str, IntegratorKind, KernelFlags); 5] = [
+    let cases: [(&str, IntegratorKind, KernelFlags); 6] = [
         ("default.toml", IntegratorKind::Whitted, SHADOWS),
         ("default.toml", IntegratorKind::Whitted, ESCAPE),
         ("default-mirror.toml", IntegratorKind::Whitted, SPECULAR),
         ("cornell-box.toml", IntegratorKind::Path, EMITTERS),
         ("cornell-box.toml", IntegratorKind::Path, SHADOWS),
+        ("fogbow.toml", IntegratorKind::Path, MEDIA),
     ];
     for (name, kind, flag) in cases {
         let s = scene(name);

@@ -155,6 +155,7 @@ fn default_scene_has_the_lecture_numbers() {
             glossy: false,
             emitters: false,
             escape: true,
+            media: false,
         }
     );
 }
@@ -189,6 +190,7 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
             glossy: false,
             emitters: false,
             escape: true,
+            media: false,
         }
     );
 
@@ -219,6 +221,7 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
             glossy: true,
             emitters: false,
             escape: true,
+            media: false,
         }
     );
 }
@@ -356,7 +359,7 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = 0.5\ncolour = 1\n",
      &["unknown key \"colour\" at materials.x (expected one of type, rho_d)"]),
     ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\nradus = 1\n",
-     &["unknown key \"radus\" at shapes[0] (expected one of type, center, radius, material, emission, two_sided)"]),
+     &["unknown key \"radus\" at shapes[0] (expected one of type, center, radius, material, emission, two_sided, medium)"]),
     ("", "[materials.x]\ntype = \"mirror\"\nior = 1.5\n",
      &["unknown key \"ior\" at materials.x (expected one of type, rho_s)"]),
     ("", "[render]\nsamples = 4\n",

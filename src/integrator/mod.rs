@@ -20,7 +20,7 @@ use crate::accel::embree::{self, Hit, RayQuery};
 use crate::film::Splats;
 use crate::geometry::{Ray, RayOffset, SpawnPoint};
 use crate::sampler::Sampler;
-use crate::scene::features::{KernelFlags, ALL, SPECULAR};
+use crate::scene::features::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -157,8 +157,9 @@ fn bdpt_any<const N: usize>(
     bdpt::radiance(ctx, ray, first_hit, wl, sampler, counters, splats)
 }
 
-/// Every kernel of one integrator, indexed by its flags (`ALL` is 15). The path tracer
-/// has no `SPECULAR` flag, so its entries with that bit are the ones without it.
+/// Every kernel of one integrator, indexed by its flags (`ALL` is 31). The path tracer
+/// has no `SPECULAR` flag, so its entries with that bit are the ones without it; the
+/// Whitted tracer has no `MEDIA` flag (scenes with media are refused under it).
 macro_rules! kernels {
     ($f:ident, $n:ident, $drop:expr; $($k:literal)*) => {
         [$($f::<$n, { $k & !$drop }> as RadianceFn<$n>),*]
@@ -172,11 +173,11 @@ pub fn kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> RadianceF
     let k = (k & ALL) as usize;
     match kind {
         IntegratorKind::Whitted => {
-            kernels!(whitted_k, N, 0; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15)[k]
+            kernels!(whitted_k, N, MEDIA; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
+                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k]
         }
-        IntegratorKind::Path => {
-            kernels!(path_k, N, SPECULAR; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15)[k]
-        }
+        IntegratorKind::Path => kernels!(path_k, N, SPECULAR; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
+                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
         IntegratorKind::LightTrace => lighttrace_any::<N>,
         IntegratorKind::Bdpt => bdpt_any::<N>,
     }

@@ -48,6 +48,10 @@ pub struct Features {
     /// A ray that leaves the scene can find radiance: a background, sky or sun (the
     /// scene's lights at infinity). When false, an escaping path simply ends.
     pub escape: bool,
+    /// Some shape encloses a participating medium: paths track the medium they are in,
+    /// sample free flights and scatter in it, and shadow rays pass media boundaries with
+    /// their transmittance. When false, none of that code is in the kernel.
+    pub media: bool,
 }
 
 /// A set of [`Features`] a kernel is compiled for, as bits (a `const` generic).
@@ -61,8 +65,10 @@ pub const SPECULAR: KernelFlags = 1 << 1;
 pub const EMITTERS: KernelFlags = 1 << 2;
 /// Radiance of the lights at infinity along escaping rays.
 pub const ESCAPE: KernelFlags = 1 << 3;
+/// Participating media (path tracer only).
+pub const MEDIA: KernelFlags = 1 << 4;
 /// The general kernel: every flag on.
-pub const ALL: KernelFlags = SHADOWS | SPECULAR | EMITTERS | ESCAPE;
+pub const ALL: KernelFlags = SHADOWS | SPECULAR | EMITTERS | ESCAPE | MEDIA;
 
 /// The flags this build was made without (`HERON_STRIP`, see the module docs).
 pub const STRIPPED: KernelFlags = (if cfg!(heron_strip_shadows) {
@@ -100,6 +106,7 @@ pub fn flag_names(k: KernelFlags) -> String {
         (SPECULAR, "specular"),
         (EMITTERS, "emitters"),
         (ESCAPE, "escape"),
+        (MEDIA, "media"),
     ]
     .iter()
     .filter(|(f, _)| k & f != 0)
@@ -161,11 +168,13 @@ impl Features {
         let non_specular = used().any(|m| m.flags().has_non_specular());
         Features {
             shadows: lit && non_specular,
-            nee: non_specular && scene.lights.iter().any(emits),
+            // Media scatter light from the lights too.
+            nee: (non_specular || !scene.media.is_empty()) && scene.lights.iter().any(emits),
             specular: used().any(|m| m.flags().is_specular()),
             glossy: used().any(|m| matches!(m, Material::Glossy(_))),
             emitters: scene.shape_light.iter().any(|&l| l != NO_LIGHT),
             escape: !scene.infinite_lights.is_empty(),
+            media: !scene.media.is_empty(),
         }
     }
 
@@ -182,7 +191,10 @@ impl Features {
                     | bit(self.escape, ESCAPE)
             }
             IntegratorKind::Path => {
-                bit(self.nee, SHADOWS) | bit(self.emitters, EMITTERS) | bit(self.escape, ESCAPE)
+                bit(self.nee, SHADOWS)
+                    | bit(self.emitters, EMITTERS)
+                    | bit(self.escape, ESCAPE)
+                    | bit(self.media, MEDIA)
             }
             IntegratorKind::LightTrace | IntegratorKind::Bdpt => ALL,
         }
@@ -195,6 +207,12 @@ impl Features {
         kind: IntegratorKind,
         choice: KernelChoice,
     ) -> Result<KernelFlags, String> {
+        if self.media && kind != IntegratorKind::Path {
+            return Err(format!(
+                "the scene has participating media (a shape's medium), which only the path integrator renders, not {}; use --integrator path",
+                kind.name()
+            ));
+        }
         let need = self.kernel(kind);
         let specialised = !matches!(kind, IntegratorKind::LightTrace | IntegratorKind::Bdpt);
         let missing = stripped_of(need);

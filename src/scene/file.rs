@@ -250,6 +250,9 @@ pub struct SphereFile {
     /// Emit from both sides (default: only the side the outward normal points to).
     #[serde(default)]
     pub two_sided: Option<bool>,
+    /// A participating medium inside the shape (closed shapes only).
+    #[serde(default)]
+    pub medium: Option<MediumFile>,
 }
 
 #[derive(Debug, serde::Deserialize)]
@@ -264,6 +267,9 @@ pub struct TriangleFile {
     pub emission: Option<Emission>,
     #[serde(default)]
     pub two_sided: Option<bool>,
+    /// A participating medium inside the shape (closed shapes only).
+    #[serde(default)]
+    pub medium: Option<MediumFile>,
 }
 
 /// An infinite plane, stored as a square of half-extent `size` centred at `point`.
@@ -281,6 +287,9 @@ pub struct PlaneFile {
     pub emission: Option<Emission>,
     #[serde(default)]
     pub two_sided: Option<bool>,
+    /// A participating medium inside the shape (closed shapes only).
+    #[serde(default)]
+    pub medium: Option<MediumFile>,
 }
 
 /// The parallelogram origin + s·edge1 + t·edge2, s, t ∈ [0, 1]; normal edge1 × edge2.
@@ -296,6 +305,9 @@ pub struct QuadFile {
     pub emission: Option<Emission>,
     #[serde(default)]
     pub two_sided: Option<bool>,
+    /// A participating medium inside the shape (closed shapes only).
+    #[serde(default)]
+    pub medium: Option<MediumFile>,
 }
 
 /// A Wavefront OBJ triangle mesh.
@@ -322,7 +334,46 @@ pub struct MeshFile {
     pub emission: Option<Emission>,
     #[serde(default)]
     pub two_sided: Option<bool>,
+    /// A participating medium inside the shape (closed shapes only).
+    #[serde(default)]
+    pub medium: Option<MediumFile>,
 }
+
+/// `medium = { type = ..., ... }` on a shape: a homogeneous participating medium inside
+/// it. `type = "mie"`: water drops of `radius_mm` (monodisperse), with either
+/// `number_density` (drops per m³) or `liquid_water_content` (g/m³); optional
+/// `absorption` (default true: water's imaginary index), `lambda_step` (nm between
+/// the Lorenz–Mie wavelength nodes, default 10) and `forward_cutoff` (degrees, default
+/// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
+/// `sigma_a`, `sigma_s` (per scene unit) and `g` in (−1, 1). The keys are checked
+/// against the type in `load.rs`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumFile {
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default)]
+    pub radius_mm: Option<PositiveNumber>,
+    #[serde(default)]
+    pub number_density: Option<PositiveNumber>,
+    #[serde(default)]
+    pub liquid_water_content: Option<PositiveNumber>,
+    #[serde(default)]
+    pub absorption: Option<bool>,
+    #[serde(default)]
+    pub lambda_step: Option<PositiveNumber>,
+    #[serde(default)]
+    pub forward_cutoff: Option<NonNegativeNumber>,
+    #[serde(default)]
+    pub sigma_a: Option<NonNegativeNumber>,
+    #[serde(default)]
+    pub sigma_s: Option<NonNegativeNumber>,
+    #[serde(default)]
+    pub g: Option<f32>,
+}
+
+/// The `type` values of [`MediumFile`].
+pub const MEDIUM_TYPES: &[&str] = &["mie", "henyey-greenstein"];
 
 /// `[[lights]]`, tagged by `type`.
 #[derive(Debug, serde::Deserialize)]

@@ -21,9 +21,9 @@ pub(crate) mod obj;
 
 use super::file::{
     show, Colour, ConductorFile, DielectricFile, DirectionalLightFile, Emission, GlossyFile,
-    IorSpec, LambertianFile, LightFile, MaterialFile, MeshFile, MetalSpec, MirrorFile, PlaneFile,
-    PointLightFile, QuadFile, SceneFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile,
-    TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
+    IorSpec, LambertianFile, LightFile, MaterialFile, MediumFile, MeshFile, MetalSpec, MirrorFile,
+    PlaneFile, PointLightFile, QuadFile, SceneFile, ShapeFile, SphereFile, SpotLightFile,
+    SunLightFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
 };
 use super::{RenderSettings, Scene};
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
@@ -63,10 +63,11 @@ pub fn load_scene_from_str(text: &str, path: &Path) -> Result<Scene> {
     Ok(scene)
 }
 
-/// Whether [`build`] tabulates a `[sky]` model. Tabulating a physical sky takes seconds
-/// (it is the model's evaluation, not the file's reading), so the fuzzing harness
-/// ([`crate::fuzzing`]) checks the `[sky]` table and constructs its model but leaves
-/// `Scene::sky` empty.
+/// Whether [`build`] tabulates a `[sky]` model and Lorenz–Mie media. Tabulating a
+/// physical sky or a medium of rain drops takes seconds (it is the model's evaluation,
+/// not the file's reading), so the fuzzing harness ([`crate::fuzzing`]) checks the
+/// `[sky]` table and constructs its model but leaves `Scene::sky` empty, and checks a
+/// `type = "mie"` medium's keys and shape but builds no medium for it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum SkyTables {
     Build,
@@ -453,6 +454,28 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
         }));
         material_names.push("(black emitter)".into());
     }
+    // A shape with a medium and no material is the medium's index-matched boundary: it
+    // gets a dielectric of index 1 (Fresnel 0, straight through), so every integrator and
+    // `heron stress` see a valid material; the path tracer passes it without a bounce.
+    let boundary = materials.len() as u32;
+    let mut plans: Vec<Option<MediumPlan>> = Vec::with_capacity(file.shapes.len());
+    for (i, s) in file.shapes.iter().enumerate() {
+        let at = format!("shapes[{i}].medium");
+        plans.push(match shape_medium(s) {
+            Some(m) => Some(plan_medium(&at, m).map_err(err)?),
+            None => None,
+        });
+    }
+    if file.shapes.iter().any(|s| {
+        let (m, e, _) = shape_emission(s);
+        m.is_none() && e.is_none() && shape_medium(s).is_some()
+    }) {
+        materials.push(Material::Dielectric(Dielectric::new(
+            Ior::Constant(1.0),
+            true,
+        )));
+        material_names.push("(medium boundary)".into());
+    }
     let index: HashMap<&str, u32> = material_names
         .iter()
         .enumerate()
@@ -480,6 +503,7 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
         match (material, emission) {
             (Some(name), _) => lookup(format!("{at}.material"), name),
             (None, Some(_)) => Ok(black),
+            (None, None) if shape_medium(s).is_some() => Ok(boundary),
             (None, None) => Err(err(format!(
                 "{at}.material: missing required key (expected the name of a material, or an emission)"
             ))),
@@ -582,12 +606,95 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
                         "{at}.two_sided: applies to emitting shapes, but emission is not given"
                     )));
                 }
-                let fallback = m.emission.as_ref().map(|_| black);
+                let fallback = match (&m.emission, &m.medium) {
+                    (Some(_), _) => Some(black),
+                    (None, Some(_)) => Some(boundary),
+                    (None, None) => None,
+                };
                 shapes.extend(build_mesh(path, &base_dir, &at, m, &lookup, fallback)?);
                 inputs.push(m.file.clone());
             }
         }
         shape_entry.resize(shapes.len(), i);
+    }
+
+    // Media: on closed shapes, whose surface lets light in (no material: an index-matched
+    // boundary; or a smooth or rough dielectric: a glass of milk); one medium per entry,
+    // tabulated once per distinct medium.
+    let mut media: Vec<crate::medium::Medium> = Vec::new();
+    let mut medium_plans: Vec<MediumPlan> = Vec::new();
+    let mut shape_medium_of = vec![crate::medium::NO_MEDIUM; shapes.len()];
+    let mut shape_interface = vec![false; shapes.len()];
+    for (k, shape) in shapes.iter().enumerate() {
+        let i = shape_entry[k];
+        let Some(plan) = &plans[i] else { continue };
+        let at = format!("shapes[{i}]");
+        let entry = &file.shapes[i];
+        if shape_emission(entry).1.is_some() {
+            return Err(err(format!(
+                "{at}.medium: a shape with a medium cannot also emit (emission is given)"
+            )));
+        }
+        if shapes
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| shape_entry[*j] == i)
+            .count()
+            > 1
+        {
+            return Err(err(format!(
+                "{at}.medium: expected a mesh of one material around the medium, got a mesh whose groups use several"
+            )));
+        }
+        if !crate::stress::closed(shape) {
+            return Err(err(format!(
+                "{at}.medium: expected a closed shape (a sphere, or a mesh whose every edge is shared by two triangles) around the medium, got an open {}",
+                match entry {
+                    ShapeFile::Sphere(_) => "sphere",
+                    ShapeFile::Triangle(_) => "triangle",
+                    ShapeFile::Plane(_) => "plane",
+                    ShapeFile::Quad(_) => "quad",
+                    ShapeFile::Mesh(_) => "mesh",
+                }
+            )));
+        }
+        match &materials[shape.material as usize] {
+            _ if shape_emission(entry).0.is_none() => shape_interface[k] = true,
+            Material::Dielectric(_) | Material::RoughDielectric(_) => {}
+            _ => {
+                return Err(err(format!(
+                    "{at}.material: a shape with a medium needs a surface light can enter: no material (an index-matched boundary) or a dielectric, got {:?}",
+                    material_names[shape.material as usize]
+                )))
+            }
+        }
+        // The fuzzing harness never renders: it checks the medium's keys and shape but
+        // does not spend seconds tabulating Lorenz–Mie (the shape is left without one).
+        if sky_tables == SkyTables::Skip && matches!(plan, MediumPlan::Mie(_)) {
+            continue;
+        }
+        let id = match medium_plans.iter().position(|p| p == plan) {
+            Some(id) => id,
+            None => {
+                media.push(match plan {
+                    MediumPlan::Mie(spec) => crate::medium::Medium::LorenzMie(
+                        crate::medium::LorenzMieMedium::new(spec.clone()),
+                    ),
+                    MediumPlan::Hg {
+                        sigma_a,
+                        sigma_s,
+                        g,
+                    } => crate::medium::Medium::HenyeyGreenstein(crate::medium::HgMedium::new(
+                        DenseSpectrum::constant(*sigma_a),
+                        DenseSpectrum::constant(*sigma_s),
+                        *g,
+                    )),
+                });
+                medium_plans.push(plan.clone());
+                media.len() - 1
+            }
+        };
+        shape_medium_of[k] = id as u32;
     }
 
     // The bounding sphere (the lights at infinity start their paths on it) must be
@@ -810,6 +917,9 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
         settings,
     });
     scene.inputs = inputs;
+    scene.media = std::sync::Arc::new(media);
+    scene.shape_medium = shape_medium_of;
+    scene.shape_interface = shape_interface;
     Ok(scene)
 }
 
@@ -1151,6 +1261,135 @@ fn plan_sky(
 }
 
 /// A shape entry's material name, emission and two-sidedness.
+/// A shape entry's medium.
+fn shape_medium(s: &ShapeFile) -> Option<&MediumFile> {
+    match s {
+        ShapeFile::Sphere(x) => x.medium.as_ref(),
+        ShapeFile::Triangle(x) => x.medium.as_ref(),
+        ShapeFile::Plane(x) => x.medium.as_ref(),
+        ShapeFile::Quad(x) => x.medium.as_ref(),
+        ShapeFile::Mesh(x) => x.medium.as_ref(),
+    }
+}
+
+/// What a `medium` table builds: the key path is `at` (`shapes[i].medium`).
+#[derive(Clone, Debug, PartialEq)]
+enum MediumPlan {
+    Mie(crate::medium::MieSpec),
+    Hg { sigma_a: f32, sigma_s: f32, g: f32 },
+}
+
+/// Checks a `medium` table against its type. Lorenz–Mie radii are limited to
+/// 0.1 µm–1 mm: the series has x + 4x^{1/3} + 2 terms per angle (x = 2πr/λ, 17 500 at
+/// 1 mm and 360 nm), so larger drops would take minutes to tabulate.
+fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+    fn given(name: &'static str, v: bool) -> Option<&'static str> {
+        if v {
+            Some(name)
+        } else {
+            None
+        }
+    }
+    match m.kind.as_str() {
+        "mie" => {
+            if let Some(k) = given("sigma_a", m.sigma_a.is_some())
+                .or(given("sigma_s", m.sigma_s.is_some()))
+                .or(given("g", m.g.is_some()))
+            {
+                return Err(format!(
+                    "{at}.{k}: applies to type = \"henyey-greenstein\", not to type = \"mie\" (whose coefficients come from Lorenz-Mie theory)"
+                ));
+            }
+            let r_mm = m
+                .radius_mm
+                .ok_or_else(|| {
+                    format!("{at}.radius_mm: missing required key (expected the drop radius in mm)")
+                })?
+                .0 as f64;
+            if !(1e-4..=1.0).contains(&r_mm) {
+                return Err(format!(
+                    "{at}.radius_mm: expected a drop radius in [0.0001, 1] mm, got {r_mm}"
+                ));
+            }
+            let r = r_mm * 1e-3;
+            let density = match (m.number_density, m.liquid_water_content) {
+                (Some(n), None) => n.0 as f64,
+                // N = LWC / (ρ_water · 4/3 π r³), ρ_water = 10⁶ g/m³.
+                (None, Some(w)) => w.0 as f64 / (1e6 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r),
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "{at}: expected one of number_density (drops per m³) or liquid_water_content (g/m³), got both"
+                    ))
+                }
+                (None, None) => {
+                    return Err(format!(
+                        "{at}.number_density: missing required key (expected drops per m³, or liquid_water_content in g/m³)"
+                    ))
+                }
+            };
+            let step = m.lambda_step.map_or(10.0, |s| s.0);
+            if !(1.0..=50.0).contains(&step) {
+                return Err(format!(
+                    "{at}.lambda_step: expected nm between wavelength nodes in [1, 50], got {step}"
+                ));
+            }
+            let cutoff = m.forward_cutoff.map_or(0.0, |c| c.0 as f64);
+            if cutoff > 10.0 {
+                return Err(format!(
+                    "{at}.forward_cutoff: expected degrees in [0, 10] (the diffraction peak counted as unscattered), got {cutoff}"
+                ));
+            }
+            Ok(MediumPlan::Mie(crate::medium::MieSpec {
+                population: vec![crate::medium::lorenz_mie::PopulationNode {
+                    radius_m: r,
+                    number_density: density,
+                }],
+                absorption: m.absorption.unwrap_or(true),
+                lambda_step_nm: step,
+                forward_cutoff_deg: cutoff,
+            }))
+        }
+        "henyey-greenstein" => {
+            if let Some(k) = given("radius_mm", m.radius_mm.is_some())
+                .or(given("number_density", m.number_density.is_some()))
+                .or(given(
+                    "liquid_water_content",
+                    m.liquid_water_content.is_some(),
+                ))
+                .or(given("absorption", m.absorption.is_some()))
+                .or(given("lambda_step", m.lambda_step.is_some()))
+                .or(given("forward_cutoff", m.forward_cutoff.is_some()))
+            {
+                return Err(format!(
+                    "{at}.{k}: applies to type = \"mie\", not to type = \"henyey-greenstein\""
+                ));
+            }
+            let g = m.g.unwrap_or(0.0);
+            if !(g.is_finite() && g.abs() < 1.0) {
+                return Err(format!(
+                    "{at}.g: expected a mean cosine in (-1, 1), got {g}"
+                ));
+            }
+            let sigma_a = m.sigma_a.map_or(0.0, |x| x.0);
+            let sigma_s = m.sigma_s.map_or(0.0, |x| x.0);
+            if !(sigma_a + sigma_s).is_finite() || sigma_a + sigma_s <= 0.0 {
+                return Err(format!(
+                    "{at}: expected sigma_a + sigma_s finite and > 0, got {sigma_a} + {sigma_s}"
+                ));
+            }
+            Ok(MediumPlan::Hg {
+                sigma_a,
+                sigma_s,
+                g,
+            })
+        }
+        other => Err(format!(
+            "{at}.type: expected one of {}, got {other:?}",
+            super::file::MEDIUM_TYPES.join(", ")
+        )),
+    }
+}
+
 fn shape_emission(s: &ShapeFile) -> (Option<&String>, Option<&Emission>, Option<bool>) {
     match s {
         ShapeFile::Sphere(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),

@@ -130,6 +130,13 @@ pub struct Scene {
     pub bounds: SceneBounds,
     /// Picks one light per shading point for the path integrator.
     pub light_sampler: LightSampler,
+    /// Participating media (`medium` on shapes); empty for most scenes.
+    pub media: std::sync::Arc<Vec<crate::medium::Medium>>,
+    /// For each shape, the medium it encloses, or [`crate::medium::NO_MEDIUM`].
+    pub shape_medium: Vec<u32>,
+    /// For each shape, whether it is only a medium's boundary (a medium and no
+    /// material): index-matched, rays pass it without refraction or reflection.
+    pub shape_interface: Vec<bool>,
 }
 
 /// What a scene is made of before its derived parts (the environment light, the list of
@@ -174,6 +181,7 @@ impl Scene {
         );
         let bounds = load::scene_bounds(&p.shapes);
         let light_sampler = LightSampler::new(p.settings.light_sampler, &lights, &bounds);
+        let n_shapes = p.shapes.len();
         let shape_light = if p.shape_light.is_empty() {
             vec![NO_LIGHT; p.shapes.len()]
         } else {
@@ -196,6 +204,9 @@ impl Scene {
             settings: p.settings,
             bounds,
             light_sampler,
+            media: Default::default(),
+            shape_medium: vec![crate::medium::NO_MEDIUM; n_shapes],
+            shape_interface: vec![false; n_shapes],
         }
     }
 

@@ -1,0 +1,117 @@
+//! Participating media inside closed shapes: one file per medium, a closed [`Medium`]
+//! enum dispatched by `match`.
+//!
+//! - `homogeneous`: water drops, σ_t(λ), σ_s(λ) and p(θ, λ) from heron's Lorenz–Mie code
+//!   (`lorenz_mie`, BHMIE with water's complex index), tabulated once per scene
+//!   (`phase_table`);
+//! - `henyey_greenstein`: constant σ_a, σ_s and the Henyey–Greenstein phase function.
+//!
+//! Both are homogeneous, so the transmittance over a distance d is exactly
+//! T(λ) = exp(−σ_t(λ) d) and free-flight sampling with the hero's σ_t has no majorant
+//! to bound (the majorant is σ_t itself; `integrator::path`).
+//!
+//! In a scene (`medium = { ... }` on a shape, `scene/file.rs`): the shape must be closed
+//! (a sphere, or a mesh whose every edge is shared by two triangles) and is either
+//! - a medium's **index-matched boundary** (no material): rays cross it without
+//!   refraction or reflection, and shadow rays continue through it; or
+//! - a **dielectric** (smooth or rough) with the medium inside (a glass of milk): the
+//!   surface refracts and reflects as any dielectric, the medium fills the inside.
+//!   Opaque materials around a medium are refused (light could never enter it).
+//!
+//! Limits, stated: the camera is outside every medium; media do not nest or overlap (a
+//! path leaving a shape's medium is in no medium, so a glass inside fog is surrounded by
+//! vacuum once the path has entered it); only the path integrator renders media (the
+//! others refuse such a scene with a one-line error).
+//!
+//! Directions: the phase functions take the angle θ between the path's propagation
+//! direction `d_in` (the ray that reached the scattering point) and the new direction;
+//! θ = 0 is forward. Being reciprocal, p is the same for light and importance.
+pub mod henyey_greenstein;
+pub mod homogeneous;
+pub mod lorenz_mie;
+pub mod phase_table;
+
+pub use henyey_greenstein::HgMedium;
+pub use homogeneous::{LorenzMieMedium, MieSpec};
+
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
+use phase_table::{direction_at, v_between};
+
+/// `Scene::shape_medium` for a shape without a medium.
+pub const NO_MEDIUM: u32 = u32::MAX;
+
+/// A participating medium.
+#[derive(Debug)]
+pub enum Medium {
+    LorenzMie(LorenzMieMedium),
+    HenyeyGreenstein(HgMedium),
+}
+
+impl Medium {
+    /// Extinction coefficient at each lane.
+    #[inline]
+    pub fn sigma_t<const N: usize>(&self, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        match self {
+            Medium::LorenzMie(m) => wl.eval(&m.sigma_t),
+            Medium::HenyeyGreenstein(m) => wl.eval(&m.sigma_t),
+        }
+    }
+
+    /// Scattering coefficient at each lane.
+    #[inline]
+    pub fn sigma_s<const N: usize>(&self, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        match self {
+            Medium::LorenzMie(m) => wl.eval(&m.sigma_s),
+            Medium::HenyeyGreenstein(m) => wl.eval(&m.sigma_s),
+        }
+    }
+
+    /// Transmittance exp(−σ_t d) at each lane over distance `d`.
+    #[inline]
+    pub fn transmittance<const N: usize>(
+        &self,
+        d: f32,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        let st = self.sigma_t(wl);
+        SampledSpectrum(std::array::from_fn(|i| (-st.0[i] * d).exp()))
+    }
+
+    /// The phase function at each lane for propagation `d_in` scattered into `d_out`
+    /// (unit vectors).
+    #[inline]
+    pub fn phase<const N: usize>(
+        &self,
+        d_in: Vec3,
+        d_out: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        let v = v_between(d_in, d_out);
+        match self {
+            Medium::LorenzMie(m) => m.phase.eval(v, &wl.lambda),
+            Medium::HenyeyGreenstein(m) => SampledSpectrum::splat(henyey_greenstein::hg(m.g, v)),
+        }
+    }
+
+    /// A new direction about `d_in` drawn from the hero wavelength's phase function
+    /// (`u_node` chooses between the table's wavelength nodes, `u` the angles), and every
+    /// lane's phase function there; lane 0's value is the sampling pdf (solid angle).
+    #[inline]
+    pub fn sample_phase<const N: usize>(
+        &self,
+        d_in: Vec3,
+        u_node: f32,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+    ) -> (Vec3, SampledSpectrum<N>) {
+        let (v, p) = match self {
+            Medium::LorenzMie(m) => m.phase.sample(u_node, u.x, &wl.lambda),
+            Medium::HenyeyGreenstein(m) => {
+                let (v, p) = henyey_greenstein::sample_hg(m.g, u.x);
+                (v, SampledSpectrum::splat(p))
+            }
+        };
+        (direction_at(d_in, v, u.y), p)
+    }
+}
