@@ -54,17 +54,7 @@ pub fn n_terms(x: f64) -> usize {
 /// The scaled Mie coefficients for a sphere of real relative index `m`, size parameter `x`.
 pub fn coefficients(m: f64, x: f64) -> MieCoefficients {
     let nstop = n_terms(x);
-    let mx = m * x;
-    // Start far enough beyond the turning point n ≈ |mx| that the error of the D = 0 start
-    // has died out by n = |mx| (it decays over a transition zone of width ~|mx|^{1/3}):
-    // with only +15 (BHMIE) D₁ is wrong by 0.06 at mx = 1333; with 8 |mx|^{1/3} more it is
-    // exact to ~1e-15 (checked against scipy's spherical Bessel functions).
-    let nmx = (nstop as f64).max(mx.abs()).ceil() as usize + 16 + (8.0 * mx.abs().cbrt()) as usize;
-    let mut d = vec![0.0f64; nmx + 1];
-    for n in (1..=nmx).rev() {
-        let nf = n as f64;
-        d[n - 1] = nf / mx - 1.0 / (d[n] + nf / mx);
-    }
+    let d = log_derivative_psi(m * x, nstop);
     let (mut psi0, mut psi1) = (x.cos(), x.sin());
     let (mut chi0, mut chi1) = (-x.sin(), x.cos());
     let mut xi1 = Complex64::new(psi1, -chi1);
@@ -89,6 +79,22 @@ pub fn coefficients(m: f64, x: f64) -> MieCoefficients {
         xi1 = xi;
     }
     MieCoefficients { a, b }
+}
+
+/// The logarithmic derivatives D_n(z) = ψ_n′(z)/ψ_n(z) for n = 0…(at least `nstop`), by
+/// the downward recurrence D_{n−1} = n/z − 1/(D_n + n/z) from D = 0. It starts far enough
+/// beyond the turning point n ≈ z that the error of the D = 0 start has died out by n = z
+/// (it decays over a transition zone of width ~z^{1/3}): with only +15 (BHMIE) D₁ is wrong
+/// by 0.06 at z = 1333; with 8 z^{1/3} more it is exact to ~1e-15 (checked against
+/// scipy's spherical Bessel functions). Shared with `debye`.
+pub fn log_derivative_psi(z: f64, nstop: usize) -> Vec<f64> {
+    let nmx = (nstop as f64).max(z.abs()).ceil() as usize + 16 + (8.0 * z.abs().cbrt()) as usize;
+    let mut d = vec![0.0f64; nmx + 1];
+    for n in (1..=nmx).rev() {
+        let nf = n as f64;
+        d[n - 1] = nf / z - 1.0 / (d[n] + nf / z);
+    }
+    d
 }
 
 /// S₁ and S₂ at μ = cos(scattering angle).

@@ -33,6 +33,7 @@
 pub mod airy;
 pub mod aristotle;
 pub mod constant;
+pub mod debye;
 pub mod descartes;
 pub mod mie;
 pub mod profile;
