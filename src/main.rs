@@ -137,6 +137,69 @@ struct SkyProfileArgs {
     /// Background radiance (constant: default 1; aristotle: default 0).
     #[arg(long, allow_hyphen_values = true)]
     background: Option<f64>,
+    /// Drop-size distribution (airy, mie): monodisperse (radius --droplet-radius),
+    /// lognormal (--median-mm, --sigma), gamma (--mode-mm, --mu) or marshall-palmer
+    /// (--rain-rate-mm-h); see heron::drops.
+    #[arg(long)]
+    distribution: Option<String>,
+    /// Log-normal: median radius, mm.
+    #[arg(long, allow_hyphen_values = true)]
+    median_mm: Option<f64>,
+    /// Log-normal: standard deviation of ln a.
+    #[arg(long, allow_hyphen_values = true)]
+    sigma: Option<f64>,
+    /// Gamma: mode radius, mm.
+    #[arg(long, allow_hyphen_values = true)]
+    mode_mm: Option<f64>,
+    /// Gamma: shape μ (≥ 1).
+    #[arg(long, allow_hyphen_values = true)]
+    mu: Option<f64>,
+    /// Marshall–Palmer: rain rate, mm/h.
+    #[arg(long, allow_hyphen_values = true)]
+    rain_rate_mm_h: Option<f64>,
+    /// Quadrature nodes of the distribution (default 48).
+    #[arg(long, allow_hyphen_values = true)]
+    nodes: Option<i64>,
+    /// Only the Debye-series term p (mie): 0 external reflection and diffraction, 1
+    /// direct transmission, 2 the primary bow, 3 the secondary, …
+    #[arg(long)]
+    debye: Option<u32>,
+}
+
+/// The distribution flags as the scene table they mirror; a parameter without
+/// `--distribution` is an error naming it.
+fn drops_from_flags(
+    distribution: Option<String>,
+    [median_mm, sigma, mode_mm, mu, rain_rate_mm_h]: [Option<f64>; 5],
+    nodes: Option<i64>,
+) -> Result<Option<heron::drops::DropsFile>> {
+    let Some(distribution) = distribution else {
+        for (flag, v) in [
+            ("--median-mm", median_mm),
+            ("--sigma", sigma),
+            ("--mode-mm", mode_mm),
+            ("--mu", mu),
+            ("--rain-rate-mm-h", rain_rate_mm_h),
+        ] {
+            if v.is_some() {
+                anyhow::bail!("{flag}: needs --distribution");
+            }
+        }
+        if nodes.is_some() {
+            anyhow::bail!("--nodes: needs --distribution");
+        }
+        return Ok(None);
+    };
+    Ok(Some(heron::drops::DropsFile {
+        distribution,
+        radius_mm: None,
+        median_mm,
+        sigma,
+        mode_mm,
+        mu,
+        rain_rate_mm_h,
+        nodes,
+    }))
 }
 
 fn cmd_sky(c: SkyCommand) -> Result<()> {
@@ -153,6 +216,12 @@ fn cmd_sky(c: SkyCommand) -> Result<()> {
                 k: a.k,
                 polarisation: a.polarisation,
                 background: a.background,
+                drops: drops_from_flags(
+                    a.distribution,
+                    [a.median_mm, a.sigma, a.mode_mm, a.mu, a.rain_rate_mm_h],
+                    a.nodes,
+                )?,
+                debye: a.debye,
             })?
         }
         SkyCommand::MiePhase {

@@ -121,12 +121,18 @@ impl DropSizeDistribution {
     /// Checks the parameters (finite, positive, μ ≥ 1, σ ≤ 1, radii ≤ 10 mm); the error
     /// names the key as `prefix.key`.
     pub fn validate(&self, prefix: &str) -> Result<(), String> {
+        self.validate_named(&|k| format!("{prefix}.{k}"))
+    }
+
+    /// As [`DropSizeDistribution::validate`], each key's name given by `name`.
+    pub fn validate_named(&self, name: &dyn Fn(&str) -> String) -> Result<(), String> {
         let pos = |key: &str, v: f64, max: f64| -> Result<(), String> {
             if v.is_finite() && v > 0.0 && v <= max {
                 Ok(())
             } else {
                 Err(format!(
-                    "{prefix}.{key}: expected a number in (0, {max}], got {v}"
+                    "{}: expected a number in (0, {max}], got {v}",
+                    name(key)
                 ))
             }
         };
@@ -140,7 +146,8 @@ impl DropSizeDistribution {
                 pos("mode_mm", mode_mm, 10.0)?;
                 if !(mu.is_finite() && (1.0..=1000.0).contains(&mu)) {
                     return Err(format!(
-                        "{prefix}.mu: expected a shape in [1, 1000], got {mu}"
+                        "{}: expected a shape in [1, 1000], got {mu}",
+                        name("mu")
                     ));
                 }
                 Ok(())
@@ -326,6 +333,15 @@ impl DropsFile {
     /// The distribution and its node count; errors are one line naming `prefix.key`
     /// (e.g. `sky.drops.sigma`).
     pub fn parse(&self, prefix: &str) -> Result<(DropSizeDistribution, usize), String> {
+        self.parse_named(&|k| format!("{prefix}.{k}"))
+    }
+
+    /// As [`DropsFile::parse`], with the name of each key in errors given by `name` (the
+    /// CLI names its flags).
+    pub fn parse_named(
+        &self,
+        name: &dyn Fn(&str) -> String,
+    ) -> Result<(DropSizeDistribution, usize), String> {
         let keys: [(&str, Option<f64>); 6] = [
             ("radius_mm", self.radius_mm),
             ("median_mm", self.median_mm),
@@ -342,15 +358,17 @@ impl DropsFile {
             "marshall-palmer" | "marshall_palmer" => &["rain_rate_mm_h"],
             other => {
                 return Err(format!(
-                    "{prefix}.distribution: expected one of monodisperse, lognormal, gamma, marshall-palmer, got {other:?}"
+                    "{}: expected one of monodisperse, lognormal, gamma, marshall-palmer, got {other:?}",
+                    name("distribution")
                 ))
             }
         };
         for (k, v) in keys {
             if v.is_some() && !wants.contains(&k) {
                 return Err(format!(
-                    "{prefix}.{k}: does not apply to the {d} distribution (it takes {})",
-                    wants.join(", ")
+                    "{}: does not apply to the {d} distribution (it takes {})",
+                    name(k),
+                    wants.iter().map(|k| name(k)).collect::<Vec<_>>().join(", ")
                 ));
             }
         }
@@ -358,7 +376,7 @@ impl DropsFile {
             keys.iter()
                 .find(|(name, _)| *name == k)
                 .and_then(|(_, v)| *v)
-                .ok_or_else(|| format!("{prefix}.{k}: the {d} distribution needs it"))
+                .ok_or_else(|| format!("{}: the {d} distribution needs it", name(k)))
         };
         let dist = match wants[0] {
             "radius_mm" => DropSizeDistribution::Monodisperse {
@@ -376,18 +394,20 @@ impl DropsFile {
                 rain_rate_mm_h: get("rain_rate_mm_h")?,
             },
         };
-        dist.validate(prefix)?;
+        dist.validate_named(name)?;
         let nodes = match self.nodes {
             None => DEFAULT_NODES,
             Some(_) if matches!(dist, DropSizeDistribution::Monodisperse { .. }) => {
                 return Err(format!(
-                    "{prefix}.nodes: does not apply to the monodisperse distribution"
+                    "{}: does not apply to the monodisperse distribution",
+                    name("nodes")
                 ))
             }
             Some(n) if (1..=MAX_NODES as i64).contains(&n) => n as usize,
             Some(n) => {
                 return Err(format!(
-                    "{prefix}.nodes: expected a count in 1..={MAX_NODES}, got {n}"
+                    "{}: expected a count in 1..={MAX_NODES}, got {n}",
+                    name("nodes")
                 ))
             }
         };

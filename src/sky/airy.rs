@@ -27,6 +27,7 @@
 //! other orders; compare `mie`). The profile is averaged over the solar disk by
 //! Gauss–Chebyshev quadrature ([`super::disk_quadrature`]).
 use super::{descartes, disk_quadrature, Polarisation};
+use crate::drops::{DropNode, DropSizeDistribution};
 use crate::spectrum::ior::Ior;
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -134,12 +135,22 @@ pub fn order_point_profile(theta: f64, n: f64, k: u32, x: f64, pol: Polarisation
         / theta.sin().max(1e-12)
 }
 
-/// Airy-theory sky of water drops of one radius, averaged over the sun's disk.
+/// Airy-theory sky of water drops of one radius or of a drop-size distribution,
+/// averaged over the sun's disk.
+///
+/// With a distribution ([`AirySky::with_distribution`]) the profile is the average of the
+/// per-radius profiles weighted by each node's share of the geometric cross-section,
+/// Σ wᵢ aᵢ² pᵢ(θ) / Σ wᵢ aᵢ² with wᵢ the number fractions ([`crate::drops`]): that is
+/// ⟨dσ/dΩ⟩ / ⟨π a²⟩, the same normalisation as for one radius, which it reduces to.
 #[derive(Clone, Debug)]
 pub struct AirySky {
     pub ior: Ior,
-    /// Drop radius in nm.
+    /// Drop radius in nm: the monodisperse radius, or the distribution's
+    /// cross-section-weighted mean radius (what [`AirySky::size_parameter`] reports).
     pub droplet_radius_nm: f64,
+    /// The radii (mm) the profile averages, with their cross-section weights (Σ = 1);
+    /// one node for one radius.
+    pub drops: Vec<DropNode>,
     /// Sun angular radius α, radians (> 0).
     pub sun_radius: f64,
     /// Orders k, each 1 or 2.
@@ -153,20 +164,37 @@ impl AirySky {
         AirySky {
             ior: crate::spectrum::ior::named("water").expect("water in the catalogue"),
             droplet_radius_nm: radius_mm * 1e6,
+            drops: vec![DropNode {
+                radius_mm,
+                weight: 1.0,
+            }],
             sun_radius,
             orders: vec![1, 2],
             polarisation: Polarisation::Unpolarised,
         }
     }
 
-    /// Size parameter x = 2πa/λ.
+    /// The same sky for drops distributed as `dsd`, integrated with `nodes` quadrature
+    /// nodes (see [`crate::drops`]).
+    pub fn with_distribution(mut self, dsd: &DropSizeDistribution, nodes: usize) -> Self {
+        self.drops = dsd.cross_section_nodes(nodes);
+        self.droplet_radius_nm = 1e6
+            * self
+                .drops
+                .iter()
+                .map(|d| d.weight * d.radius_mm)
+                .sum::<f64>();
+        self
+    }
+
+    /// Size parameter x = 2πa/λ of [`AirySky::droplet_radius_nm`].
     pub fn size_parameter(&self, lambda_nm: f32) -> f64 {
         2.0 * PI * self.droplet_radius_nm / lambda_nm as f64
     }
 
-    pub fn profile(&self, theta_rad: f64, lambda_nm: f32) -> f32 {
-        let n = self.ior.eval(lambda_nm) as f64;
-        let x = self.size_parameter(lambda_nm);
+    /// The disk-averaged profile of one radius (nm).
+    fn radius_profile(&self, theta_rad: f64, n: f64, radius_nm: f64, lambda_nm: f32) -> f64 {
+        let x = 2.0 * PI * radius_nm / lambda_nm as f64;
         let alpha = self.sun_radius;
         let mut sum = 0.0;
         for &k in &self.orders {
@@ -183,7 +211,15 @@ impl AirySky {
                 })
                 .sum::<f64>();
         }
-        sum as f32
+        sum
+    }
+
+    pub fn profile(&self, theta_rad: f64, lambda_nm: f32) -> f32 {
+        let n = self.ior.eval(lambda_nm) as f64;
+        self.drops
+            .iter()
+            .map(|d| d.weight * self.radius_profile(theta_rad, n, d.radius_mm * 1e6, lambda_nm))
+            .sum::<f64>() as f32
     }
 
     pub fn radiance(&self, view_dir: Vec3, lambda_nm: f32, sun_dir: Vec3) -> f32 {

@@ -32,6 +32,7 @@
 //! what `heron sky profile` uses) or on a grid every `lambda_step_nm` and interpolated
 //! linearly between the two nearest (for rendering).
 use super::{disk_kernel, disk_quadrature, Polarisation};
+use crate::drops::{DropNode, DropSizeDistribution};
 use crate::spectrum::ior::Ior;
 use glam::Vec3;
 use num_complex::Complex64;
@@ -151,11 +152,22 @@ impl MieTable {
     }
 }
 
-/// Lorenz–Mie sky of water drops of one radius.
+/// Lorenz–Mie sky of water drops of one radius or of a drop-size distribution.
+///
+/// With a distribution ([`MieSky::with_distribution`]) each wavelength's point profile is
+/// Σ wᵢ aᵢ² pᵢ(θ) / Σ wᵢ aᵢ² over the quadrature nodes ([`crate::drops`]; wᵢ the number
+/// fractions), i.e. ⟨dσ/dΩ⟩ / ⟨π a²⟩, which for one radius is that radius's profile; the
+/// θ grid is the largest radius's (the finest), and the sum is disk-averaged once (the
+/// average is linear). The cost is one Mie series per node and wavelength.
 pub struct MieSky {
     pub ior: Ior,
-    /// Drop radius in nm.
+    /// Drop radius in nm: the monodisperse radius, or the distribution's
+    /// cross-section-weighted mean radius (what [`MieSky::size_parameter`] reports).
     pub droplet_radius_nm: f64,
+    /// The radii (mm) averaged, with their cross-section weights (Σ = 1).
+    pub drops: Vec<DropNode>,
+    /// Only this term of the Debye series ([`super::debye`]), or the full Mie solution.
+    pub debye: Option<u32>,
     /// Sun angular radius α, radians (> 0).
     pub sun_radius: f64,
     pub polarisation: Polarisation,
@@ -170,6 +182,8 @@ impl std::fmt::Debug for MieSky {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("MieSky")
             .field("droplet_radius_nm", &self.droplet_radius_nm)
+            .field("drops", &self.drops.len())
+            .field("debye", &self.debye)
             .field("sun_radius", &self.sun_radius)
             .field("polarisation", &self.polarisation)
             .field("lambda_step_nm", &self.lambda_step_nm)
@@ -183,6 +197,11 @@ impl MieSky {
         MieSky {
             ior: crate::spectrum::ior::named("water").expect("water in the catalogue"),
             droplet_radius_nm: radius_mm * 1e6,
+            drops: vec![DropNode {
+                radius_mm,
+                weight: 1.0,
+            }],
+            debye: None,
             sun_radius,
             polarisation: Polarisation::Unpolarised,
             window: (30f64.to_radians(), 62f64.to_radians()),
@@ -191,7 +210,20 @@ impl MieSky {
         }
     }
 
-    /// Size parameter x = 2πa/λ.
+    /// The same sky for drops distributed as `dsd`, integrated with `nodes` quadrature
+    /// nodes (see [`crate::drops`]).
+    pub fn with_distribution(mut self, dsd: &DropSizeDistribution, nodes: usize) -> Self {
+        self.drops = dsd.cross_section_nodes(nodes);
+        self.droplet_radius_nm = 1e6
+            * self
+                .drops
+                .iter()
+                .map(|d| d.weight * d.radius_mm)
+                .sum::<f64>();
+        self
+    }
+
+    /// Size parameter x = 2πa/λ of [`MieSky::droplet_radius_nm`].
     pub fn size_parameter(&self, lambda_nm: f32) -> f64 {
         2.0 * PI * self.droplet_radius_nm / lambda_nm as f64
     }
@@ -218,18 +250,34 @@ impl MieSky {
     /// Computes the table for one wavelength (not cached; see [`MieSky::table`]).
     pub fn compute_table(&self, lambda_nm: f32) -> MieTable {
         let m = self.ior.eval(lambda_nm) as f64;
-        let x = self.size_parameter(lambda_nm);
-        let c = coefficients(m, x);
-        let theta = self.grid(x);
+        let to_x = |radius_mm: f64| 2.0 * PI * radius_mm * 1e6 / lambda_nm as f64;
+        let x_max = self
+            .drops
+            .iter()
+            .map(|d| to_x(d.radius_mm))
+            .fold(0.0, f64::max);
+        let theta = self.grid(x_max);
         let pol = self.polarisation;
-        let point: Vec<f64> = theta
-            .par_iter()
-            .with_min_len(64)
-            .map(|&t| {
-                let (s1, s2) = amplitudes(&c, (PI - t).cos());
-                phase_value(s1, s2, x, pol)
-            })
-            .collect();
+        let mut point = vec![0.0; theta.len()];
+        for d in &self.drops {
+            let x = to_x(d.radius_mm);
+            let c = match self.debye {
+                None => coefficients(m, x),
+                Some(p) => super::debye::coefficients(m, x, p),
+            };
+            let one: Vec<f64> = theta
+                .par_iter()
+                .with_min_len(64)
+                .map(|&t| {
+                    let (s1, s2) = amplitudes(&c, (PI - t).cos());
+                    phase_value(s1, s2, x, pol)
+                })
+                .collect();
+            for (acc, v) in point.iter_mut().zip(one) {
+                *acc += d.weight * v;
+            }
+        }
+        let x = self.size_parameter(lambda_nm);
         let alpha = self.sun_radius;
         let disk: Vec<f64> = (0..theta.len())
             .into_par_iter()
@@ -301,7 +349,7 @@ impl MieSky {
 }
 
 /// Disk average of the tabulated `point` profile at node i.
-fn disk_average(theta: &[f64], point: &[f64], i: usize, alpha: f64) -> f64 {
+pub(crate) fn disk_average(theta: &[f64], point: &[f64], i: usize, alpha: f64) -> f64 {
     let t0 = theta[i];
     let lo = theta.partition_point(|&t| t < t0 - alpha);
     let hi = theta.partition_point(|&t| t <= t0 + alpha);
