@@ -49,6 +49,39 @@ fn sky_section_errors_name_the_key() {
             "sky.droplet_radius",
         ),
         ("[sky]\nmodel = \"descartes\"\ncolour = 1", "colour"),
+        // Drop-size distributions and Debye terms (src/drops, src/sky/debye.rs).
+        (
+            "[sky]\nmodel = \"descartes\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = 0.1 }",
+            "sky.drops",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndroplet_radius = 0.5\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = 0.1 }",
+            "sky.droplet_radius",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = -0.1 }",
+            "sky.drops.sigma",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5 }",
+            "sky.drops.sigma",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigmaa = 0.1 }",
+            "sigmaa",
+        ),
+        (
+            "[sky]\nmodel = \"mie\"\ndrops = { distribution = \"marshall-palmer\", rain_rate_mm_h = 5 }",
+            "sky.drops",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndroplet_radius = 0.5\ndebye = 2",
+            "sky.debye",
+        ),
+        (
+            "[sky]\nmodel = \"mie\"\ndroplet_radius = 0.5\ndebye = 99",
+            "sky.debye",
+        ),
     ] {
         let e = load_err(extra);
         assert!(

@@ -21,7 +21,8 @@
 //! scattering angle π − θ.
 //!
 //! Table per (radius, wavelength), computed on first use and cached in the model:
-//! θ from 0 to 180°, with step min(0.01°, 0.5/x rad) inside the bow window (default
+//! θ from 0 to 180°, with step min(0.01°, 0.5/x rad) (0.01° for a drop-size distribution,
+//! see [`MieSky`]) inside the bow window (default
 //! 30°–62°, the bows, the dark band and the first supernumeraries) and 0.05° outside.
 //! Large drops have fine ripple (period ~ a few /x rad), so inside the window the step
 //! resolves it; outside, the ripple is undersampled and the disk average there is only
@@ -133,7 +134,7 @@ pub struct MieTable {
     pub disk: Vec<f64>,
 }
 
-fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+pub(crate) fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     let i = xs.partition_point(|&v| v <= x);
     if i == 0 {
         return ys[0];
@@ -173,6 +174,9 @@ pub struct MieSky {
     pub polarisation: Polarisation,
     /// θ window (radians) tabulated finely.
     pub window: (f64, f64),
+    /// Tabulate only the window (outside it the table holds its edge values): for
+    /// `heron sky lee`, which asks for angles well inside it.
+    pub window_only: bool,
     /// 0: compute each wavelength asked for; > 0: a grid every this many nm, interpolated.
     pub lambda_step_nm: f32,
     cache: RwLock<HashMap<u32, Arc<MieTable>>>,
@@ -205,6 +209,7 @@ impl MieSky {
             sun_radius,
             polarisation: Polarisation::Unpolarised,
             window: (30f64.to_radians(), 62f64.to_radians()),
+            window_only: false,
             lambda_step_nm: 0.0,
             cache: RwLock::new(HashMap::new()),
         }
@@ -228,9 +233,17 @@ impl MieSky {
         2.0 * PI * self.droplet_radius_nm / lambda_nm as f64
     }
 
-    /// The θ nodes for size parameter x.
-    fn grid(&self, x: f64) -> Vec<f64> {
-        let fine = (0.01f64.to_radians()).min(0.5 / x);
+    /// The θ nodes for size parameter x (one radius) or, for a distribution (`dsd`),
+    /// 0.01° in the window whatever x: the sum over nodes is evaluated exactly at each θ,
+    /// and the ripple finer than that, whose phase ∝ x differs from node to node, is
+    /// averaged out by the distribution and the sun's disk (a residue of order the
+    /// one-radius ripple over √nodes remains).
+    fn grid(&self, x: f64, dsd: bool) -> Vec<f64> {
+        let fine = if dsd {
+            0.01f64.to_radians()
+        } else {
+            (0.01f64.to_radians()).min(0.5 / x)
+        };
         let coarse = 0.05f64.to_radians().max(fine);
         let (w0, w1) = self.window;
         let mut g = Vec::new();
@@ -240,6 +253,11 @@ impl MieSky {
                 g.push(a + (b - a) * i as f64 / n as f64);
             }
         };
+        if self.window_only {
+            push_range(w0, w1, fine, &mut g);
+            g.push(w1);
+            return g;
+        }
         push_range(0.0, w0, coarse, &mut g);
         push_range(w0, w1, fine, &mut g);
         push_range(w1, PI, coarse, &mut g);
@@ -256,7 +274,7 @@ impl MieSky {
             .iter()
             .map(|d| to_x(d.radius_mm))
             .fold(0.0, f64::max);
-        let theta = self.grid(x_max);
+        let theta = self.grid(x_max, self.drops.len() > 1);
         let pol = self.polarisation;
         let mut point = vec![0.0; theta.len()];
         for d in &self.drops {

@@ -35,6 +35,7 @@ pub mod aristotle;
 pub mod constant;
 pub mod debye;
 pub mod descartes;
+pub mod lee;
 pub mod mie;
 pub mod profile;
 pub mod table;

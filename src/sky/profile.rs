@@ -151,6 +151,11 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
                 }
             })
             .map_err(bad)?;
+        let n = if model == "mie" && f.nodes.is_none() {
+            crate::drops::MIE_DEFAULT_NODES
+        } else {
+            n
+        };
         let largest = d.max_radius_mm();
         if largest > max_mm {
             return Err(bad(format!(
