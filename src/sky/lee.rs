@@ -112,8 +112,19 @@ impl LeeRequest {
     }
 }
 
-/// X, Y, Z of every (radius, angle), radius-major: `[radius][angle]`.
-pub fn lee_xyz(req: &LeeRequest) -> Result<(Vec<f64>, Vec<f64>, Vec<Vec<[f64; 3]>>)> {
+/// A computed Lee diagram.
+#[derive(Clone, Debug)]
+pub struct LeeDiagram {
+    /// Drop radii, mm.
+    pub radii_mm: Vec<f64>,
+    /// Angles from the antisolar point, degrees.
+    pub theta_deg: Vec<f64>,
+    /// X, Y, Z of every (radius, angle), radius-major: `xyz[radius][angle]`.
+    pub xyz: Vec<Vec<[f64; 3]>>,
+}
+
+/// Computes the diagram of a request.
+pub fn lee_xyz(req: &LeeRequest) -> Result<LeeDiagram> {
     req.validate()?;
     let thetas = super::profile::angles(req.from_deg, req.to_deg, req.step_deg)?;
     let radii = req.radii_mm();
@@ -172,13 +183,21 @@ pub fn lee_xyz(req: &LeeRequest) -> Result<(Vec<f64>, Vec<f64>, Vec<Vec<[f64; 3]
             }
         }
     }
-    Ok((radii, thetas, xyz))
+    Ok(LeeDiagram {
+        radii_mm: radii,
+        theta_deg: thetas,
+        xyz,
+    })
 }
 
 /// The CSV of a request: `radius_mm,theta_deg,X,Y,Z,R,G,B` (R, G, B: encoded sRGB in
 /// [0, 1] of XYZ / the radius's largest Y, see the module documentation).
 pub fn lee_csv(req: &LeeRequest) -> Result<String> {
-    let (radii, thetas, xyz) = lee_xyz(req)?;
+    let LeeDiagram {
+        radii_mm: radii,
+        theta_deg: thetas,
+        xyz,
+    } = lee_xyz(req)?;
     let mut out = String::from("radius_mm,theta_deg,X,Y,Z,R,G,B\n");
     for (r, row) in radii.iter().zip(&xyz) {
         let ymax = row.iter().map(|c| c[1]).fold(0.0, f64::max);
