@@ -1,7 +1,7 @@
 //! Drop-size distributions of water drops, shared by the rainbow skies (`sky::airy`,
 //! `sky::mie`) and by media of drops.
 //!
-//! A distribution is a number density n(a) over the drop radius a (mm). [`nodes`] turns
+//! A distribution is a number density n(a) over the drop radius a (mm). [`DropSizeDistribution::nodes`] turns
 //! it into a quadrature: radii a_i and weights w_i, Σ w_i = 1, with
 //! Σ w_i f(a_i) ≈ ∫ n(a) f(a) da / ∫ n(a) da over the distribution's stated range.
 //! A quantity per drop (a cross-section) averages as Σ w_i f(a_i); the skies weight by
