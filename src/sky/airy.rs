@@ -207,7 +207,8 @@ pub struct AirySky {
     /// Orders k, each 1 or 2.
     pub orders: Vec<u32>,
     pub polarisation: Polarisation,
-    /// Per-wavelength tables of a distribution (λ bits → table).
+    /// Per-wavelength tables of a distribution (λ bits → table), filled on first use: set
+    /// `orders`, `polarisation` and `sun_radius` before the first `profile` call.
     cache: RwLock<HashMap<u32, Arc<DsdTable>>>,
 }
 
