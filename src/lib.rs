@@ -12,6 +12,7 @@ pub mod camera;
 pub mod checkpoint;
 pub mod colorimetry;
 pub mod converge;
+pub mod drops;
 pub mod error;
 pub mod film;
 #[doc(hidden)]

@@ -90,6 +90,10 @@ enum SkyCommand {
     /// per wavelength. Units: dσ/dΩ/(πa²) per sr for descartes, airy and mie (see
     /// heron::sky); the texture's radiance for aristotle.
     Profile(SkyProfileArgs),
+    /// Lee diagram: the bow's colour against drop radius (log-spaced) and angle from the
+    /// antisolar point, from Lorenz–Mie theory under a D65 sun averaged over its disk, as
+    /// CSV radius_mm,theta_deg,X,Y,Z,R,G,B (see heron::sky::lee).
+    Lee(SkyLeeArgs),
     /// Mie amplitudes S1, S2 (Bohren & Huffman) of a sphere, for tests/python/test_mie.py.
     #[command(hide = true)]
     MiePhase {
@@ -107,6 +111,37 @@ enum SkyCommand {
         #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
         step: f64,
     },
+}
+
+#[derive(clap::Args)]
+struct SkyLeeArgs {
+    /// Smallest drop radius, mm.
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    radius_from: f64,
+    /// Largest drop radius, mm.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    radius_to: f64,
+    /// Number of radii, log-spaced.
+    #[arg(long, default_value_t = 40)]
+    radii: usize,
+    /// First angle from the antisolar point, degrees.
+    #[arg(long, default_value_t = 36.0, allow_hyphen_values = true)]
+    from: f64,
+    /// Last angle, degrees.
+    #[arg(long, default_value_t = 44.0, allow_hyphen_values = true)]
+    to: f64,
+    /// Angle step, degrees.
+    #[arg(long, default_value_t = 0.05, allow_hyphen_values = true)]
+    step: f64,
+    /// Wavelength step of the colour sums over 380–780 nm.
+    #[arg(long, default_value_t = 10.0, allow_hyphen_values = true)]
+    lambda_step: f64,
+    /// Sun angular radius in degrees.
+    #[arg(long, default_value_t = 0.2666, allow_hyphen_values = true)]
+    sun_radius: f64,
+    /// Output CSV (written atomically); default: standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -142,6 +177,69 @@ struct SkyProfileArgs {
     /// Background radiance (constant: default 1; aristotle: default 0).
     #[arg(long, allow_hyphen_values = true)]
     background: Option<f64>,
+    /// Drop-size distribution (airy, mie): monodisperse (radius --droplet-radius),
+    /// lognormal (--median-mm, --sigma), gamma (--mode-mm, --mu) or marshall-palmer
+    /// (--rain-rate-mm-h); see heron::drops.
+    #[arg(long)]
+    distribution: Option<String>,
+    /// Log-normal: median radius, mm.
+    #[arg(long, allow_hyphen_values = true)]
+    median_mm: Option<f64>,
+    /// Log-normal: standard deviation of ln a.
+    #[arg(long, allow_hyphen_values = true)]
+    sigma: Option<f64>,
+    /// Gamma: mode radius, mm.
+    #[arg(long, allow_hyphen_values = true)]
+    mode_mm: Option<f64>,
+    /// Gamma: shape μ (≥ 1).
+    #[arg(long, allow_hyphen_values = true)]
+    mu: Option<f64>,
+    /// Marshall–Palmer: rain rate, mm/h.
+    #[arg(long, allow_hyphen_values = true)]
+    rain_rate_mm_h: Option<f64>,
+    /// Quadrature nodes of the distribution (default 48; 16 for mie).
+    #[arg(long, allow_hyphen_values = true)]
+    nodes: Option<i64>,
+    /// Only the Debye-series term p (mie): 0 external reflection and diffraction, 1
+    /// direct transmission, 2 the primary bow, 3 the secondary, …
+    #[arg(long)]
+    debye: Option<u32>,
+}
+
+/// The distribution flags as the scene table they mirror; a parameter without
+/// `--distribution` is an error naming it.
+fn drops_from_flags(
+    distribution: Option<String>,
+    [median_mm, sigma, mode_mm, mu, rain_rate_mm_h]: [Option<f64>; 5],
+    nodes: Option<i64>,
+) -> Result<Option<heron::drops::DropsFile>> {
+    let Some(distribution) = distribution else {
+        for (flag, v) in [
+            ("--median-mm", median_mm),
+            ("--sigma", sigma),
+            ("--mode-mm", mode_mm),
+            ("--mu", mu),
+            ("--rain-rate-mm-h", rain_rate_mm_h),
+        ] {
+            if v.is_some() {
+                anyhow::bail!("{flag}: needs --distribution");
+            }
+        }
+        if nodes.is_some() {
+            anyhow::bail!("--nodes: needs --distribution");
+        }
+        return Ok(None);
+    };
+    Ok(Some(heron::drops::DropsFile {
+        distribution,
+        radius_mm: None,
+        median_mm,
+        sigma,
+        mode_mm,
+        mu,
+        rain_rate_mm_h,
+        nodes,
+    }))
 }
 
 fn cmd_sky(c: SkyCommand) -> Result<()> {
@@ -158,7 +256,32 @@ fn cmd_sky(c: SkyCommand) -> Result<()> {
                 k: a.k,
                 polarisation: a.polarisation,
                 background: a.background,
+                drops: drops_from_flags(
+                    a.distribution,
+                    [a.median_mm, a.sigma, a.mode_mm, a.mu, a.rain_rate_mm_h],
+                    a.nodes,
+                )?,
+                debye: a.debye,
             })?
+        }
+        SkyCommand::Lee(a) => {
+            let csv = heron::sky::lee::lee_csv(&heron::sky::lee::LeeRequest {
+                radius_from_mm: a.radius_from,
+                radius_to_mm: a.radius_to,
+                radii: a.radii,
+                from_deg: a.from,
+                to_deg: a.to,
+                step_deg: a.step,
+                lambda_step_nm: a.lambda_step,
+                sun_radius_deg: a.sun_radius,
+            })?;
+            match a.output {
+                Some(path) => {
+                    heron::sky::lee::write_csv(&path, &csv)?;
+                    return Ok(());
+                }
+                None => csv,
+            }
         }
         SkyCommand::MiePhase {
             m,

@@ -49,6 +49,39 @@ fn sky_section_errors_name_the_key() {
             "sky.droplet_radius",
         ),
         ("[sky]\nmodel = \"descartes\"\ncolour = 1", "colour"),
+        // Drop-size distributions and Debye terms (src/drops, src/sky/debye.rs).
+        (
+            "[sky]\nmodel = \"descartes\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = 0.1 }",
+            "sky.drops",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndroplet_radius = 0.5\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = 0.1 }",
+            "sky.droplet_radius",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = -0.1 }",
+            "sky.drops.sigma",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5 }",
+            "sky.drops.sigma",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigmaa = 0.1 }",
+            "sigmaa",
+        ),
+        (
+            "[sky]\nmodel = \"mie\"\ndrops = { distribution = \"marshall-palmer\", rain_rate_mm_h = 5 }",
+            "sky.drops",
+        ),
+        (
+            "[sky]\nmodel = \"airy\"\ndroplet_radius = 0.5\ndebye = 2",
+            "sky.debye",
+        ),
+        (
+            "[sky]\nmodel = \"mie\"\ndroplet_radius = 0.5\ndebye = 99",
+            "sky.debye",
+        ),
     ] {
         let e = load_err(extra);
         assert!(
@@ -112,4 +145,36 @@ fn rendered_descartes_sky_has_its_bows_and_dark_band_where_optics_puts_them() {
         band_max < inside && band_max < y2 && y2 < y1,
         "band {band_max}, inside {inside}, bows {y1} {y2}"
     );
+}
+
+#[test]
+fn sky_drops_reach_the_tabulated_model() {
+    // A log-normal airy sky with 4 nodes (the table takes about a second): the scene's
+    // (θ, λ) table at its grid nodes is the model's profile built from the same table,
+    // and differs from the one-radius sky (so the distribution was not dropped).
+    let text = format!(
+        "{BASE}\n[sky]\nmodel = \"airy\"\ndrops = {{ distribution = \"lognormal\", median_mm = 0.2, sigma = 0.2, nodes = 4 }}\n"
+    );
+    let scene = load_scene_from_str(&text, Path::new("drops.toml")).unwrap();
+    let table = &scene.sky.as_ref().expect("a sky").table;
+    let alpha = 0.2666f64.to_radians();
+    let want = heron::sky::AirySky::water(1.0, alpha).with_distribution(
+        &heron::drops::DropSizeDistribution::LogNormal {
+            median_mm: 0.2,
+            sigma: 0.2,
+        },
+        4,
+    );
+    let mono = heron::sky::AirySky::water(0.2, alpha);
+    let mut differs = false;
+    for theta in [40.0, 40.5, 41.0, 41.5, 42.0] {
+        let got = table.eval(theta, 550.0);
+        let w = want.profile(f64::to_radians(theta), 550.0);
+        assert!(
+            (got - w).abs() <= 1e-5 * w.abs().max(1e-3),
+            "θ {theta}: {got} vs {w}"
+        );
+        differs |= (got - mono.profile(f64::to_radians(theta), 550.0)).abs() > 0.01 * w;
+    }
+    assert!(differs, "the distribution's sky equals the one-radius sky");
 }

@@ -100,6 +100,13 @@ pub struct SkyFile {
     /// Multiplies the model's radiance; default 1.
     #[serde(default)]
     pub scale: Option<PositiveNumber>,
+    /// A drop-size distribution (airy, mie) instead of `droplet_radius`, e.g.
+    /// `{ distribution = "lognormal", median_mm = 0.5, sigma = 0.1 }` (crate::drops).
+    #[serde(default)]
+    pub drops: Option<crate::drops::DropsFile>,
+    /// Only this term p of the Debye series (mie): 2 the primary bow, 3 the secondary.
+    #[serde(default)]
+    pub debye: Option<u32>,
 }
 
 /// `[camera]`: the seed's pinhole camera.

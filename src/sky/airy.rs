@@ -27,9 +27,12 @@
 //! other orders; compare `mie`). The profile is averaged over the solar disk by
 //! Gauss–Chebyshev quadrature ([`super::disk_quadrature`]).
 use super::{descartes, disk_quadrature, Polarisation};
+use crate::drops::{DropNode, DropSizeDistribution};
 use crate::spectrum::ior::Ior;
 use glam::Vec3;
+use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::sync::{Arc, RwLock};
 
 /// −a′₁, the first zero of Ai′ negated: Ai²(−z) is largest at z = 1.018792971647471.
 pub const AIRY_FIRST_MAX_Z: f64 = 1.018_792_971_647_471;
@@ -116,35 +119,111 @@ pub fn main_peak_offset(n: f64, k: u32, x: f64) -> f64 {
     AIRY_FIRST_MAX_Z * (h / (2.0 * x * x)).cbrt()
 }
 
+/// What the Airy profile of order k needs of the index n (root solves, done once per
+/// (n, k)): minimum-deviation impact parameter b₀, Descartes angle θ₀, curvature h, and the
+/// Fresnel factor for the polarisation.
+#[derive(Clone, Copy, Debug)]
+pub struct OrderParams {
+    pub k: u32,
+    pub b0: f64,
+    pub theta0: f64,
+    pub h: f64,
+    pub fresnel: f64,
+}
+
+impl OrderParams {
+    pub fn new(n: f64, k: u32, pol: Polarisation) -> Self {
+        let b0 = descartes::min_deviation_b(n, k);
+        let (fs, fp) = descartes::fresnel_factors(b0, n, k);
+        OrderParams {
+            k,
+            b0,
+            theta0: descartes::theta_of_b(b0, n, k),
+            h: descartes::deviation_curvature(b0, n, k),
+            fresnel: pol.mix(fs, fp),
+        }
+    }
+
+    /// The point-sun profile at θ for size parameter x.
+    pub fn eval(&self, theta: f64, x: f64) -> f64 {
+        let delta = if self.k % 2 == 1 {
+            self.theta0 - theta
+        } else {
+            theta - self.theta0
+        };
+        let z = delta * (2.0 * x * x / self.h).cbrt();
+        let ai = airy_ai(-z);
+        2.0 * 2f64.cbrt().powi(2)
+            * self.b0
+            * self.fresnel
+            * x.cbrt()
+            * self.h.powf(-2.0 / 3.0)
+            * ai
+            * ai
+            / theta.sin().max(1e-12)
+    }
+}
+
 /// Point-sun Airy profile of one order k (see the module documentation), normalised as
 /// dσ/dΩ / (π a²).
 pub fn order_point_profile(theta: f64, n: f64, k: u32, x: f64, pol: Polarisation) -> f64 {
-    let b0 = descartes::min_deviation_b(n, k);
-    let theta0 = descartes::theta_of_b(b0, n, k);
-    let h = descartes::deviation_curvature(b0, n, k);
-    let delta = if k % 2 == 1 {
-        theta0 - theta
-    } else {
-        theta - theta0
-    };
-    let z = delta * (2.0 * x * x / h).cbrt();
-    let (fs, fp) = descartes::fresnel_factors(b0, n, k);
-    let ai = airy_ai(-z);
-    2.0 * 2f64.cbrt().powi(2) * b0 * pol.mix(fs, fp) * x.cbrt() * h.powf(-2.0 / 3.0) * ai * ai
-        / theta.sin().max(1e-12)
+    OrderParams::new(n, k, pol).eval(theta, x)
 }
 
-/// Airy-theory sky of water drops of one radius, averaged over the sun's disk.
-#[derive(Clone, Debug)]
+/// A distribution's profile at one wavelength, tabulated over θ (see [`AirySky`]).
+#[derive(Debug)]
+struct DsdTable {
+    theta: Vec<f64>,
+    disk: Vec<f64>,
+}
+
+/// Airy-theory sky of water drops of one radius or of a drop-size distribution,
+/// averaged over the sun's disk.
+///
+/// With a distribution ([`AirySky::with_distribution`]) the profile is the average of the
+/// per-radius profiles weighted by each node's share of the geometric cross-section,
+/// Σ wᵢ aᵢ² pᵢ(θ) / Σ wᵢ aᵢ² with wᵢ the number fractions ([`crate::drops`]): that is
+/// ⟨dσ/dΩ⟩ / ⟨π a²⟩, the same normalisation as for one radius, which it reduces to.
+///
+/// Cost: one radius is evaluated per call (the disk average by Gauss–Chebyshev
+/// quadrature). A distribution is tabulated once per wavelength instead (the per-call sum
+/// over nodes × disk nodes costs minutes for a scene's table): the node-weighted point
+/// profile on θ steps of 1/16 of the largest radius's fringe scale (h/(2x²))^{1/3}, at
+/// most 0.01° (at 1/8 the table's interpolation moved a narrow distribution's profile by
+/// 0.9% of the peak from the directly evaluated one), within 25°–70° (both bows,
+/// Alexander's band, the supernumeraries) and 0.1° outside, then averaged over the disk
+/// with the chord kernel (`mie`'s trapezoid rule) and interpolated linearly.
+#[derive(Debug)]
 pub struct AirySky {
     pub ior: Ior,
-    /// Drop radius in nm.
+    /// Drop radius in nm: the monodisperse radius, or the distribution's
+    /// cross-section-weighted mean radius (what [`AirySky::size_parameter`] reports).
     pub droplet_radius_nm: f64,
+    /// The radii (mm) the profile averages, with their cross-section weights (Σ = 1);
+    /// one node for one radius.
+    pub drops: Vec<DropNode>,
     /// Sun angular radius α, radians (> 0).
     pub sun_radius: f64,
     /// Orders k, each 1 or 2.
     pub orders: Vec<u32>,
     pub polarisation: Polarisation,
+    /// Per-wavelength tables of a distribution (λ bits → table), filled on first use: set
+    /// `orders`, `polarisation` and `sun_radius` before the first `profile` call.
+    cache: RwLock<HashMap<u32, Arc<DsdTable>>>,
+}
+
+impl Clone for AirySky {
+    fn clone(&self) -> Self {
+        AirySky {
+            ior: self.ior.clone(),
+            droplet_radius_nm: self.droplet_radius_nm,
+            drops: self.drops.clone(),
+            sun_radius: self.sun_radius,
+            orders: self.orders.clone(),
+            polarisation: self.polarisation,
+            cache: RwLock::new(HashMap::new()),
+        }
+    }
 }
 
 impl AirySky {
@@ -153,20 +232,38 @@ impl AirySky {
         AirySky {
             ior: crate::spectrum::ior::named("water").expect("water in the catalogue"),
             droplet_radius_nm: radius_mm * 1e6,
+            drops: vec![DropNode {
+                radius_mm,
+                weight: 1.0,
+            }],
             sun_radius,
             orders: vec![1, 2],
             polarisation: Polarisation::Unpolarised,
+            cache: RwLock::new(HashMap::new()),
         }
     }
 
-    /// Size parameter x = 2πa/λ.
+    /// The same sky for drops distributed as `dsd`, integrated with `nodes` quadrature
+    /// nodes (see [`crate::drops`]).
+    pub fn with_distribution(mut self, dsd: &DropSizeDistribution, nodes: usize) -> Self {
+        self.drops = dsd.cross_section_nodes(nodes);
+        self.droplet_radius_nm = 1e6
+            * self
+                .drops
+                .iter()
+                .map(|d| d.weight * d.radius_mm)
+                .sum::<f64>();
+        self
+    }
+
+    /// Size parameter x = 2πa/λ of [`AirySky::droplet_radius_nm`].
     pub fn size_parameter(&self, lambda_nm: f32) -> f64 {
         2.0 * PI * self.droplet_radius_nm / lambda_nm as f64
     }
 
-    pub fn profile(&self, theta_rad: f64, lambda_nm: f32) -> f32 {
-        let n = self.ior.eval(lambda_nm) as f64;
-        let x = self.size_parameter(lambda_nm);
+    /// The disk-averaged profile of one radius (nm).
+    fn radius_profile(&self, theta_rad: f64, n: f64, radius_nm: f64, lambda_nm: f32) -> f64 {
+        let x = 2.0 * PI * radius_nm / lambda_nm as f64;
         let alpha = self.sun_radius;
         let mut sum = 0.0;
         for &k in &self.orders {
@@ -183,7 +280,77 @@ impl AirySky {
                 })
                 .sum::<f64>();
         }
-        sum as f32
+        sum
+    }
+
+    pub fn profile(&self, theta_rad: f64, lambda_nm: f32) -> f32 {
+        let n = self.ior.eval(lambda_nm) as f64;
+        if let [d] = self.drops.as_slice() {
+            return (d.weight * self.radius_profile(theta_rad, n, d.radius_mm * 1e6, lambda_nm))
+                as f32;
+        }
+        let t = self.dsd_table(lambda_nm);
+        super::mie::interp(&t.theta, &t.disk, theta_rad) as f32
+    }
+
+    /// The (cached) table of a distribution at `lambda_nm`.
+    fn dsd_table(&self, lambda_nm: f32) -> Arc<DsdTable> {
+        let key = lambda_nm.to_bits();
+        if let Some(t) = self.cache.read().expect("airy cache").get(&key) {
+            return t.clone();
+        }
+        let t = Arc::new(self.compute_dsd_table(lambda_nm));
+        self.cache
+            .write()
+            .expect("airy cache")
+            .entry(key)
+            .or_insert(t)
+            .clone()
+    }
+
+    fn compute_dsd_table(&self, lambda_nm: f32) -> DsdTable {
+        let n = self.ior.eval(lambda_nm) as f64;
+        let params: Vec<OrderParams> = self
+            .orders
+            .iter()
+            .map(|&k| OrderParams::new(n, k, self.polarisation))
+            .collect();
+        let xs: Vec<(f64, f64)> = self
+            .drops
+            .iter()
+            .map(|d| (2.0 * PI * d.radius_mm * 1e6 / lambda_nm as f64, d.weight))
+            .collect();
+        let x_max = xs.iter().map(|&(x, _)| x).fold(0.0, f64::max);
+        let scale = params
+            .iter()
+            .map(|p| (p.h / (2.0 * x_max * x_max)).cbrt())
+            .fold(f64::INFINITY, f64::min);
+        let fine = (scale / 16.0)
+            .min(0.01f64.to_radians())
+            .max(1e-3f64.to_radians());
+        let coarse = 0.1f64.to_radians().max(fine);
+        let (w0, w1) = (25f64.to_radians(), 70f64.to_radians());
+        let mut theta = Vec::new();
+        let mut push = |a: f64, b: f64, step: f64| {
+            let m = ((b - a) / step).ceil().max(1.0) as usize;
+            theta.extend((0..m).map(|i| a + (b - a) * i as f64 / m as f64));
+        };
+        push(0.0, w0, coarse);
+        push(w0, w1, fine);
+        push(w1, PI, coarse);
+        theta.push(PI);
+        let point: Vec<f64> = theta
+            .iter()
+            .map(|&t| {
+                xs.iter()
+                    .map(|&(x, w)| w * params.iter().map(|p| p.eval(t, x)).sum::<f64>())
+                    .sum()
+            })
+            .collect();
+        let disk = (0..theta.len())
+            .map(|i| super::mie::disk_average(&theta, &point, i, self.sun_radius))
+            .collect();
+        DsdTable { theta, disk }
     }
 
     pub fn radiance(&self, view_dir: Vec3, lambda_nm: f32, sun_dir: Vec3) -> f32 {

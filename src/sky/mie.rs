@@ -21,7 +21,8 @@
 //! scattering angle π − θ.
 //!
 //! Table per (radius, wavelength), computed on first use and cached in the model:
-//! θ from 0 to 180°, with step min(0.01°, 0.5/x rad) inside the bow window (default
+//! θ from 0 to 180°, with step min(0.01°, 0.5/x rad) (0.01° for a drop-size distribution,
+//! see [`MieSky`]) inside the bow window (default
 //! 30°–62°, the bows, the dark band and the first supernumeraries) and 0.05° outside.
 //! Large drops have fine ripple (period ~ a few /x rad), so inside the window the step
 //! resolves it; outside, the ripple is undersampled and the disk average there is only
@@ -32,6 +33,7 @@
 //! what `heron sky profile` uses) or on a grid every `lambda_step_nm` and interpolated
 //! linearly between the two nearest (for rendering).
 use super::{disk_kernel, disk_quadrature, Polarisation};
+use crate::drops::{DropNode, DropSizeDistribution};
 use crate::spectrum::ior::Ior;
 use glam::Vec3;
 use num_complex::Complex64;
@@ -54,17 +56,7 @@ pub fn n_terms(x: f64) -> usize {
 /// The scaled Mie coefficients for a sphere of real relative index `m`, size parameter `x`.
 pub fn coefficients(m: f64, x: f64) -> MieCoefficients {
     let nstop = n_terms(x);
-    let mx = m * x;
-    // Start far enough beyond the turning point n ≈ |mx| that the error of the D = 0 start
-    // has died out by n = |mx| (it decays over a transition zone of width ~|mx|^{1/3}):
-    // with only +15 (BHMIE) D₁ is wrong by 0.06 at mx = 1333; with 8 |mx|^{1/3} more it is
-    // exact to ~1e-15 (checked against scipy's spherical Bessel functions).
-    let nmx = (nstop as f64).max(mx.abs()).ceil() as usize + 16 + (8.0 * mx.abs().cbrt()) as usize;
-    let mut d = vec![0.0f64; nmx + 1];
-    for n in (1..=nmx).rev() {
-        let nf = n as f64;
-        d[n - 1] = nf / mx - 1.0 / (d[n] + nf / mx);
-    }
+    let d = log_derivative_psi(m * x, nstop);
     let (mut psi0, mut psi1) = (x.cos(), x.sin());
     let (mut chi0, mut chi1) = (-x.sin(), x.cos());
     let mut xi1 = Complex64::new(psi1, -chi1);
@@ -89,6 +81,22 @@ pub fn coefficients(m: f64, x: f64) -> MieCoefficients {
         xi1 = xi;
     }
     MieCoefficients { a, b }
+}
+
+/// The logarithmic derivatives D_n(z) = ψ_n′(z)/ψ_n(z) for n = 0…(at least `nstop`), by
+/// the downward recurrence D_{n−1} = n/z − 1/(D_n + n/z) from D = 0. It starts far enough
+/// beyond the turning point n ≈ z that the error of the D = 0 start has died out by n = z
+/// (it decays over a transition zone of width ~z^{1/3}): with only +15 (BHMIE) D₁ is wrong
+/// by 0.06 at z = 1333; with 8 z^{1/3} more it is exact to ~1e-15 (checked against
+/// scipy's spherical Bessel functions). Shared with `debye`.
+pub fn log_derivative_psi(z: f64, nstop: usize) -> Vec<f64> {
+    let nmx = (nstop as f64).max(z.abs()).ceil() as usize + 16 + (8.0 * z.abs().cbrt()) as usize;
+    let mut d = vec![0.0f64; nmx + 1];
+    for n in (1..=nmx).rev() {
+        let nf = n as f64;
+        d[n - 1] = nf / z - 1.0 / (d[n] + nf / z);
+    }
+    d
 }
 
 /// S₁ and S₂ at μ = cos(scattering angle).
@@ -126,7 +134,7 @@ pub struct MieTable {
     pub disk: Vec<f64>,
 }
 
-fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+pub(crate) fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     let i = xs.partition_point(|&v| v <= x);
     if i == 0 {
         return ys[0];
@@ -145,16 +153,30 @@ impl MieTable {
     }
 }
 
-/// Lorenz–Mie sky of water drops of one radius.
+/// Lorenz–Mie sky of water drops of one radius or of a drop-size distribution.
+///
+/// With a distribution ([`MieSky::with_distribution`]) each wavelength's point profile is
+/// Σ wᵢ aᵢ² pᵢ(θ) / Σ wᵢ aᵢ² over the quadrature nodes ([`crate::drops`]; wᵢ the number
+/// fractions), i.e. ⟨dσ/dΩ⟩ / ⟨π a²⟩, which for one radius is that radius's profile; the
+/// θ grid is the largest radius's (the finest), and the sum is disk-averaged once (the
+/// average is linear). The cost is one Mie series per node and wavelength.
 pub struct MieSky {
     pub ior: Ior,
-    /// Drop radius in nm.
+    /// Drop radius in nm: the monodisperse radius, or the distribution's
+    /// cross-section-weighted mean radius (what [`MieSky::size_parameter`] reports).
     pub droplet_radius_nm: f64,
+    /// The radii (mm) averaged, with their cross-section weights (Σ = 1).
+    pub drops: Vec<DropNode>,
+    /// Only this term of the Debye series ([`super::debye`]), or the full Mie solution.
+    pub debye: Option<u32>,
     /// Sun angular radius α, radians (> 0).
     pub sun_radius: f64,
     pub polarisation: Polarisation,
     /// θ window (radians) tabulated finely.
     pub window: (f64, f64),
+    /// Tabulate only the window (outside it the table holds its edge values): for
+    /// `heron sky lee`, which asks for angles well inside it.
+    pub window_only: bool,
     /// 0: compute each wavelength asked for; > 0: a grid every this many nm, interpolated.
     pub lambda_step_nm: f32,
     cache: RwLock<HashMap<u32, Arc<MieTable>>>,
@@ -164,6 +186,8 @@ impl std::fmt::Debug for MieSky {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("MieSky")
             .field("droplet_radius_nm", &self.droplet_radius_nm)
+            .field("drops", &self.drops.len())
+            .field("debye", &self.debye)
             .field("sun_radius", &self.sun_radius)
             .field("polarisation", &self.polarisation)
             .field("lambda_step_nm", &self.lambda_step_nm)
@@ -177,22 +201,49 @@ impl MieSky {
         MieSky {
             ior: crate::spectrum::ior::named("water").expect("water in the catalogue"),
             droplet_radius_nm: radius_mm * 1e6,
+            drops: vec![DropNode {
+                radius_mm,
+                weight: 1.0,
+            }],
+            debye: None,
             sun_radius,
             polarisation: Polarisation::Unpolarised,
             window: (30f64.to_radians(), 62f64.to_radians()),
+            window_only: false,
             lambda_step_nm: 0.0,
             cache: RwLock::new(HashMap::new()),
         }
     }
 
-    /// Size parameter x = 2πa/λ.
+    /// The same sky for drops distributed as `dsd`, integrated with `nodes` quadrature
+    /// nodes (see [`crate::drops`]).
+    pub fn with_distribution(mut self, dsd: &DropSizeDistribution, nodes: usize) -> Self {
+        self.drops = dsd.cross_section_nodes(nodes);
+        self.droplet_radius_nm = 1e6
+            * self
+                .drops
+                .iter()
+                .map(|d| d.weight * d.radius_mm)
+                .sum::<f64>();
+        self
+    }
+
+    /// Size parameter x = 2πa/λ of [`MieSky::droplet_radius_nm`].
     pub fn size_parameter(&self, lambda_nm: f32) -> f64 {
         2.0 * PI * self.droplet_radius_nm / lambda_nm as f64
     }
 
-    /// The θ nodes for size parameter x.
-    fn grid(&self, x: f64) -> Vec<f64> {
-        let fine = (0.01f64.to_radians()).min(0.5 / x);
+    /// The θ nodes for size parameter x (one radius) or, for a distribution (`dsd`),
+    /// 0.01° in the window whatever x: the sum over nodes is evaluated exactly at each θ,
+    /// and the ripple finer than that, whose phase ∝ x differs from node to node, is
+    /// averaged out by the distribution and the sun's disk (a residue of order the
+    /// one-radius ripple over √nodes remains).
+    fn grid(&self, x: f64, dsd: bool) -> Vec<f64> {
+        let fine = if dsd {
+            0.01f64.to_radians()
+        } else {
+            (0.01f64.to_radians()).min(0.5 / x)
+        };
         let coarse = 0.05f64.to_radians().max(fine);
         let (w0, w1) = self.window;
         let mut g = Vec::new();
@@ -202,6 +253,11 @@ impl MieSky {
                 g.push(a + (b - a) * i as f64 / n as f64);
             }
         };
+        if self.window_only {
+            push_range(w0, w1, fine, &mut g);
+            g.push(w1);
+            return g;
+        }
         push_range(0.0, w0, coarse, &mut g);
         push_range(w0, w1, fine, &mut g);
         push_range(w1, PI, coarse, &mut g);
@@ -212,18 +268,34 @@ impl MieSky {
     /// Computes the table for one wavelength (not cached; see [`MieSky::table`]).
     pub fn compute_table(&self, lambda_nm: f32) -> MieTable {
         let m = self.ior.eval(lambda_nm) as f64;
-        let x = self.size_parameter(lambda_nm);
-        let c = coefficients(m, x);
-        let theta = self.grid(x);
+        let to_x = |radius_mm: f64| 2.0 * PI * radius_mm * 1e6 / lambda_nm as f64;
+        let x_max = self
+            .drops
+            .iter()
+            .map(|d| to_x(d.radius_mm))
+            .fold(0.0, f64::max);
+        let theta = self.grid(x_max, self.drops.len() > 1);
         let pol = self.polarisation;
-        let point: Vec<f64> = theta
-            .par_iter()
-            .with_min_len(64)
-            .map(|&t| {
-                let (s1, s2) = amplitudes(&c, (PI - t).cos());
-                phase_value(s1, s2, x, pol)
-            })
-            .collect();
+        let mut point = vec![0.0; theta.len()];
+        for d in &self.drops {
+            let x = to_x(d.radius_mm);
+            let c = match self.debye {
+                None => coefficients(m, x),
+                Some(p) => super::debye::coefficients(m, x, p),
+            };
+            let one: Vec<f64> = theta
+                .par_iter()
+                .with_min_len(64)
+                .map(|&t| {
+                    let (s1, s2) = amplitudes(&c, (PI - t).cos());
+                    phase_value(s1, s2, x, pol)
+                })
+                .collect();
+            for (acc, v) in point.iter_mut().zip(one) {
+                *acc += d.weight * v;
+            }
+        }
+        let x = self.size_parameter(lambda_nm);
         let alpha = self.sun_radius;
         let disk: Vec<f64> = (0..theta.len())
             .into_par_iter()
@@ -295,7 +367,7 @@ impl MieSky {
 }
 
 /// Disk average of the tabulated `point` profile at node i.
-fn disk_average(theta: &[f64], point: &[f64], i: usize, alpha: f64) -> f64 {
+pub(crate) fn disk_average(theta: &[f64], point: &[f64], i: usize, alpha: f64) -> f64 {
     let t0 = theta[i];
     let lo = theta.partition_point(|&t| t < t0 - alpha);
     let hi = theta.partition_point(|&t| t <= t0 + alpha);

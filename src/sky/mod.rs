@@ -27,13 +27,20 @@
 //! orders k integrate to 1 over the sphere when Fresnel factors are 1; Mie adds diffraction
 //! (another 1, almost all within a few degrees of the sun).
 //!
+//! Drop-size distributions (`airy`, `mie`; [`crate::drops`]): the profile is
+//! ⟨dσ/dΩ⟩ / ⟨π a²⟩ over the distribution, i.e. the per-radius profiles averaged with
+//! weights ∝ number × a², so one radius gives that radius's profile unchanged. `debye`
+//! splits the `mie` solution into the Debye series' terms; `lee` computes Lee diagrams.
+//!
 //! Polarisation: `S` means incident light polarised perpendicular to the scattering plane
 //! (Fresnel's s, Mie's S₁), `P` parallel to it (Fresnel's p, Mie's S₂); unpolarised light is
 //! their mean.
 pub mod airy;
 pub mod aristotle;
 pub mod constant;
+pub mod debye;
 pub mod descartes;
+pub mod lee;
 pub mod mie;
 pub mod profile;
 pub mod table;

@@ -20,6 +20,17 @@ pub struct ProfileRequest {
     pub polarisation: Option<String>,
     /// Background radiance for `constant` (default 1) and `aristotle` (default 0).
     pub background: Option<f64>,
+    /// A drop-size distribution (airy, mie) from the flags `--distribution`,
+    /// `--median-mm`, …: the scene table's keys ([`crate::drops::DropsFile`]); the
+    /// monodisperse radius is `--droplet-radius`.
+    pub drops: Option<crate::drops::DropsFile>,
+    /// Only Debye term p (mie).
+    pub debye: Option<u32>,
+}
+
+/// The CLI flag of a drop-size distribution key: `median_mm` → `--median-mm`.
+pub fn drops_flag(key: &str) -> String {
+    format!("--{}", key.replace('_', "-"))
 }
 
 fn bad(msg: String) -> HeronError {
@@ -95,8 +106,64 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
             "--polarisation applies to descartes, airy and mie, not {model}"
         )));
     }
+    if (req.drops.is_some() || req.debye.is_some())
+        && is_model(model)
+        && !matches!(model, "airy" | "mie")
+    {
+        let flag = if req.drops.is_some() {
+            "--distribution"
+        } else {
+            "--debye"
+        };
+        return Err(bad(format!("{flag} applies to airy and mie, not {model}")));
+    }
+    if req.debye.is_some() && model == "airy" {
+        return Err(bad("--debye applies to mie, not airy".into()));
+    }
+    if let Some(p) = req.debye {
+        if p > super::debye::MAX_TERM {
+            return Err(bad(format!(
+                "--debye: expected a term p in 0..={}, got {p}",
+                super::debye::MAX_TERM
+            )));
+        }
+    }
     let orders = parse_orders(req.k.as_deref(), model)?;
     let pol = parse_polarisation(req.polarisation.as_deref())?;
+    // A distribution other than monodisperse replaces --droplet-radius.
+    let dsd = |max_mm: f64| -> Result<Option<(crate::drops::DropSizeDistribution, usize)>> {
+        let Some(f) = &req.drops else { return Ok(None) };
+        let mut f = f.clone();
+        if f.distribution == "monodisperse" {
+            f.radius_mm = req.droplet_radius_mm;
+        } else if req.droplet_radius_mm.is_some() {
+            return Err(bad(format!(
+                "--droplet-radius: gives one radius; the {} distribution takes its own flags",
+                f.distribution
+            )));
+        }
+        let (d, n) = f
+            .parse_named(&|k| {
+                if k == "radius_mm" {
+                    "--droplet-radius".into()
+                } else {
+                    drops_flag(k)
+                }
+            })
+            .map_err(bad)?;
+        let n = if model == "mie" && f.nodes.is_none() {
+            crate::drops::MIE_DEFAULT_NODES
+        } else {
+            n
+        };
+        let largest = d.max_radius_mm();
+        if largest > max_mm {
+            return Err(bad(format!(
+                "--distribution: the {model} model takes radii up to {max_mm} mm; this distribution reaches {largest:.3} mm"
+            )));
+        }
+        Ok(Some((d, n)))
+    };
     let radius = |max_mm: f64| -> Result<f64> {
         let r = req.droplet_radius_mm.ok_or_else(|| {
             bad(format!(
@@ -130,14 +197,21 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
             Sky::Descartes(s)
         }
         "airy" => {
-            let mut s = AirySky::water(radius(10.0)?, alpha);
+            let mut s = match dsd(10.0)? {
+                Some((d, n)) => AirySky::water(1.0, alpha).with_distribution(&d, n),
+                None => AirySky::water(radius(10.0)?, alpha),
+            };
             s.orders = orders;
             s.polarisation = pol;
             Sky::Airy(s)
         }
         "mie" => {
-            let mut s = MieSky::water(radius(MIE_MAX_RADIUS_MM)?, alpha);
+            let mut s = match dsd(MIE_MAX_RADIUS_MM)? {
+                Some((d, n)) => MieSky::water(1.0, alpha).with_distribution(&d, n),
+                None => MieSky::water(radius(MIE_MAX_RADIUS_MM)?, alpha),
+            };
             s.polarisation = pol;
+            s.debye = req.debye;
             Sky::Mie(s)
         }
         other => {

@@ -9,7 +9,8 @@ heron's output, a pinned package or a script changed: rerun papers/NAME/make.sh 
 commit the result if the change is intended.
 
 The full sets run here (no reduced mode): descartes-rainbow takes about 25 s on two
-cores (about 2 900 `heron trace` runs), aristotelian-rainbow about 5 s.
+cores (about 2 900 `heron trace` runs), aristotelian-rainbow about 5 s, lee-diagram about
+55 s (24 radii × 41 wavelengths of Lorenz–Mie series, up to x = 16 500).
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ import pytest
 from heronrun import REPO, require_heron_bin
 
 PAPERS = REPO / "papers"
-SETS = ["aristotelian-rainbow", "descartes-rainbow"]
+SETS = ["aristotelian-rainbow", "descartes-rainbow", "lee-diagram"]
 OUTPUT_DIRS = ("data", "figures")
 TIMEOUT_S = float(os.environ.get("HERON_PAPERS_TIMEOUT", "300"))
 
