@@ -157,9 +157,13 @@ def sky_profile(
     k: Optional[Union[int, str]] = None,
     polarisation: Optional[Literal["unpolarised", "s", "p"]] = None,
     background: Optional[float] = None,
+    drops: Optional[dict[str, Any]] = None,
+    debye: Optional[int] = None,
 ) -> npt.NDArray[np.float32]:
     """Radiance against the angle theta (degrees) from the antisolar point, as
-    ``heron sky profile``: len(theta) rows by len(wavelengths) columns."""
+    ``heron sky profile``: len(theta) rows by len(wavelengths) columns. drops (airy,
+    mie): a drop-size distribution as the scene files' ``[sky] drops`` table;
+    debye (mie): only Debye term p."""
 
 class Color(TypedDict):
     XYZ: list[float]

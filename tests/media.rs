@@ -620,6 +620,32 @@ fn media_are_refused_by_other_integrators_and_bad_keys_named() {
             sphere,
             "colour",
         ),
+        // Drop-size distributions.
+        (
+            r#"{ type = "mie", radius_mm = 0.5, drops = { distribution = "monodisperse", radius_mm = 0.5 }, number_density = 1 }"#,
+            sphere,
+            "shapes[0].medium: expected one of radius_mm (one drop radius) or drops (a distribution), got both",
+        ),
+        (
+            r#"{ type = "mie", drops = { distribution = "gauss" }, number_density = 1 }"#,
+            sphere,
+            "shapes[0].medium.drops.distribution: expected one of monodisperse, lognormal, gamma, marshall-palmer",
+        ),
+        (
+            r#"{ type = "mie", drops = { distribution = "lognormal", median_mm = 0.1 }, number_density = 1 }"#,
+            sphere,
+            "shapes[0].medium.drops.sigma: the lognormal distribution needs it",
+        ),
+        (
+            r#"{ type = "mie", drops = { distribution = "marshall-palmer", rain_rate_mm_h = 5 } }"#,
+            sphere,
+            "shapes[0].medium.drops: expected drop radii in [0.0001, 1] mm",
+        ),
+        (
+            r#"{ type = "henyey-greenstein", sigma_s = 1, drops = { distribution = "monodisperse", radius_mm = 0.5 } }"#,
+            sphere,
+            "shapes[0].medium.drops: applies to type = \"mie\"",
+        ),
     ] {
         let e = bad(medium, shape);
         assert!(e.contains(want) && !e.contains('\n'), "{medium}: {e}");
@@ -672,5 +698,71 @@ irradiance = 2.0
             .collect::<Vec<u32>>()
     };
     assert_eq!(bits(1), bits(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A drop-size distribution in a medium (issue 12, part 1): `drops` with one radius
+/// gives exactly the coefficients of `radius_mm`; a log-normal population's extinction
+/// is Σ Nᵢ Q_ext π rᵢ² with Q_ext → 2 for drops large against the wavelength (van de
+/// Hulst's extinction paradox; Q_ext − 2 ≈ 2 x^{−2/3} is under 3% at x ≥ 200), from a
+/// number density given directly or through the liquid water content.
+#[test]
+fn drop_size_distributions_fill_the_medium() {
+    let dir = temp_dir("drops");
+    let scene_with = |medium: &str| {
+        load_in(
+            &dir,
+            &format!(
+                "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmedium = {medium}\n"
+            ),
+        )
+    };
+    let coefficients = |scene: &Scene, lambda: f32| {
+        let Medium::LorenzMie(m) = &scene.media[0] else {
+            panic!("not a Lorenz-Mie medium")
+        };
+        (m.sigma_t.eval(lambda) as f64, m.sigma_s.eval(lambda) as f64)
+    };
+    let one = scene_with(r#"{ type = "mie", radius_mm = 0.02, number_density = 1e6 }"#);
+    let mono = scene_with(
+        r#"{ type = "mie", drops = { distribution = "monodisperse", radius_mm = 0.02 }, number_density = 1e6 }"#,
+    );
+    for lambda in [400.0, 550.0, 700.0] {
+        // radius_mm is read as f32, the drops table's as f64: equal to 1e-7.
+        let ((t1, s1), (t2, s2)) = (coefficients(&one, lambda), coefficients(&mono, lambda));
+        assert!((t1 / t2 - 1.0).abs() < 1e-5 && (s1 / s2 - 1.0).abs() < 1e-5);
+    }
+    // A log-normal fog: median 20 µm, σ = 0.2, 8 nodes (x ≥ 120 at 700 nm).
+    let dist = heron::drops::DropSizeDistribution::LogNormal {
+        median_mm: 0.02,
+        sigma: 0.2,
+    };
+    let nodes = dist.nodes(8);
+    let mean_r2: f64 = nodes
+        .iter()
+        .map(|n| n.weight * (n.radius_mm * 1e-3).powi(2))
+        .sum();
+    let mean_v: f64 = nodes
+        .iter()
+        .map(|n| n.weight * 4.0 / 3.0 * std::f64::consts::PI * (n.radius_mm * 1e-3).powi(3))
+        .sum();
+    let n_total = 2.0e8;
+    let lwc = n_total * 1e6 * mean_v;
+    let by_n = scene_with(&format!(
+        r#"{{ type = "mie", drops = {{ distribution = "lognormal", median_mm = 0.02, sigma = 0.2, nodes = 8 }}, number_density = {n_total} }}"#
+    ));
+    let by_lwc = scene_with(&format!(
+        r#"{{ type = "mie", drops = {{ distribution = "lognormal", median_mm = 0.02, sigma = 0.2, nodes = 8 }}, liquid_water_content = {lwc} }}"#
+    ));
+    for lambda in [450.0, 550.0, 650.0] {
+        let (t, s) = coefficients(&by_n, lambda);
+        let geometric = n_total * std::f64::consts::PI * mean_r2;
+        let q = t / geometric;
+        assert!((2.0..2.08).contains(&q), "Q_ext {q} at {lambda} nm");
+        // Water barely absorbs over a few tens of µm.
+        assert!(s <= t && s > 0.999 * t, "σ_s {s}, σ_t {t}");
+        let (t2, _) = coefficients(&by_lwc, lambda);
+        assert!((t2 / t - 1.0).abs() < 1e-5, "{t2} against {t}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -76,10 +76,13 @@ pub fn trace<'py>(
 /// sun_radius (degrees, default 0.2666), droplet_radius (mm; airy and mie), k ("1", "2",
 /// "both"; descartes also "0" and "all"; descartes and airy), polarisation
 /// ("unpolarised", "s", "p"; descartes, airy and mie), background (constant: default 1,
-/// aristotle: default 0). Units: dσ/dΩ/(πa²) per sr for descartes, airy and mie; the
-/// texture's radiance for aristotle.
+/// aristotle: default 0), drops (airy and mie: a drop-size distribution as the scene
+/// files' `[sky] drops` table, e.g. {"distribution": "lognormal", "median_mm": 0.5,
+/// "sigma": 0.1}; monodisperse takes droplet_radius), debye (mie: only the Debye term
+/// p, 0–20). Units: dσ/dΩ/(πa²) per sr for descartes, airy and mie (averaged over the
+/// distribution: ⟨dσ/dΩ⟩/⟨πa²⟩); the texture's radiance for aristotle.
 #[pyfunction]
-#[pyo3(signature = (model, wavelengths, theta, *, sun_radius=0.2666, droplet_radius=None, k=None, polarisation=None, background=None))]
+#[pyo3(signature = (model, wavelengths, theta, *, sun_radius=0.2666, droplet_radius=None, k=None, polarisation=None, background=None, drops=None, debye=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sky_profile<'py>(
     py: Python<'py>,
@@ -91,6 +94,8 @@ pub fn sky_profile<'py>(
     k: Option<&Bound<'py, PyAny>>,
     polarisation: Option<&str>,
     background: Option<f64>,
+    drops: Option<&Bound<'py, PyAny>>,
+    debye: Option<u32>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     guard(|| {
         use heron_core::sky::profile;
@@ -102,7 +107,24 @@ pub fn sky_profile<'py>(
             ("--k", "k"),
             ("--polarisation", "polarisation"),
             ("--background", "background"),
+            ("--distribution", "drops['distribution']"),
+            ("--median-mm", "drops['median_mm']"),
+            ("--sigma", "drops['sigma']"),
+            ("--mode-mm", "drops['mode_mm']"),
+            ("--mu", "drops['mu']"),
+            ("--rain-rate-mm-h", "drops['rain_rate_mm_h']"),
+            ("--nodes", "drops['nodes']"),
+            ("--debye", "debye"),
         ];
+        // The distribution as the scene files' table, through the same serde schema.
+        let drops = match drops {
+            None => None,
+            Some(d) => Some(
+                to_toml(d, "drops")?
+                    .try_into::<heron_core::drops::DropsFile>()
+                    .map_err(|e| err(format!("drops: {}", e.message())))?,
+            ),
+        };
         // `k` as the CLI's text: 1 and "1" alike.
         let k = match k {
             None => None,
@@ -143,6 +165,8 @@ pub fn sky_profile<'py>(
             k,
             polarisation: polarisation.map(str::to_string),
             background,
+            drops,
+            debye,
         };
         let sky = profile::build_sky(&req).map_err(|e| lib_err(e, RENAMES))?;
         let (rows, cols) = (thetas.len(), lambdas.len());

@@ -361,6 +361,9 @@ pub struct MediumFile {
     pub kind: String,
     #[serde(default)]
     pub radius_mm: Option<PositiveNumber>,
+    /// A drop-size distribution instead of one radius (the `[sky] drops` table).
+    #[serde(default)]
+    pub drops: Option<crate::drops::DropsFile>,
     #[serde(default)]
     pub number_density: Option<PositiveNumber>,
     #[serde(default)]

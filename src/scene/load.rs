@@ -1324,6 +1324,10 @@ fn shape_medium(s: &ShapeFile) -> Option<&MediumFile> {
     }
 }
 
+/// Drop-size quadrature nodes of a medium's distribution when its table gives none:
+/// each node is one Lorenz–Mie tabulation (about 16 s for 0.5 mm drops).
+pub const MEDIUM_DEFAULT_NODES: usize = 8;
+
 /// What a `medium` table builds: the key path is `at` (`shapes[i].medium`).
 #[derive(Clone, Debug, PartialEq)]
 enum MediumPlan {
@@ -1352,32 +1356,76 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
                     "{at}.{k}: applies to type = \"henyey-greenstein\", not to type = \"mie\" (whose coefficients come from Lorenz-Mie theory)"
                 ));
             }
-            let r_mm = m
-                .radius_mm
-                .ok_or_else(|| {
-                    format!("{at}.radius_mm: missing required key (expected the drop radius in mm)")
-                })?
-                .0 as f64;
-            if !(1e-4..=1.0).contains(&r_mm) {
-                return Err(format!(
-                    "{at}.radius_mm: expected a drop radius in [0.0001, 1] mm, got {r_mm}"
-                ));
+            // The drops: one radius, or a distribution's quadrature nodes (number
+            // fractions summing to 1).
+            let (nodes, dist) = match (m.radius_mm, &m.drops) {
+                (Some(r), None) => (
+                    vec![crate::drops::DropNode {
+                        radius_mm: r.0 as f64,
+                        weight: 1.0,
+                    }],
+                    None,
+                ),
+                (None, Some(d)) => {
+                    let (dist, n) = d.parse(&format!("{at}.drops"))?;
+                    // Each node is a Lorenz–Mie tabulation (seconds for rain drops), so
+                    // media default to fewer nodes than skies.
+                    let n = if d.nodes.is_none() {
+                        MEDIUM_DEFAULT_NODES
+                    } else {
+                        n
+                    };
+                    (dist.nodes(n), Some(dist))
+                }
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "{at}: expected one of radius_mm (one drop radius) or drops (a distribution), got both"
+                    ))
+                }
+                (None, None) => {
+                    return Err(format!(
+                        "{at}.radius_mm: missing required key (expected the drop radius in mm, or a drops table)"
+                    ))
+                }
+            };
+            for n in &nodes {
+                if !(1e-4..=1.0).contains(&n.radius_mm) {
+                    return Err(if dist.is_some() {
+                        format!(
+                            "{at}.drops: expected drop radii in [0.0001, 1] mm (larger drops take minutes to tabulate), but the distribution has a quadrature node at {:.4} mm",
+                            n.radius_mm
+                        )
+                    } else {
+                        format!(
+                            "{at}.radius_mm: expected a drop radius in [0.0001, 1] mm, got {}",
+                            n.radius_mm
+                        )
+                    });
+                }
             }
-            let r = r_mm * 1e-3;
+            // Σ wᵢ (4/3) π rᵢ³: the mean drop volume in m³.
+            let mean_volume: f64 = nodes
+                .iter()
+                .map(|n| n.weight * 4.0 / 3.0 * std::f64::consts::PI * (n.radius_mm * 1e-3).powi(3))
+                .sum();
             let density = match (m.number_density, m.liquid_water_content) {
                 (Some(n), None) => n.0 as f64,
-                // N = LWC / (ρ_water · 4/3 π r³), ρ_water = 10⁶ g/m³.
-                (None, Some(w)) => w.0 as f64 / (1e6 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r),
+                // N = LWC / (ρ_water ⟨V⟩), ρ_water = 10⁶ g/m³.
+                (None, Some(w)) => w.0 as f64 / (1e6 * mean_volume),
                 (Some(_), Some(_)) => {
                     return Err(format!(
                         "{at}: expected one of number_density (drops per m³) or liquid_water_content (g/m³), got both"
                     ))
                 }
-                (None, None) => {
-                    return Err(format!(
-                        "{at}.number_density: missing required key (expected drops per m³, or liquid_water_content in g/m³)"
-                    ))
-                }
+                // Marshall–Palmer defines its own number density (N0/Λ).
+                (None, None) => match dist.as_ref().and_then(|d| d.number_density()) {
+                    Some(n) => n,
+                    None => {
+                        return Err(format!(
+                            "{at}.number_density: missing required key (expected drops per m³, or liquid_water_content in g/m³)"
+                        ))
+                    }
+                },
             };
             let step = m.lambda_step.map_or(10.0, |s| s.0);
             if !(1.0..=50.0).contains(&step) {
@@ -1392,10 +1440,13 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
                 ));
             }
             Ok(MediumPlan::Mie(crate::medium::MieSpec {
-                population: vec![crate::medium::lorenz_mie::PopulationNode {
-                    radius_m: r,
-                    number_density: density,
-                }],
+                population: nodes
+                    .iter()
+                    .map(|n| crate::medium::lorenz_mie::PopulationNode {
+                        radius_m: n.radius_mm * 1e-3,
+                        number_density: density * n.weight,
+                    })
+                    .collect(),
                 absorption: m.absorption.unwrap_or(true),
                 lambda_step_nm: step,
                 forward_cutoff_deg: cutoff,
@@ -1403,6 +1454,7 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
         }
         "henyey-greenstein" => {
             if let Some(k) = given("radius_mm", m.radius_mm.is_some())
+                .or(given("drops", m.drops.is_some()))
                 .or(given("number_density", m.number_density.is_some()))
                 .or(given(
                     "liquid_water_content",

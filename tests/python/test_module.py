@@ -10,7 +10,8 @@
   `error: `; where the CLI names a flag the message names the argument.
 - `trace` equals `heron trace`'s JSON, and the primary rainbow ray (TRT) of a water drop
   leaves at Descartes' deviation D = 180° + 2i − 4r for its impact parameter.
-- `sky_profile` equals `heron sky profile`'s CSV (printed to 7 significant digits).
+- `sky_profile` equals `heron sky profile`'s CSV (printed to 7 significant digits),
+  with drop-size distributions and Debye terms too.
 - `color` equals `heron color`'s JSON.
 - `ior`: water and N-BK7 at known wavelengths; models as dicts.
 - Ctrl-C: a SIGINT during a long render raises KeyboardInterrupt within a row of a
@@ -362,6 +363,10 @@ PROFILES = [
     ("airy", dict(droplet_radius=0.3, k=2), ["--droplet-radius", "0.3", "--k", "2"]),
     ("mie", dict(droplet_radius=0.02, polarisation="p"), ["--droplet-radius", "0.02", "--polarisation", "p"]),
     ("aristotle", dict(background=0.25), ["--background", "0.25"]),
+    # Drop-size distributions (issue 12) and a Debye term, as the scene files' table.
+    ("airy", dict(drops=dict(distribution="lognormal", median_mm=0.3, sigma=0.1, nodes=12)),
+     ["--distribution", "lognormal", "--median-mm", "0.3", "--sigma", "0.1", "--nodes", "12"]),
+    ("mie", dict(droplet_radius=0.02, debye=2), ["--droplet-radius", "0.02", "--debye", "2"]),
 ]
 
 
@@ -388,6 +393,14 @@ def test_sky_profile_errors():
                      "--lambda", "500", "--from", "40", "--to", "41", "--step", "1")
     assert py_error(heron.sky_profile, "mie", [500], [40], k=1, droplet_radius=0.1) == want.replace("--k", "k")
     assert py_error(heron.sky_profile, "rainbow", [500], [40]).startswith('model: unknown model "rainbow"')
+    want = cli_error("sky", "profile", "--model", "airy", "--distribution", "lognormal",
+                     "--median-mm", "0.3", "--lambda", "500", "--from", "40", "--to", "41", "--step", "1")
+    assert "--sigma" in want
+    assert py_error(heron.sky_profile, "airy", [500], [40],
+                    drops=dict(distribution="lognormal", median_mm=0.3)) == want.replace("--sigma", "drops['sigma']")
+    assert py_error(heron.sky_profile, "airy", [500], [40],
+                    drops=dict(distribution="gauss")).startswith("drops['distribution']")
+    assert py_error(heron.sky_profile, "airy", [500], [40], drops=dict(median=1)).startswith("drops: unknown field")
     assert py_error(heron.sky_profile, "descartes", [500], [190]) == (
         "theta: expected angles in 0–180° from the antisolar point, got 190")
 
