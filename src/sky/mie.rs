@@ -2,8 +2,9 @@
 //!
 //! Series (Bohren & Huffman, *Absorption and Scattering of Light by Small Particles*,
 //! 1983, §4.4 and their program BHMIE, appendix A), for a sphere of relative index m (real
-//! here: water's imaginary index is < 3·10⁻⁸ over 360–830 nm, Hale & Querry 1973, so
-//! absorption is neglected) and size parameter x = 2πa/λ:
+//! here: water's imaginary index is < 3.4·10⁻⁸ below 700 nm and < 1.9·10⁻⁷ up to 830 nm,
+//! Hale & Querry 1973, so absorption is neglected in the skies; the media of
+//! `crate::medium` include it) and size parameter x = 2πa/λ:
 //!
 //! - number of terms N = x + 4 x^{1/3} + 2 (Wiscombe 1980, "Improved Mie scattering
 //!   algorithms", Appl. Opt. 19, 1505);
