@@ -333,6 +333,12 @@ pub struct DropsFile {
     pub nodes: Option<i64>,
 }
 
+/// The weighted mean radius of `nodes` in nm: for cross-section nodes, the radius the
+/// `airy` and `mie` skies report and size their tables by.
+pub fn mean_radius_nm(nodes: &[DropNode]) -> f64 {
+    1e6 * nodes.iter().map(|d| d.weight * d.radius_mm).sum::<f64>()
+}
+
 /// The distribution names [`DropsFile::distribution`] accepts.
 pub const DISTRIBUTION_NAMES: [&str; 4] = ["monodisperse", "lognormal", "gamma", "marshall-palmer"];
 

@@ -247,12 +247,7 @@ impl AirySky {
     /// nodes (see [`crate::drops`]).
     pub fn with_distribution(mut self, dsd: &DropSizeDistribution, nodes: usize) -> Self {
         self.drops = dsd.cross_section_nodes(nodes);
-        self.droplet_radius_nm = 1e6
-            * self
-                .drops
-                .iter()
-                .map(|d| d.weight * d.radius_mm)
-                .sum::<f64>();
+        self.droplet_radius_nm = crate::drops::mean_radius_nm(&self.drops);
         self
     }
 
