@@ -37,17 +37,17 @@ fn shading(c: &mut Criterion) {
                 continue;
             }
             let mut o = RenderOptions::from_scene(&scene);
-            o.spp = 1;
+            o.settings.spp = 1;
             o.threads = 1;
-            o.lanes = lanes;
-            let id = match o.integrator {
-                heron::integrator::IntegratorKind::Whitted => format!("{name}/lanes{lanes}"),
+            o.settings.lanes = lanes;
+            let id = match o.settings.integrator {
+                heron::settings::IntegratorKind::Whitted => format!("{name}/lanes{lanes}"),
                 k => format!("{name}/{}/lanes{lanes}", k.name()),
             };
             g.bench_function(id, |b| b.iter(|| renderer.render(&o).unwrap()));
             if name == "default" && lanes == 4 {
                 // Camera rays one by one instead of Embree 8-wide packets.
-                o.packets = false;
+                o.settings.packets = false;
                 g.bench_function(format!("{name}/lanes{lanes}/no-packets"), |b| {
                     b.iter(|| renderer.render(&o).unwrap())
                 });

@@ -246,7 +246,7 @@ impl Checkpoint {
     /// Writes the file atomically: a temporary file in the same folder, renamed.
     pub fn write(&self, path: &Path) -> Result<()> {
         let bytes = self.to_bytes();
-        crate::film::Staged::write(path, |tmp| {
+        crate::files::Staged::write(path, |tmp| {
             std::fs::write(tmp, &bytes).map_err(|e| format!("cannot write the film state: {e}"))
         })?
         .commit()

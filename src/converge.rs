@@ -51,18 +51,18 @@ pub fn converge(
     let renderer = Renderer::with_threads(scene, base.threads)?;
     let mut o = base.clone();
     o.progress = None;
-    o.spp = ref_spp;
-    o.lanes = 8;
-    o.seed = base.seed.wrapping_add(1);
-    o.sampler = crate::sampler::SamplerKind::Independent;
+    o.settings.spp = ref_spp;
+    o.settings.lanes = 8;
+    o.settings.seed = base.settings.seed.wrapping_add(1);
+    o.settings.sampler = crate::settings::SamplerKind::Independent;
     let (reference, ref_stats) = renderer.render(&o)?;
     let mut rows = Vec::new();
     for &l in lanes {
         for &spp in spps {
             let mut o = base.clone();
             o.progress = None;
-            o.lanes = l;
-            o.spp = spp;
+            o.settings.lanes = l;
+            o.settings.spp = spp;
             let (film, stats) = renderer.render(&o)?;
             let wall = stats.wall.as_secs_f64();
             let e = rel_rmse(&film, &reference);

@@ -20,9 +20,9 @@
 //! - [`spectral_csv`]: the spectral CSV readers on one text: a spectral distribution
 //!   (`heron color`, dielectric index tables) through the interpolation onto the 1 nm
 //!   grid, a metal's `wavelength_nm,n,k` table, and the Aristotelian bow texture.
-use crate::bsdf::{ComplexIor, Dielectric, Material};
+use crate::bsdf::{Dielectric, Material};
 use crate::camera::Camera;
-use crate::colorimetry::{colour_of, Illuminant, SpectrumCsv, StandardObserver};
+use crate::colorimetry::{colour_of, Illuminant, StandardObserver};
 use crate::geometry::{Shape, ShapeKind};
 use crate::light::Light;
 use crate::scene::file::{
@@ -30,7 +30,9 @@ use crate::scene::file::{
     SceneFile, ShapeFile,
 };
 use crate::scene::load::{self, SkyTables};
+use crate::spectrum::csv::SpectrumCsv;
 use crate::spectrum::ior::Ior;
+use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
 use std::collections::BTreeMap;

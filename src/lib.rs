@@ -14,6 +14,7 @@ pub mod colorimetry;
 pub mod converge;
 pub mod drops;
 pub mod error;
+pub mod files;
 pub mod film;
 #[doc(hidden)]
 pub mod fuzzing;
@@ -26,6 +27,7 @@ pub mod provenance;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod settings;
 pub mod sky;
 pub mod spectrum;
 pub mod stress;

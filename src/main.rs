@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use heron::film::{exr::stage_exr, png::stage_png};
 use heron::render::{render_state, RenderOptions};
 use heron::scene::load_scene;
+use heron::settings::SettingsArgs;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -80,7 +81,7 @@ struct StressArgs {
     #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
     integrator: Option<String>,
     /// auto, epsilon or robust (as render --offset); default: the scene's render.offset.
-    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::scene::OffsetMode::NAMES))]
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::settings::OffsetMode::NAMES))]
     offset: Option<String>,
 }
 
@@ -382,13 +383,6 @@ struct ConvergeArgs {
     sampler: Option<String>,
 }
 
-fn wavelength_sampler(name: &str) -> heron::spectrum::WavelengthSampler {
-    match name {
-        "visible" => heron::spectrum::WavelengthSampler::Visible,
-        _ => heron::spectrum::WavelengthSampler::Uniform,
-    }
-}
-
 #[derive(clap::Args)]
 struct TraceArgs {
     /// Scene file (TOML).
@@ -498,7 +492,7 @@ struct RenderArgs {
     /// robust (offset by the hit point's floating-point error bound, pbrt-v4 §6.8.6) or
     /// auto (epsilon for whitted, robust for path, lighttrace and bdpt); default: the
     /// scene's render.offset, else auto.
-    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::scene::OffsetMode::NAMES))]
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::settings::OffsetMode::NAMES))]
     offset: Option<String>,
     /// Write the film's state to FILE (atomically) during the render, so that a killed
     /// render can continue with --resume FILE.
@@ -649,36 +643,27 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if args.threads == Some(0) {
         bail!("--threads: expected at least 1");
     }
-    if args.spp == Some(0) {
-        bail!("--spp: expected at least 1");
-    }
-    let mut scene = load_scene(&args.scene)?;
-    if let Some(d) = args.max_depth {
-        scene.settings.max_depth = d;
-    }
-    apply_offset(&mut scene, &args.offset)?;
+    let settings_args = SettingsArgs {
+        spp: args.spp.map(i64::from),
+        seed: args.seed,
+        lanes: Some(args.lanes as i64),
+        integrator: args.integrator.as_deref(),
+        sampler: args.sampler.as_deref(),
+        wavelengths: Some(&args.wavelengths),
+        spectral_bins: Some(args.spectral_bins.map_or(0, i64::from)),
+        max_depth: args.max_depth.map(i64::from),
+        offset: args.offset.as_deref(),
+        kernel: Some(&args.kernel),
+        no_packets: args.no_packets,
+    };
+    // Before the scene loads, which may take seconds (sky and medium tables).
+    settings_args.check().map_err(anyhow::Error::msg)?;
+    let scene = load_scene(&args.scene)?;
     let mut opts = RenderOptions::from_scene(&scene);
-    if let Some(i) = &args.integrator {
-        opts.integrator = heron::integrator::IntegratorKind::parse(i)
-            .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?;
-    }
-    if let Some(s) = &args.sampler {
-        opts.sampler =
-            heron::sampler::SamplerKind::parse(s).map_err(|e| anyhow::anyhow!("--sampler: {e}"))?;
-    }
-    if let Some(s) = args.spp {
-        opts.spp = s;
-    }
-    if let Some(s) = args.seed {
-        opts.seed = s;
-    }
+    opts.settings
+        .apply(&settings_args)
+        .map_err(anyhow::Error::msg)?;
     opts.threads = args.threads.unwrap_or(0);
-    opts.lanes = args.lanes;
-    opts.packets = !args.no_packets;
-    opts.spectral_bins = args.spectral_bins.map_or(0, usize::from);
-    opts.wavelengths = wavelength_sampler(&args.wavelengths);
-    opts.kernel = heron::scene::features::KernelChoice::parse(&args.kernel)
-        .map_err(|e| anyhow::anyhow!("--kernel: {e}"))?;
     let seconds = |flag: &str, v: f64| -> Result<std::time::Duration> {
         if v.is_finite() && v >= 0.0 {
             Ok(std::time::Duration::from_secs_f64(v))
@@ -752,10 +737,10 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         film.width,
         film.height,
         stats.spp,
-        opts.lanes,
-        opts.sampler.name(),
-        opts.integrator.name(),
-        heron::scene::features::flag_names(stats.kernel),
+        opts.settings.lanes,
+        opts.settings.sampler.name(),
+        opts.settings.integrator.name(),
+        heron::settings::flag_names(stats.kernel),
         stats.wall.as_secs_f64(),
         stats.total_rays(),
         stats.counters.rays,
@@ -785,9 +770,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         } else {
             "time limit reached"
         };
-        let want = opts
-            .shard
-            .map_or(opts.spp, |s| s.samples(opts.spp).len() as u32);
+        let want = opts.shard.map_or(opts.settings.spp, |s| {
+            s.samples(opts.settings.spp).len() as u32
+        });
         // A film file is a checkpoint too.
         let resume = match &opts.checkpoint {
             Some((c, _)) => Some(c.as_path()),
@@ -885,17 +870,16 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("--size: {e}"))?;
     }
     let mut base = RenderOptions::from_scene(&scene);
-    base.seed = a.seed;
+    base.settings
+        .apply(&SettingsArgs {
+            seed: Some(a.seed),
+            integrator: a.integrator.as_deref(),
+            sampler: a.sampler.as_deref(),
+            wavelengths: Some(&a.wavelengths),
+            ..SettingsArgs::default()
+        })
+        .map_err(anyhow::Error::msg)?;
     base.threads = a.threads.map_or(0, usize::from);
-    base.wavelengths = wavelength_sampler(&a.wavelengths);
-    if let Some(i) = &a.integrator {
-        base.integrator = heron::integrator::IntegratorKind::parse(i)
-            .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?;
-    }
-    if let Some(s) = &a.sampler {
-        base.sampler =
-            heron::sampler::SamplerKind::parse(s).map_err(|e| anyhow::anyhow!("--sampler: {e}"))?;
-    }
     let (ref_wall, rows) =
         heron::converge::converge(&scene, &base, a.reference_spp, &a.lanes, &a.spp)?;
     println!(
@@ -903,7 +887,7 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
         a.scene.display(),
         scene.camera.width,
         scene.camera.height,
-        base.integrator.name(),
+        base.settings.integrator.name(),
         a.wavelengths,
         a.reference_spp,
         ref_wall
@@ -1003,14 +987,16 @@ fn cmd_info(path: &Path) -> Result<()> {
 }
 
 fn cmd_stress(args: StressArgs) -> Result<()> {
-    let mut scene = load_scene(&args.scene)?;
-    let kind = match &args.integrator {
-        Some(i) => heron::integrator::IntegratorKind::parse(i)
-            .map_err(|e| anyhow::anyhow!("--integrator: {e}"))?,
-        None => scene.settings.integrator,
-    };
-    apply_offset(&mut scene, &args.offset)?;
-    let offset = scene.settings.ray_offset(kind);
+    let scene = load_scene(&args.scene)?;
+    let mut settings = scene.settings.clone();
+    settings
+        .apply(&SettingsArgs {
+            integrator: args.integrator.as_deref(),
+            offset: args.offset.as_deref(),
+            ..SettingsArgs::default()
+        })
+        .map_err(anyhow::Error::msg)?;
+    let offset = settings.ray_offset(settings.integrator);
     let device = heron::accel::embree::Device::new("")?;
     let accel = heron::render::build_accel(&scene, &device)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -1035,15 +1021,6 @@ fn cmd_stress(args: StressArgs) -> Result<()> {
     }
     if failures > 0 {
         std::process::exit(3);
-    }
-    Ok(())
-}
-
-/// Applies `--offset NAME` (when given) to the scene's settings.
-fn apply_offset(scene: &mut heron::scene::Scene, flag: &Option<String>) -> Result<()> {
-    if let Some(o) = flag {
-        scene.settings.offset =
-            heron::scene::OffsetMode::parse(o).map_err(|e| anyhow::anyhow!("--offset: {e}"))?;
     }
     Ok(())
 }

@@ -8,40 +8,11 @@
 //! ray offsets, camera packets and spectral bins. Nothing that differs between identical runs (no
 //! date, no wall time, no thread count, no absolute path) is recorded, so identical
 //! renders stay byte-identical.
-use crate::render::RenderOptions;
 use crate::scene::Scene;
-use crate::spectrum::WavelengthSampler;
-use sha2::{Digest, Sha256};
-use std::path::Path;
+use crate::settings::{RenderSettings, WavelengthSampler};
 
 /// The attribute-name prefix.
 pub const PREFIX: &str = "heron.";
-
-/// SHA-256 of `bytes`, as 64 lowercase hex digits.
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
-
-/// (path as the scene names it, SHA-256 of the file's bytes) for each distinct file,
-/// sorted by path. The files were just read by the loader; an error names the file.
-pub fn hash_inputs(
-    base_dir: &Path,
-    mut files: Vec<String>,
-) -> std::result::Result<Vec<(String, String)>, String> {
-    files.sort();
-    files.dedup();
-    files
-        .into_iter()
-        .map(|f| {
-            let bytes = std::fs::read(base_dir.join(&f))
-                .map_err(|e| format!("{f}: cannot read it again to hash it: {e}"))?;
-            Ok((f, sha256_hex(&bytes)))
-        })
-        .collect()
-}
 
 /// The provenance of a render, as (key, value) pairs in a fixed order; the EXR
 /// attribute of each is `heron.<key>`.
@@ -90,8 +61,8 @@ impl Provenance {
             .map(Provenance)
     }
 
-    /// What `scene` rendered with `opts` to `spp` samples per pixel records.
-    pub fn of_render(scene: &Scene, opts: &RenderOptions, spp: u32) -> Provenance {
+    /// What `scene` rendered with `settings` to `spp` samples per pixel records.
+    pub fn of_render(scene: &Scene, settings: &RenderSettings, spp: u32) -> Provenance {
         let name = scene
             .source
             .file_name()
@@ -103,7 +74,7 @@ impl Provenance {
             .map(|(f, h)| format!("{h}  {f}"))
             .collect::<Vec<_>>()
             .join("\n");
-        let wavelengths = match opts.wavelengths {
+        let wavelengths = match settings.wavelengths {
             WavelengthSampler::Uniform => "uniform",
             WavelengthSampler::Visible => "visible",
         };
@@ -112,19 +83,19 @@ impl Provenance {
             ("scene", name),
             ("sceneSha256", scene.source_sha256.clone()),
             ("inputs", inputs),
-            ("integrator", opts.integrator.name().to_string()),
-            ("sampler", opts.sampler.name().to_string()),
+            ("integrator", settings.integrator.name().to_string()),
+            ("sampler", settings.sampler.name().to_string()),
             ("spp", spp.to_string()),
-            ("seed", opts.seed.to_string()),
-            ("lanes", opts.lanes.to_string()),
+            ("seed", settings.seed.to_string()),
+            ("lanes", settings.lanes.to_string()),
             ("wavelengths", wavelengths.to_string()),
-            ("maxDepth", scene.settings.max_depth.to_string()),
+            ("maxDepth", settings.max_depth.to_string()),
             (
                 "offset",
-                scene.settings.ray_offset(opts.integrator).to_string(),
+                settings.ray_offset(settings.integrator).to_string(),
             ),
-            ("packets", opts.packets.to_string()),
-            ("spectralBins", opts.spectral_bins.to_string()),
+            ("packets", settings.packets.to_string()),
+            ("spectralBins", settings.spectral_bins.to_string()),
         ])
     }
 }
@@ -143,12 +114,12 @@ mod tests {
             std::path::Path::new("p.toml"),
         )
         .unwrap();
-        let opts = RenderOptions::from_scene(&scene);
-        let p = Provenance::of_render(&scene, &opts, 7);
+        let settings = &scene.settings;
+        let p = Provenance::of_render(&scene, settings, 7);
         let names: Vec<&str> = p.0.iter().map(|(k, _)| *k).collect();
         assert_eq!(names, KEYS);
         let key: serde_json::Map<String, serde_json::Value> =
-            Provenance::of_render(&scene, &opts, opts.spp)
+            Provenance::of_render(&scene, settings, settings.spp)
                 .0
                 .into_iter()
                 .map(|(k, v)| (k.to_string(), v.into()))

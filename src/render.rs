@@ -13,11 +13,11 @@ use crate::checkpoint::{Checkpoint, Shard};
 use crate::film::fixed::{to_fixed, to_fixed3};
 use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
-use crate::integrator::{self, Context, IntegratorKind, TraceCounters};
-use crate::sampler::{Sampler, SamplerKind};
-use crate::scene::features::{KernelChoice, KernelFlags};
+use crate::integrator::{self, Context, TraceCounters};
+use crate::sampler::Sampler;
 use crate::scene::{Features, Scene};
-use crate::spectrum::{SampledWavelengths, WavelengthSampler};
+use crate::settings::{KernelFlags, RenderSettings};
+use crate::spectrum::SampledWavelengths;
 use crate::{HeronError, Result};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -26,27 +26,13 @@ use std::time::{Duration, Instant};
 const TILE: u32 = 16;
 const PACKET: usize = 8;
 
+/// A render: its settings (everything that decides the pixels) and how it runs.
 #[derive(Clone)]
 pub struct RenderOptions {
-    pub spp: u32,
-    pub seed: u64,
+    /// The scene's settings with the flags or keyword arguments applied.
+    pub settings: RenderSettings,
     /// Worker threads; 0 means one per core.
     pub threads: usize,
-    /// Wavelength lanes per path: 1, 4 or 8.
-    pub lanes: usize,
-    /// Trace camera rays as 8-wide packets (otherwise one by one).
-    pub packets: bool,
-    /// How hero wavelengths are drawn.
-    pub wavelengths: WavelengthSampler,
-    /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
-    /// (0: none).
-    pub spectral_bins: usize,
-    /// The integrator (default: the scene's `[render] integrator`).
-    pub integrator: IntegratorKind,
-    /// Where the random numbers come from.
-    pub sampler: SamplerKind,
-    /// The kernel specialised to the scene's features, or the general one.
-    pub kernel: KernelChoice,
     /// Write the film's state to this file after a pass when this long has passed since
     /// the last write (zero: after every pass).
     pub checkpoint: Option<(std::path::PathBuf, Duration)>,
@@ -66,20 +52,11 @@ pub struct RenderOptions {
 }
 
 impl RenderOptions {
+    /// A render of `scene` with its own settings, on every core, with no checkpoints.
     pub fn from_scene(scene: &Scene) -> Self {
         RenderOptions {
-            spp: scene.settings.spp,
-            seed: scene.settings.seed,
+            settings: scene.settings.clone(),
             threads: 0,
-            // The defaults with the lowest RMSE·√t over the course scenes, the Cornell box
-            // and a rainbow (scripts/bench_defaults.py, BENCHMARKS.md "Defaults").
-            lanes: 8,
-            packets: true,
-            wavelengths: WavelengthSampler::Visible,
-            spectral_bins: 0,
-            integrator: scene.settings.integrator,
-            sampler: SamplerKind::Sobol,
-            kernel: KernelChoice::Auto,
             checkpoint: None,
             resume: None,
             shard: None,
@@ -236,15 +213,16 @@ fn render_with(
     pool: &rayon::ThreadPool,
     opts: &RenderOptions,
 ) -> Result<(Checkpoint, RenderStats)> {
-    let kind = opts.integrator;
+    let kind = opts.settings.integrator;
     let ctx = Context {
         scene,
         accel,
-        offset: scene.settings.ray_offset(kind),
+        settings: &opts.settings,
+        offset: opts.settings.ray_offset(kind),
     };
     // The kernel is decided here, once per render, from what the scene uses.
     let k = Features::of(scene)
-        .choose(kind, opts.kernel)
+        .choose(kind, opts.settings.kernel)
         .map_err(HeronError::Invalid)?;
     let integrate = move |n: Lanes| -> SampleFn {
         match n {
@@ -268,7 +246,7 @@ fn render_with(
         ((1u32 << 22) / npix).max(1)
     };
     let mut opts = opts.clone();
-    opts.packets &= kind.uses_camera_rays();
+    opts.settings.packets &= kind.uses_camera_rays();
     let (state, mut stats) = render_passes(&ctx, pool, &opts, pass, &integrate)?;
     stats.kernel = k;
     Ok((state, stats))
@@ -283,7 +261,9 @@ fn settings_key(
     pass_spp: u32,
 ) -> serde_json::Map<String, serde_json::Value> {
     let mut m = serde_json::Map::new();
-    for (k, v) in crate::provenance::Provenance::of_render(scene, opts, opts.spp).0 {
+    for (k, v) in
+        crate::provenance::Provenance::of_render(scene, &opts.settings, opts.settings.spp).0
+    {
         m.insert(k.to_string(), v.into());
     }
     m.insert("width".into(), scene.camera.width.into());
@@ -294,7 +274,7 @@ fn settings_key(
 
 /// Whether the render's integrator splats (so that splat buffers are needed).
 fn kind_splats(opts: &RenderOptions) -> bool {
-    opts.integrator.splats()
+    opts.settings.integrator.splats()
 }
 
 /// The lane counts a render can use, chosen once per render.
@@ -326,10 +306,10 @@ pub(crate) fn render_passes(
     pass_spp: u32,
     integrate: &(dyn Fn(Lanes) -> SampleFn + Sync),
 ) -> Result<(Checkpoint, RenderStats)> {
-    if opts.spp == 0 {
+    if opts.settings.spp == 0 {
         return Err(HeronError::Invalid("spp must be at least 1".into()));
     }
-    let lanes = match opts.lanes {
+    let lanes = match opts.settings.lanes {
         1 => Lanes::One,
         4 => Lanes::Four,
         8 => Lanes::Eight,
@@ -346,8 +326,10 @@ pub(crate) fn render_passes(
     let tiles: Vec<(u32, u32)> = (0..th)
         .flat_map(|ty| (0..tw).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let pass_spp = pass_spp.clamp(1, opts.spp);
-    let range = opts.shard.map_or(0..opts.spp, |s| s.samples(opts.spp));
+    let pass_spp = pass_spp.clamp(1, opts.settings.spp);
+    let range = opts
+        .shard
+        .map_or(0..opts.settings.spp, |s| s.samples(opts.settings.spp));
     let passes: Vec<(u32, u32)> = range
         .clone()
         .step_by(pass_spp as usize)
@@ -356,7 +338,7 @@ pub(crate) fn render_passes(
     let n_work = tiles.len() as u64 * passes.len() as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
     let npix = (cam.width * cam.height) as usize;
-    let nb = opts.spectral_bins;
+    let nb = opts.settings.spectral_bins;
     // Unnormalised sums over the whole render: XYZ and bins per pixel, finite samples per
     // pixel, and splatted XYZ.
     let key = settings_key(ctx.scene, opts, pass_spp);
@@ -539,9 +521,9 @@ fn render_tile<const N: usize>(
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
     let bins = SpectralBins {
-        count: opts.spectral_bins,
+        count: opts.settings.spectral_bins,
     };
-    let nb = opts.spectral_bins;
+    let nb = opts.settings.spectral_bins;
     let mut xyz = vec![[0i128; 3]; (w * h) as usize];
     let mut spectral = vec![0i128; (w * h) as usize * nb];
     let mut good = vec![0u32; (w * h) as usize];
@@ -550,11 +532,17 @@ fn render_tile<const N: usize>(
     let mut first_nonfinite = None;
     let mut splats = Splats::with_bins(
         cam.width * cam.height,
-        (opts.spectral_bins > 0).then_some(SpectralBins {
-            count: opts.spectral_bins,
+        (opts.settings.spectral_bins > 0).then_some(SpectralBins {
+            count: opts.settings.spectral_bins,
         }),
     );
-    let base = Sampler::new(opts.sampler, opts.seed, cam.width, cam.height, opts.spp);
+    let base = Sampler::new(
+        opts.settings.sampler,
+        opts.settings.seed,
+        cam.width,
+        cam.height,
+        opts.settings.spp,
+    );
     let mut samplers: [Sampler; PACKET] = std::array::from_fn(|_| base.clone());
     let mut rays = [RayQuery {
         origin: cam.eye,
@@ -585,10 +573,11 @@ fn render_tile<const N: usize>(
                     let sampler = &mut samplers[k];
                     sampler.start_pixel_sample(px, py, s);
                     let j = sampler.get_pixel_2d();
-                    wls[k] = SampledWavelengths::sample(opts.wavelengths, sampler.get_1d());
+                    wls[k] =
+                        SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
                     rays[k].dir = cam.direction(px as f32 + j.x, py as f32 + j.y);
                 }
-                let hits = if opts.packets {
+                let hits = if opts.settings.packets {
                     counters.rays += lanes as u64;
                     Some(ctx.accel.intersect8(&rays, active))
                 } else {
@@ -655,6 +644,7 @@ fn render_tile<const N: usize>(
 mod tests {
     use super::*;
     use crate::scene::load::load_scene_from_str;
+    use crate::settings::IntegratorKind;
     use std::path::Path;
 
     /// A splatting integrator (standing in for light tracing): each sample splats the
@@ -674,6 +664,7 @@ mod tests {
         let ctx = Context {
             scene: &scene,
             accel: &accel,
+            settings: &scene.settings,
             offset: scene.settings.ray_offset(IntegratorKind::Whitted),
         };
         fn splat_one(
@@ -698,8 +689,8 @@ mod tests {
         let run = |threads: usize, pass: u32| {
             let pool = embree::worker_pool(threads).unwrap();
             let mut o = RenderOptions::from_scene(&scene);
-            o.spp = 64;
-            o.lanes = 4;
+            o.settings.spp = 64;
+            o.settings.lanes = 4;
             o.threads = threads;
             render_passes(&ctx, &pool, &o, pass, &integrate)
                 .unwrap()

@@ -34,10 +34,10 @@ use crate::geometry::{Interaction, Ray, RayOffset, Shape, ShapeKind};
 use crate::math::warp::{cosine_hemisphere, uniform_sphere, uniform_triangle};
 use crate::math::{Frame, Rng};
 use crate::scene::Scene;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampler};
+use crate::settings::WavelengthSampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 /// Wavelength lanes of the material cases (heron's default).
 const LANES: usize = 8;
@@ -182,8 +182,8 @@ fn material_wo(m: &Material, inc: Incidence, lambda: f32, rng: &mut Rng) -> Opti
         Incidence::Uniform => Some(uniform_sphere(u2(rng))),
         Incidence::TirEdge => {
             // n_i/n_t for light arriving from outside (front) and from inside.
-            let front = m.hit_info(lambda, true).0;
-            let back = m.hit_info(lambda, false).0;
+            let front = m.ior1_over_ior2(lambda, true);
+            let back = m.ior1_over_ior2(lambda, false);
             let (r, sign) = if back > 1.0 && (side < 0.0 || front <= 1.0) {
                 (back, -1.0)
             } else if front > 1.0 {
@@ -203,7 +203,7 @@ fn material_wo(m: &Material, inc: Incidence, lambda: f32, rng: &mut Rng) -> Opti
 
 /// Whether the material has a side with total internal reflection (at 550 nm).
 pub fn has_tir(m: &Material) -> bool {
-    m.hit_info(550.0, true).0 > 1.0 || m.hit_info(550.0, false).0 > 1.0
+    m.ior1_over_ior2(550.0, true) > 1.0 || m.ior1_over_ior2(550.0, false) > 1.0
 }
 
 /// One material case: `rays` outgoing directions in regime `inc`.
@@ -288,25 +288,6 @@ fn check_eval(
     }
 }
 
-/// Per shape: whether it encloses a volume (a sphere, or a mesh whose every edge is
-/// shared by exactly two triangles), which makes a ray leaving into it a leak if it
-/// escapes.
-pub fn closed(shape: &Shape) -> bool {
-    match &shape.kind {
-        ShapeKind::Sphere { .. } => true,
-        ShapeKind::Mesh(m) => {
-            let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-            for t in &m.indices {
-                for k in 0..3 {
-                    let (a, b) = (t[k], t[(k + 1) % 3]);
-                    *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-                }
-            }
-            !edges.is_empty() && edges.values().all(|&c| c == 2)
-        }
-    }
-}
-
 /// A point of the shape (spheres uniformly, meshes by triangle then uniformly within
 /// it), its outward unit normal, and a length of the order of the shape's size.
 fn shape_point(shape: &Shape, rng: &mut Rng) -> (Vec3, Vec3, f32) {
@@ -326,9 +307,10 @@ fn shape_point(shape: &Shape, rng: &mut Rng) -> (Vec3, Vec3, f32) {
     }
 }
 
-/// Whether each shape of the scene is closed ([`closed`]), computed once per scene.
+/// Whether each shape of the scene is closed ([`Shape::is_closed`]), computed once per
+/// scene.
 pub fn closed_shapes(scene: &Scene) -> Vec<bool> {
-    scene.shapes.iter().map(closed).collect()
+    scene.shapes.iter().map(Shape::is_closed).collect()
 }
 
 /// One shape case: `rays` rays traced at and from shape `index` of `scene`; `closed` is
@@ -398,13 +380,13 @@ fn shape_sample(
         return;
     };
     let wl = SampledWavelengths::<LANES>::sample(WavelengthSampler::Visible, rng.uniform());
-    let (it, material) = scene.interaction(&ray, &hit, 0, wl.lambda[0], offset.is_robust());
+    let (it, material) = scene.interaction(&ray, &hit, offset.is_robust());
     // The classification's tolerances come from the hit point's error bound whichever
     // offsets the rays use (with ε offsets the render leaves it zero).
     let err = if offset.is_robust() {
         it.p_err
     } else {
-        scene.interaction(&ray, &hit, 0, wl.lambda[0], true).0.p_err
+        scene.interaction(&ray, &hit, true).0.p_err
     };
     let at = |what: &str| {
         format!(

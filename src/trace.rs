@@ -100,7 +100,7 @@ pub fn trace(
     let mut ray = Ray::new(origin, dir.normalize(), 0.0, f32::INFINITY);
     let mut events = Vec::new();
     let mut dielectric_events = 0usize;
-    for depth in 0..=scene.settings.max_depth {
+    for _ in 0..=scene.settings.max_depth {
         let q = RayQuery {
             origin: ray.origin,
             dir: ray.dir,
@@ -126,7 +126,7 @@ pub fn trace(
                 truncated: false,
             });
         };
-        let (it, material) = scene.interaction(&ray, &hit, depth, lambda_nm, offset.is_robust());
+        let (it, material) = scene.interaction(&ray, &hit, offset.is_robust());
         let wo = -ray.dir;
         let mut ev = TraceEvent {
             kind: EventKind::Absorb,

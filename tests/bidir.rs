@@ -6,10 +6,10 @@ mod common;
 use common::chi2::{Chi2, Spherical};
 use glam::Vec3;
 use heron::film::Film;
-use heron::integrator::IntegratorKind;
 use heron::render::{render, RenderOptions, Renderer};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{load_scene, Scene};
+use heron::settings::IntegratorKind;
 use std::path::Path;
 
 fn scenes() -> std::path::PathBuf {
@@ -27,10 +27,10 @@ fn resize(scene: &mut Scene, w: u32, h: u32) {
 
 fn run(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64, lanes: usize) -> Film {
     let mut o = RenderOptions::from_scene(scene);
-    o.integrator = kind;
-    o.spp = spp;
-    o.seed = seed;
-    o.lanes = lanes;
+    o.settings.integrator = kind;
+    o.settings.spp = spp;
+    o.settings.seed = seed;
+    o.settings.lanes = lanes;
     let (film, stats) = render(scene, &o).unwrap();
     assert_eq!(stats.nonfinite, 0, "{kind:?}: non-finite samples");
     film
@@ -256,8 +256,8 @@ fn splatting_integrators_are_deterministic_for_any_thread_count() {
             .iter()
             .map(|&t| {
                 let mut o = RenderOptions::from_scene(&scene);
-                o.integrator = kind;
-                o.spp = 4;
+                o.settings.integrator = kind;
+                o.settings.spp = 4;
                 o.threads = t;
                 render(&scene, &o).unwrap().0
             })
@@ -357,10 +357,10 @@ fn newton() -> (Scene, Film) {
     let mut o = RenderOptions::from_scene(&scene);
     // 128 spp at 256²: 8.4M light paths, about 180k per 10 nm bin after the prism ends
     // the companions, so each bin's flux has a standard error near 0.25%.
-    o.spp = 128;
-    o.lanes = 4;
-    o.spectral_bins = 47;
-    o.seed = 5;
+    o.settings.spp = 128;
+    o.settings.lanes = 4;
+    o.settings.spectral_bins = 47;
+    o.settings.seed = 5;
     let (film, stats) = render(&scene, &o).unwrap();
     assert_eq!(stats.nonfinite, 0);
     (scene, film)

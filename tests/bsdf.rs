@@ -21,13 +21,14 @@ use glam::{Vec2, Vec3};
 use heron::bsdf::fresnel::fresnel_dielectric;
 use heron::bsdf::microfacet::TrowbridgeReitz;
 use heron::bsdf::{
-    BsdfContext, ComplexIor, Conductor, Dielectric, Glossy, Lambertian, LobeFlags, Material,
-    Mirror, RoughConductor, RoughDielectric, TransportMode,
+    BsdfContext, Conductor, Dielectric, Glossy, Lambertian, LobeFlags, Material, Mirror,
+    RoughConductor, RoughDielectric, TransportMode,
 };
 use heron::math::warp::uniform_sphere;
 use heron::math::Rng;
 use heron::spectrum::ior::{self, Ior};
-use heron::spectrum::{metals, DenseSpectrum, SampledWavelengths};
+use heron::spectrum::metals::{self, ComplexIor};
+use heron::spectrum::{DenseSpectrum, SampledWavelengths};
 
 // ----------------------------------------------------------------------------------
 // Materials and directions

@@ -9,7 +9,8 @@ use heron::geometry::{Mesh, Shape, ShapeKind};
 use heron::light::{Light, PointLight};
 use heron::math::Rng;
 use heron::render::{render, RenderOptions, Renderer};
-use heron::scene::{RenderSettings, Scene, SceneParts};
+use heron::scene::{Scene, SceneParts};
+use heron::settings::RenderSettings;
 use heron::spectrum::ior::{self, Ior};
 use heron::spectrum::DenseSpectrum;
 use heron::trace::{trace, EventKind, TraceReport};
@@ -321,10 +322,10 @@ fn ending_secondary_wavelengths_is_unbiased() {
     s.background = DenseSpectrum::from_fn(|l| if l < 500.0 { 1.0 } else { 0.2 });
     s.camera = Camera::new(Vec3::new(0.0, 0.5, -3.0), Vec3::ZERO, Vec3::Y, 1.2, 48, 48).unwrap();
     let mut o = RenderOptions::from_scene(&s);
-    o.spp = 64;
-    o.lanes = 1;
+    o.settings.spp = 64;
+    o.settings.lanes = 1;
     let (one, _) = render(&s, &o).unwrap();
-    o.lanes = 4;
+    o.settings.lanes = 4;
     let (four, _) = render(&s, &o).unwrap();
     for c in 0..3 {
         let d: Vec<f64> = one

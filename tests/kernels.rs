@@ -4,12 +4,12 @@
 //! feature compiled in; a kernel missing a feature the scene uses does not; and the
 //! course's scenes get the kernels their contents imply.
 use heron::camera::Camera;
-use heron::integrator::IntegratorKind;
 use heron::render::{render, RenderOptions};
-use heron::scene::features::{
+use heron::scene::{load_scene, Features, Scene};
+use heron::settings::IntegratorKind;
+use heron::settings::{
     flag_names, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS, SPECULAR,
 };
-use heron::scene::{load_scene, Features, Scene};
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -27,10 +27,10 @@ fn scene(name: &str) -> Scene {
 
 fn image(s: &Scene, kind: IntegratorKind, kernel: KernelChoice) -> (Vec<u32>, KernelFlags) {
     let mut o = RenderOptions::from_scene(s);
-    o.integrator = kind;
-    o.kernel = kernel;
-    o.spp = 3;
-    o.lanes = 4;
+    o.settings.integrator = kind;
+    o.settings.kernel = kernel;
+    o.settings.spp = 3;
+    o.settings.lanes = 4;
     o.threads = 2;
     let (film, stats) = render(s, &o).unwrap();
     let bits = film.xyz.iter().flatten().map(|v| v.to_bits()).collect();

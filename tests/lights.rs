@@ -11,7 +11,6 @@ mod common;
 
 use common::chi2::{assert_all, discrete, seed_of, Chi2, Outcome, Spherical};
 use glam::{DVec3, Vec2, Vec3};
-use heron::light::sampler::LightSamplerKind;
 use heron::light::sun::SUN_ANGULAR_RADIUS_DEG;
 use heron::light::{
     AreaLight, AreaShape, DirectionalLight, EnvironmentLight, Light, LightSampler, PointLight,
@@ -19,6 +18,7 @@ use heron::light::{
 };
 use heron::math::Rng;
 use heron::scene::load::load_scene_from_str;
+use heron::settings::LightSamplerKind;
 use heron::spectrum::{DenseSpectrum, SampledWavelengths};
 use std::f64::consts::PI;
 use std::path::Path;

@@ -23,12 +23,12 @@ mod common;
 use common::chi2::{assert_all, Chi2, Outcome, Spherical};
 use glam::{Vec2, Vec3};
 use heron::film::Film;
-use heron::integrator::IntegratorKind;
 use heron::medium::lorenz_mie::PopulationNode;
 use heron::medium::{HgMedium, LorenzMieMedium, Medium, MieSpec};
 use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::Scene;
+use heron::settings::IntegratorKind;
 use heron::spectrum::{DenseSpectrum, SampledWavelengths};
 use std::path::{Path, PathBuf};
 
@@ -168,8 +168,8 @@ fn load_in(dir: &Path, toml: &str) -> Scene {
 
 fn run(scene: &Scene, spp: u32) -> Film {
     let mut o = RenderOptions::from_scene(scene);
-    o.integrator = IntegratorKind::Path;
-    o.spp = spp;
+    o.settings.integrator = IntegratorKind::Path;
+    o.settings.spp = spp;
     let (film, stats) = render(scene, &o).unwrap();
     assert_eq!(stats.nonfinite, 0, "non-finite samples");
     film
@@ -565,7 +565,7 @@ fn media_are_refused_by_other_integrators_and_bad_keys_named() {
         IntegratorKind::Bdpt,
     ] {
         let mut o = RenderOptions::from_scene(&scene);
-        o.integrator = kind;
+        o.settings.integrator = kind;
         let e = render(&scene, &o).unwrap_err().to_string();
         assert!(
             e.contains("only the path integrator") && !e.contains('\n'),
@@ -687,8 +687,8 @@ irradiance = 2.0
     );
     let bits = |threads: usize| {
         let mut o = RenderOptions::from_scene(&scene);
-        o.integrator = IntegratorKind::Path;
-        o.spp = 8;
+        o.settings.integrator = IntegratorKind::Path;
+        o.settings.spp = 8;
         o.threads = threads;
         let (film, _) = render(&scene, &o).unwrap();
         film.xyz

@@ -8,7 +8,8 @@ use heron::film::Film;
 use heron::geometry::{Mesh, Shape, ShapeKind};
 use heron::light::{DirectionalLight, Light, PointLight};
 use heron::render::{render, RenderOptions};
-use heron::scene::{RenderSettings, Scene, SceneParts};
+use heron::scene::{Scene, SceneParts};
+use heron::settings::RenderSettings;
 use heron::spectrum::ior::Ior;
 use heron::spectrum::DenseSpectrum;
 use std::f32::consts::PI;
@@ -275,7 +276,7 @@ fn image_is_identical_for_any_thread_count() {
     let c = run(&s, 7);
     assert!(a == b && b == c, "films differ between thread counts");
     let mut o = RenderOptions::from_scene(&s);
-    o.packets = false;
+    o.settings.packets = false;
     let (d, _) = render(&s, &o).unwrap();
     // Embree's packet and single-ray kernels may round t differently in the last bits,
     // so the two images agree closely but not bit for bit.

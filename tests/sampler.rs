@@ -8,12 +8,12 @@
 //! over seeds gives the standard errors even though Sobol's pixels are correlated.
 use heron::camera::Camera;
 use heron::film::Film;
-use heron::integrator::IntegratorKind;
 use heron::render::{render, RenderOptions};
-use heron::sampler::SamplerKind;
 use heron::scene::load::load_scene;
 use heron::scene::Scene;
-use heron::spectrum::WavelengthSampler;
+use heron::settings::IntegratorKind;
+use heron::settings::SamplerKind;
+use heron::settings::WavelengthSampler;
 use std::path::Path;
 
 fn scene(name: &str, size: u32) -> Scene {
@@ -35,12 +35,12 @@ struct Setting {
 
 fn run(scene: &Scene, s: &Setting, sampler: SamplerKind, seed: u64) -> Film {
     let mut o = RenderOptions::from_scene(scene);
-    o.integrator = s.integrator;
-    o.lanes = s.lanes;
-    o.wavelengths = s.wavelengths;
-    o.spp = s.spp;
-    o.sampler = sampler;
-    o.seed = seed;
+    o.settings.integrator = s.integrator;
+    o.settings.lanes = s.lanes;
+    o.settings.wavelengths = s.wavelengths;
+    o.settings.spp = s.spp;
+    o.settings.sampler = sampler;
+    o.settings.seed = seed;
     let (film, stats) = render(scene, &o).unwrap();
     assert_eq!(stats.nonfinite, 0);
     film

@@ -4,11 +4,11 @@
 use glam::Vec3;
 use heron::bsdf::Material;
 use heron::geometry::{Shape, ShapeKind};
-use heron::integrator::IntegratorKind;
 use heron::light::Light;
-use heron::scene::features::{flag_names, KernelChoice, ALL, EMITTERS, SHADOWS};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{load_scene, Features, Scene};
+use heron::settings::IntegratorKind;
+use heron::settings::{flag_names, KernelChoice, ALL, EMITTERS, SHADOWS};
 use heron::spectrum::uplift::{named, rgb_to_illuminant, rgb_to_reflectance};
 use heron::spectrum::DenseSpectrum;
 use heron::HeronError;

@@ -111,7 +111,7 @@ fn rendered_descartes_sky_has_its_bows_and_dark_band_where_optics_puts_them() {
     let (w, h) = (1u32, 400u32);
     s.camera = Camera::new(c.eye, c.look_at, c.up, 0.6, w, h).unwrap();
     let mut o = RenderOptions::from_scene(&s);
-    o.spp = 64;
+    o.settings.spp = 64;
     let (film, _) = render(&s, &o).unwrap();
     let rows: Vec<(f64, f32)> = (0..h)
         .map(|y| {

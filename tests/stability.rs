@@ -25,10 +25,11 @@
 use glam::Vec3;
 use heron::accel::embree;
 use heron::geometry::RayOffset;
-use heron::integrator::IntegratorKind;
 use heron::render::{build_accel, render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
-use heron::scene::{OffsetMode, Scene};
+use heron::scene::Scene;
+use heron::settings::IntegratorKind;
+use heron::settings::OffsetMode;
 use heron::stress::{self, CaseReport, Incidence};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -155,9 +156,9 @@ fn box_scene(s: f32, o: Vec3) -> Scene {
 
 fn image(scene: &Scene, kind: IntegratorKind, seed: u64) -> Vec<f32> {
     let mut o = RenderOptions::from_scene(scene);
-    o.integrator = kind;
-    o.spp = 16;
-    o.seed = seed;
+    o.settings.integrator = kind;
+    o.settings.spp = 16;
+    o.settings.seed = seed;
     o.threads = 2;
     let (film, stats) = render(scene, &o).unwrap();
     assert_eq!(stats.nonfinite, 0, "{}: non-finite samples", kind.name());

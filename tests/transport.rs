@@ -15,10 +15,10 @@
 //! estimates of the same quantity. Scenes use the spectrum E (constant 1), so every
 //! wavelength has the same expected radiance and the film's Y is that radiance.
 use heron::film::Film;
-use heron::integrator::IntegratorKind;
 use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::Scene;
+use heron::settings::IntegratorKind;
 use std::path::Path;
 
 fn load(toml: &str) -> Scene {
@@ -27,9 +27,9 @@ fn load(toml: &str) -> Scene {
 
 fn run(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64) -> Film {
     let mut o = RenderOptions::from_scene(scene);
-    o.integrator = kind;
-    o.spp = spp;
-    o.seed = seed;
+    o.settings.integrator = kind;
+    o.settings.spp = spp;
+    o.settings.seed = seed;
     let (film, stats) = render(scene, &o).unwrap();
     assert_eq!(stats.nonfinite, 0, "non-finite samples");
     film
@@ -257,7 +257,7 @@ fn path_tracing_is_deterministic_for_any_thread_count() {
         .iter()
         .map(|&t| {
             let mut o = RenderOptions::from_scene(&scene);
-            o.spp = 4;
+            o.settings.spp = 4;
             o.threads = t;
             render(&scene, &o).unwrap().0
         })
@@ -307,11 +307,11 @@ emission = { spectrum = "E", scale = 20.0 }
     let mut films = Vec::new();
     for (lanes, seed) in [(4usize, 11u64), (1, 12)] {
         let mut o = RenderOptions::from_scene(&scene);
-        o.integrator = IntegratorKind::Path;
+        o.settings.integrator = IntegratorKind::Path;
         // At 1024 spp, dropping the hero's factor N shows up at 5.3 standard errors.
-        o.spp = 1024;
-        o.lanes = lanes;
-        o.seed = seed;
+        o.settings.spp = 1024;
+        o.settings.lanes = lanes;
+        o.settings.seed = seed;
         let (film, stats) = render(&scene, &o).unwrap();
         assert_eq!(stats.nonfinite, 0);
         films.push(film);
@@ -355,8 +355,8 @@ fn every_scene_renders_with_the_path_integrator() {
         let c = &scene.camera;
         scene.camera = heron::camera::Camera::new(c.eye, c.look_at, c.up, c.d, 24, 16).unwrap();
         let mut o = RenderOptions::from_scene(&scene);
-        o.integrator = IntegratorKind::Path;
-        o.spp = 4;
+        o.settings.integrator = IntegratorKind::Path;
+        o.settings.spp = 4;
         let (_, stats) = render(&scene, &o).unwrap();
         assert_eq!(stats.nonfinite, 0, "{name}");
         n += 1;

@@ -2,6 +2,7 @@
 use crate::{err, guard, lib_err, panic_message};
 use heron_core::film::Film;
 use heron_core::render::{RenderOptions, RenderStats};
+use heron_core::settings::SettingsArgs;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -10,6 +11,19 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
 use std::time::Duration;
+
+/// The CLI flags `RenderSettings::apply` names, and the arguments of `Scene.render`.
+const RENAMES: &[(&str, &str)] = &[
+    ("--spp", "spp"),
+    ("--seed", "seed"),
+    ("--lanes", "lanes"),
+    ("--integrator", "integrator"),
+    ("--sampler", "sampler"),
+    ("--wavelengths", "wavelengths"),
+    ("--spectral-bins", "spectral_bins"),
+    ("--max-depth", "max_depth"),
+    ("--offset", "offset"),
+];
 
 /// How often the thread that called `render` wakes to let Python run its signal
 /// handlers (Ctrl-C): short enough to feel immediate, long enough to cost nothing.
@@ -166,80 +180,31 @@ impl Scene {
         offset: Option<&str>,
     ) -> PyResult<RenderResult> {
         guard(|| {
-            // The checks of cmd_render (src/main.rs) and of its flags' parsers, in the
-            // same order; the messages name the arguments instead of the flags.
+            // The settings' rules are the CLI's (RenderSettings::apply); the messages name
+            // the arguments instead of the flags.
             if threads < 0 || threads > u16::MAX as i64 {
                 return Err(err(format!(
                     "threads: expected 0 (one per core) or a number of threads, got {threads}"
                 )));
             }
-            let spp = match spp {
-                Some(s) if s < 1 => return Err(err("spp: expected at least 1")),
-                Some(s) => Some(
-                    u32::try_from(s)
-                        .map_err(|_| err(format!("spp: expected at most {}, got {s}", u32::MAX)))?,
-                ),
-                None => None,
-            };
-            let lanes = match lanes {
-                1 | 4 | 8 => lanes as usize,
-                n => return Err(err(format!("lanes: expected 1, 4 or 8, got {n}"))),
-            };
-            let wavelengths = match wavelengths {
-                "visible" => heron_core::spectrum::WavelengthSampler::Visible,
-                "uniform" => heron_core::spectrum::WavelengthSampler::Uniform,
-                other => {
-                    return Err(err(format!(
-                        "wavelengths: expected uniform or visible, got {other:?}"
-                    )))
-                }
-            };
-            if !(0..=470).contains(&spectral_bins) {
-                return Err(err(format!(
-                    "spectral_bins: expected 0 (none) or 1 to 470 bins, got {spectral_bins}"
-                )));
-            }
-            let max_depth = match max_depth {
-                Some(d) if d < 1 || d > u32::MAX as i64 => {
-                    return Err(err(format!("max_depth: expected at least 1, got {d}")))
-                }
-                Some(d) => Some(d as u32),
-                None => None,
-            };
-            // Settings that live in the scene are changed on a copy of it.
-            let scene = if max_depth.is_some() || offset.is_some() {
-                let mut s = (*self.inner).clone();
-                if let Some(d) = max_depth {
-                    s.settings.max_depth = d;
-                }
-                if let Some(o) = offset {
-                    s.settings.offset = heron_core::scene::OffsetMode::parse(o)
-                        .map_err(|e| err(format!("offset: {e}")))?;
-                }
-                Arc::new(s)
-            } else {
-                self.inner.clone()
-            };
-            let mut opts = RenderOptions::from_scene(&scene);
-            if let Some(i) = integrator {
-                opts.integrator = heron_core::integrator::IntegratorKind::parse(i)
-                    .map_err(|e| err(format!("integrator: {e}")))?;
-            }
-            if let Some(s) = sampler {
-                opts.sampler = heron_core::sampler::SamplerKind::parse(s)
-                    .map_err(|e| err(format!("sampler: {e}")))?;
-            }
-            if let Some(s) = spp {
-                opts.spp = s;
-            }
-            if let Some(s) = seed {
-                opts.seed = s;
-            }
+            let mut opts = RenderOptions::from_scene(&self.inner);
+            opts.settings
+                .apply(&SettingsArgs {
+                    spp,
+                    seed,
+                    lanes: Some(lanes),
+                    integrator,
+                    sampler,
+                    wavelengths: Some(wavelengths),
+                    spectral_bins: Some(spectral_bins),
+                    max_depth,
+                    offset,
+                    kernel: None,
+                    no_packets: false,
+                })
+                .map_err(|e| lib_err(e, RENAMES))?;
             opts.threads = threads as usize;
-            opts.lanes = lanes;
-            opts.packets = true;
-            opts.spectral_bins = spectral_bins as usize;
-            opts.wavelengths = wavelengths;
+            let scene = self.inner.clone();
             let (film, stats, opts) = render_interruptible(py, scene, opts)?;
             RenderResult::new(py, &film, &stats, &opts)
         })
@@ -396,11 +361,11 @@ impl RenderResult {
             nonfinite_samples: stats.nonfinite,
             wall_seconds: stats.wall.as_secs_f64(),
             mrays_per_s: stats.mrays_per_s(),
-            kernel: heron_core::scene::features::flag_names(stats.kernel),
-            integrator: opts.integrator.name().to_string(),
-            lanes: opts.lanes,
-            sampler: opts.sampler.name().to_string(),
-            seed: opts.seed,
+            kernel: heron_core::settings::flag_names(stats.kernel),
+            integrator: opts.settings.integrator.name().to_string(),
+            lanes: opts.settings.lanes,
+            sampler: opts.settings.sampler.name().to_string(),
+            seed: opts.settings.seed,
             width: film.width,
             height: film.height,
         })

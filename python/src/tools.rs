@@ -217,7 +217,7 @@ pub fn color<'py>(
             &numbers(values, "values")?,
         )?;
         // The same interpolation and check as a CSV file's (SpectrumCsv::parse).
-        heron_core::colorimetry::interpolate_column(Path::new("values"), "value", &samples)
+        heron_core::spectrum::csv::interpolate_column(Path::new("values"), "value", &samples)
             .map_err(|e| lib_err(e, &[]))?;
         let c = colour_of(&DenseSpectrum::from_table(&samples), observer, illuminant);
         let d = PyDict::new(py);

@@ -220,7 +220,7 @@ pub fn procedural_mesh(n: u32) -> Mesh {
 /// Writes a mesh as OBJ (positions and faces), through a temporary file.
 pub fn write_obj(mesh: &Mesh, path: &Path) -> Result<()> {
     use std::io::Write;
-    crate::film::write_atomically(path, |tmp| {
+    crate::files::write_atomically(path, |tmp| {
         let f = std::fs::File::create(tmp).map_err(|e| e.to_string())?;
         let mut w = std::io::BufWriter::new(f);
         let mut go = || -> std::io::Result<()> {

@@ -8,15 +8,9 @@
 //! not, so every lane is kept.
 use super::fresnel::fresnel_conductor;
 use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags};
-use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use crate::spectrum::metals::ComplexIor;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
-
-/// A spectral complex refractive index n(λ) + i k(λ), relative to the outside (n = 1).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ComplexIor {
-    pub n: DenseSpectrum,
-    pub k: DenseSpectrum,
-}
 
 impl ComplexIor {
     /// R(cos θ) per lane.

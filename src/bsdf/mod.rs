@@ -32,7 +32,7 @@ pub mod phong;
 pub mod rough_conductor;
 pub mod rough_dielectric;
 
-pub use conductor::{ComplexIor, Conductor};
+pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use lambertian::Lambertian;
 pub use mirror::Mirror;
@@ -339,7 +339,7 @@ impl Material {
     }
 
     /// The smooth refractive interface of this material, if it has one (a dielectric, or
-    /// the seed's glossy-over-refractive base): for the HitInfo's ior1_over_ior2 and for
+    /// the seed's glossy-over-refractive base): for [`Material::ior1_over_ior2`] and for
     /// `heron trace`'s report.
     #[inline]
     pub fn interface(&self) -> Option<&Dielectric> {
@@ -350,11 +350,12 @@ impl Material {
         }
     }
 
-    /// The seed's HitInfo fields for a hit on this material at `lambda` nm:
-    /// (ior1_over_ior2, specular ρs, shininess s).
+    /// The seed's HitInfo `ior1_over_ior2` for a hit on this material at `lambda` nm:
+    /// n_i/n_t of a ray crossing it from the side `front_face` says (1 for a material
+    /// that refracts nothing).
     #[inline]
-    pub fn hit_info(&self, lambda: f32, front_face: bool) -> (f32, f32, f32) {
-        let ratio = match self {
+    pub fn ior1_over_ior2(&self, lambda: f32, front_face: bool) -> f32 {
+        match self {
             Material::Dielectric(d) => d.ior1_over_ior2(lambda, front_face),
             Material::RoughDielectric(d) => d.interface.ior1_over_ior2(lambda, front_face),
             Material::Glossy(g) => g
@@ -362,10 +363,6 @@ impl Material {
                 .as_ref()
                 .map_or(1.0, |b| b.ior1_over_ior2(lambda, front_face)),
             _ => 1.0,
-        };
-        match self {
-            Material::Glossy(g) => (ratio, g.rho_s, g.shininess),
-            _ => (ratio, 0.0, 0.0),
         }
     }
 }

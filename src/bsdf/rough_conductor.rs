@@ -6,9 +6,9 @@
 //! with the conductor Fresnel term per lane and directions sampled from the visible
 //! normals (Heitz 2018): pdf = D_ωo(ωm)/(4 |ωo·ωm|). Single scattering only, so energy
 //! is lost at high roughness (tests/bsdf.rs states how much).
-use super::conductor::ComplexIor;
 use super::microfacet::TrowbridgeReitz;
 use super::{reflect, same_hemisphere, BsdfContext, BsdfSample, LobeFlags};
+use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 

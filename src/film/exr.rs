@@ -5,7 +5,8 @@
 //! 10(3)): one emissive channel `S0.<λ>nm` per bin (λ the bin centre, written with a
 //! decimal comma as the paper specifies), the `spectralLayoutVersion` attribute "1.0"
 //! and `emissiveUnits` "W.m^-2.sr^-1".
-use super::{Film, Staged};
+use super::Film;
+use crate::files::Staged;
 use crate::provenance::{Provenance, PREFIX};
 use crate::spectrum::color::SRGB_CHROMATICITIES;
 use exr::prelude::*;

@@ -11,8 +11,6 @@ pub mod png;
 use crate::spectrum::cie::cie1931;
 use crate::spectrum::color::xyz_to_linear_srgb;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
-use std::io;
-use std::path::{Path, PathBuf};
 
 /// Weights that turn one sample's lanes into XYZ: x̄(λ)/(N p(λ) Σȳ) for each lane.
 #[inline]
@@ -165,76 +163,4 @@ impl Film {
     pub fn linear_srgb(&self) -> Vec<[f32; 3]> {
         self.xyz.iter().map(|&c| xyz_to_linear_srgb(c)).collect()
     }
-}
-
-/// An output written to a temporary file in its target's folder, waiting to be renamed
-/// into place by [`Staged::commit`]. Dropped without commit, the temporary file is
-/// removed, so a failed run never leaves a partial or stray file.
-pub struct Staged {
-    tmp: PathBuf,
-    path: PathBuf,
-    committed: bool,
-}
-
-impl Staged {
-    /// Runs `write` on a temporary path next to `path`.
-    pub fn write(
-        path: &Path,
-        write: impl FnOnce(&Path) -> Result<(), String>,
-    ) -> crate::Result<Staged> {
-        let err = |message: String| crate::HeronError::Io {
-            path: path.to_path_buf(),
-            message,
-        };
-        let name = path
-            .file_name()
-            .ok_or_else(|| err("not a file path".into()))?;
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        if !dir.is_dir() {
-            return Err(err(format!(
-                "output folder {} does not exist",
-                dir.display()
-            )));
-        }
-        let staged = Staged {
-            tmp: dir.join(format!(
-                ".{}.{}.tmp",
-                name.to_string_lossy(),
-                std::process::id()
-            )),
-            path: path.to_path_buf(),
-            committed: false,
-        };
-        write(&staged.tmp).map_err(err)?;
-        Ok(staged)
-    }
-
-    /// Renames the temporary file into place.
-    pub fn commit(mut self) -> crate::Result<()> {
-        std::fs::rename(&self.tmp, &self.path).map_err(|e: io::Error| crate::HeronError::Io {
-            path: self.path.clone(),
-            message: format!("cannot rename into place: {e}"),
-        })?;
-        self.committed = true;
-        Ok(())
-    }
-}
-
-impl Drop for Staged {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
-}
-
-/// Writes one file through a temporary file and a rename.
-pub(crate) fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> crate::Result<()> {
-    Staged::write(path, write)?.commit()
 }

@@ -1,6 +1,7 @@
 //! PNG preview: linear sRGB clamped to [0, 1] and encoded with the sRGB transfer
 //! function, 8 bits per channel. For looking at, not for measuring: use the EXR.
-use super::{Film, Staged};
+use super::Film;
+use crate::files::Staged;
 use crate::spectrum::color::srgb_encode;
 use std::path::Path;
 

@@ -1,17 +1,20 @@
-//! The surface interaction: the seed's HitInfo, with the fields the lecture adds for
-//! specular and glossy shading (shader index, ior1_over_ior2, specular, shininess) and
-//! the path depth, plus the geometry the materials' local frame is built from.
+//! The surface interaction: the seed's HitInfo as far as anyone reads it (distance,
+//! position, normal, shader index), plus the geometry the materials' local frame and the
+//! robust ray offsets are built from.
+//!
+//! The seed's other HitInfo fields live where they are used: `has_hit` is the integrator
+//! loop's `Option<Hit>`, `depth` its loop counter, `ior1_over_ior2` the dielectric's
+//! (`Dielectric::ior1_over_ior2`, and `Material::ior1_over_ior2` for `heron trace` and
+//! `heron stress`), `specular` and `shininess` the Phong material's `rho_s` and
+//! `shininess`.
 use super::spawn::{self, SpawnPoint};
 use super::{Ray, Shape, ShapeKind};
 use crate::accel::embree::Hit;
-use crate::bsdf::Material;
 use crate::math::Frame;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Interaction {
-    /// The lecture's has_hit: cleared by a shader that continues the path.
-    pub has_hit: bool,
     /// Distance along the ray.
     pub dist: f32,
     pub position: Vec3,
@@ -29,35 +32,17 @@ pub struct Interaction {
     pub material: u32,
     /// The shape hit (its Embree geometry ID).
     pub shape: u32,
-    /// Relative index n_i/n_t for a ray crossing here (1 for non-refractive materials).
-    pub ior1_over_ior2: f32,
-    /// Specular reflectance ρs (glossy materials; 0 otherwise).
-    pub specular: f32,
-    /// Phong exponent s (glossy materials; 0 otherwise).
-    pub shininess: f32,
-    /// Number of times the path has been continued before reaching this hit.
-    pub depth: u32,
 }
 
 impl Interaction {
-    /// Fills the record for `hit` of `ray` on `shape`, whose material is `material`;
-    /// `lambda` (nm) is the wavelength the path follows (the hero), at which the index
-    /// ratio is evaluated. With `robust` (robust ray offsets) the position comes with its
+    /// Fills the record for `hit` of `ray` on `shape`. With `robust` (robust ray offsets) the position comes with its
     /// error bound; without, the bound is left zero and its cost (the triangle's
     /// vertices and the bound's arithmetic, 3% of a Whitted render's instructions by
     /// callgrind) is not paid.
     // Always inlined: left to itself LLVM outlines it since it grew the robust branch,
     // and the call with its copied-out record cost 3% of a Whitted render (callgrind).
     #[inline(always)]
-    pub fn new(
-        ray: &Ray,
-        hit: &Hit,
-        shape: &Shape,
-        material: &Material,
-        depth: u32,
-        lambda: f32,
-        robust: bool,
-    ) -> Self {
+    pub fn new(ray: &Ray, hit: &Hit, shape: &Shape, robust: bool) -> Self {
         let (position, p_err, outward) = match &shape.kind {
             ShapeKind::Sphere { center, radius } => {
                 // Re-project onto the sphere: the float hit point drifts off the surface
@@ -84,9 +69,7 @@ impl Interaction {
         };
         let front_face = outward.dot(ray.dir) < 0.0;
         let normal = if front_face { outward } else { -outward };
-        let (ior1_over_ior2, specular, shininess) = material.hit_info(lambda, front_face);
         Interaction {
-            has_hit: true,
             dist: hit.t,
             position,
             p_err,
@@ -95,10 +78,6 @@ impl Interaction {
             front_face,
             material: shape.material,
             shape: hit.geom_id,
-            ior1_over_ior2,
-            specular,
-            shininess,
-            depth,
         }
     }
 

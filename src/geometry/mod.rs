@@ -6,9 +6,10 @@ pub mod spawn;
 
 pub use interaction::Interaction;
 pub use ray::Ray;
-pub use spawn::{RayOffset, SpawnPoint};
+pub use spawn::{RayOffset, SpawnPoint, MIN_RELATIVE_RADIUS};
 
 use glam::Vec3;
+use std::collections::HashMap;
 
 /// A triangle mesh in world space. Planes, quads and single triangles from scene files
 /// become meshes too, so Embree sees one triangle type.
@@ -43,4 +44,25 @@ pub struct Shape {
     pub kind: ShapeKind,
     /// Index into `Scene::materials`.
     pub material: u32,
+}
+
+impl Shape {
+    /// Whether the shape encloses a volume: a sphere, or a mesh whose every edge is
+    /// shared by exactly two triangles. A medium needs one around it, and `heron stress`
+    /// counts a ray that escapes after leaving into one as a leak.
+    pub fn is_closed(&self) -> bool {
+        match &self.kind {
+            ShapeKind::Sphere { .. } => true,
+            ShapeKind::Mesh(m) => {
+                let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+                for t in &m.indices {
+                    for k in 0..3 {
+                        let (a, b) = (t[k], t[(k + 1) % 3]);
+                        *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+                    }
+                }
+                !edges.is_empty() && edges.values().all(|&c| c == 2)
+            }
+        }
+    }
 }

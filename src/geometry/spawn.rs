@@ -17,6 +17,7 @@
 //!   renders the same. The default of the physically based integrators.
 use super::Ray;
 use crate::accel::embree::RayQuery;
+use crate::settings::{IntegratorKind, RenderSettings};
 use glam::Vec3;
 
 /// How rays leave surfaces in a render (see the module notes).
@@ -27,6 +28,25 @@ pub enum RayOffset {
     /// Offsets by the hit point's floating-point error bound.
     Robust,
 }
+
+impl RenderSettings {
+    /// The ray offsets of a render by `integrator`: `offset`, with `auto` resolved by
+    /// the integrator.
+    #[inline]
+    pub fn ray_offset(&self, integrator: IntegratorKind) -> RayOffset {
+        if self.offset.is_epsilon(integrator) {
+            RayOffset::Epsilon(self.epsilon)
+        } else {
+            RayOffset::Robust
+        }
+    }
+}
+
+/// The smallest sphere radius a scene may have, relative to its centre's largest
+/// coordinate: below it the sphere spans a handful of f32 steps at its centre, less than
+/// the error bound of its hit points ([`sphere_point`]), and rays pass through it
+/// (`heron stress` finds leaks from 2e-7 down).
+pub const MIN_RELATIVE_RADIUS: f32 = 1e-6;
 
 /// pbrt-v4's `ShadowEpsilon`: a robust shadow ray stops this fraction short of its
 /// (already offset) target, for the rounding of the ray's own arithmetic.
@@ -305,7 +325,7 @@ mod tests {
             assert!(side(sp.offset_toward(-n)) < 0.0, "triangle {a} {b} {c}");
 
             let center = shift;
-            if scale < crate::scene::load::MIN_RELATIVE_RADIUS * center.abs().max_element() {
+            if scale < MIN_RELATIVE_RADIUS * center.abs().max_element() {
                 // Below float precision where it is: the loader refuses such a sphere.
                 continue;
             }

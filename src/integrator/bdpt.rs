@@ -340,13 +340,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
                 }
                 break;
             };
-            let (it, material) = scene.interaction(
-                &ray,
-                &hit,
-                bounces as u32,
-                self.wl.lambda[0],
-                self.ctx.offset.is_robust(),
-            );
+            let (it, material) = scene.interaction(&ray, &hit, self.ctx.offset.is_robust());
             let mut v = Vertex::EMPTY;
             v.kind = Kind::Surface;
             v.beta = beta;
@@ -767,8 +761,7 @@ pub fn radiance<const N: usize>(
     counters: &mut TraceCounters,
     splats: &mut Splats,
 ) -> SampledSpectrum<N> {
-    let scene = ctx.scene;
-    let max_depth = (scene.settings.max_depth as usize).min(MAX_VERTICES - 2);
+    let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
     let b = Bdpt { ctx, wl };
     let mut light = [Vertex::<N>::EMPTY; MAX_VERTICES];
     let mut camera = [Vertex::<N>::EMPTY; MAX_VERTICES];

@@ -46,7 +46,7 @@ pub fn radiance<const N: usize>(
 ) -> SampledSpectrum<N> {
     let scene = ctx.scene;
     let cam = &scene.camera;
-    let settings = &scene.settings;
+    let settings = ctx.settings;
     let u_light = sampler.get_1d();
     let u_pos = sampler.get_2d();
     let u_dir = sampler.get_2d();
@@ -92,8 +92,7 @@ pub fn radiance<const N: usize>(
         let Some(hit) = ctx.accel.intersect1(&query(&ray)) else {
             break;
         };
-        let (it, material) =
-            scene.interaction(&ray, &hit, depth, wl.lambda[0], ctx.offset.is_robust());
+        let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
         // The path has scattered `depth` times before this vertex; scattering here
         // toward the camera is one more.
         if depth == settings.max_depth {

@@ -20,67 +20,18 @@ use crate::accel::embree::{self, Hit, RayQuery};
 use crate::film::Splats;
 use crate::geometry::{Ray, RayOffset, SpawnPoint};
 use crate::sampler::Sampler;
-use crate::scene::features::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::scene::Scene;
+use crate::settings::{IntegratorKind, RenderSettings};
+use crate::settings::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
-/// The integrators a scene or the CLI can choose.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum IntegratorKind {
-    /// The seed's Whitted tracer: shadow rays to the lights at diffuse and glossy
-    /// surfaces, specular continuation; the default for the course's scenes.
-    #[default]
-    Whitted,
-    /// Unidirectional path tracing with next-event estimation and MIS.
-    Path,
-    /// Paths from the lights, every diffuse or glossy vertex connected to the camera.
-    LightTrace,
-    /// Bidirectional path tracing, every strategy, power-heuristic MIS.
-    Bdpt,
-}
-
-impl IntegratorKind {
-    pub const NAMES: &'static [&'static str] = &["whitted", "path", "lighttrace", "bdpt"];
-
-    /// Whether the integrator adds to other pixels than the one it samples.
-    pub fn splats(self) -> bool {
-        matches!(self, IntegratorKind::LightTrace | IntegratorKind::Bdpt)
-    }
-
-    /// Whether it starts from the camera ray of the pixel sample (light tracing does
-    /// not, so the renderer traces no camera packets for it).
-    pub fn uses_camera_rays(self) -> bool {
-        !matches!(self, IntegratorKind::LightTrace)
-    }
-
-    pub fn parse(name: &str) -> Result<IntegratorKind, String> {
-        match name {
-            "whitted" => Ok(IntegratorKind::Whitted),
-            "path" => Ok(IntegratorKind::Path),
-            "lighttrace" => Ok(IntegratorKind::LightTrace),
-            "bdpt" => Ok(IntegratorKind::Bdpt),
-            other => Err(format!(
-                "expected one of {}, got {other:?}",
-                Self::NAMES.join(", ")
-            )),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            IntegratorKind::Whitted => "whitted",
-            IntegratorKind::Path => "path",
-            IntegratorKind::LightTrace => "lighttrace",
-            IntegratorKind::Bdpt => "bdpt",
-        }
-    }
-}
-
-/// What an integrator needs to trace: the scene and its committed Embree scene.
+/// What an integrator needs to trace: the scene, its committed Embree scene and the
+/// render's settings (the scene's, with flags applied).
 #[derive(Clone, Copy)]
 pub struct Context<'a> {
     pub scene: &'a Scene,
     pub accel: &'a embree::Scene,
+    pub settings: &'a RenderSettings,
     /// How rays leave surfaces in this render.
     pub offset: RayOffset,
 }

@@ -48,8 +48,8 @@ use crate::light::{Light, SurfacePoint};
 use crate::math::warp::power_heuristic;
 use crate::medium::NO_MEDIUM;
 use crate::sampler::Sampler;
-use crate::scene::features::{on, KernelFlags, EMITTERS, ESCAPE, MEDIA, SHADOWS};
 use crate::scene::NO_LIGHT;
+use crate::settings::{on, KernelFlags, EMITTERS, ESCAPE, MEDIA, SHADOWS};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Radiance arriving along the camera ray `ray` at the wavelengths `wl`.
@@ -67,7 +67,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
     let scene = ctx.scene;
-    let settings = &scene.settings;
+    let settings = ctx.settings;
     let mut l = SampledSpectrum::<N>::zero();
     let mut beta = SampledSpectrum::<N>::splat(1.0);
     let mut bsdf_ctx = BsdfContext::radiance::<N>();
@@ -202,8 +202,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
             if let Some(h) = &hit {
                 if scene.shape_interface[h.geom_id as usize] {
                     // An index-matched boundary: cross it, switching media, no bounce.
-                    let (it, _) =
-                        scene.interaction(&ray, h, depth, wl.lambda[0], ctx.offset.is_robust());
+                    let (it, _) = scene.interaction(&ray, h, ctx.offset.is_robust());
                     medium = if ray.dir.dot(it.n_outward) < 0.0 {
                         scene.shape_medium[h.geom_id as usize]
                     } else {
@@ -249,8 +248,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
             }
             break;
         };
-        let (it, material) =
-            scene.interaction(&ray, &hit, depth, wl.lambda[0], ctx.offset.is_robust());
+        let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
         let wo = -ray.dir;
 
         // Emission of an area light the path has reached.
@@ -472,7 +470,7 @@ pub(crate) fn transmittance<const N: usize>(
             tr *= scene.media[medium as usize].transmittance(h.t * scale, wl);
         }
         let ray = crate::geometry::Ray::new(q.origin, q.dir, q.tnear, q.tfar);
-        let (it, _) = scene.interaction(&ray, &h, 0, wl.lambda[0], ctx.offset.is_robust());
+        let (it, _) = scene.interaction(&ray, &h, ctx.offset.is_robust());
         medium = if wi.dot(it.n_outward) < 0.0 {
             scene.shape_medium[g]
         } else {

@@ -20,8 +20,8 @@ use crate::bsdf::{BsdfContext, LobeFlags};
 use crate::geometry::{Interaction, Ray};
 use crate::light::Light;
 use crate::sampler::Sampler;
-use crate::scene::features::{on, KernelFlags, EMITTERS, ESCAPE, SHADOWS, SPECULAR};
 use crate::scene::NO_LIGHT;
+use crate::settings::{on, KernelFlags, EMITTERS, ESCAPE, SHADOWS, SPECULAR};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -67,8 +67,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
             }
             break;
         };
-        let (mut it, material) =
-            scene.interaction(&ray, &hit, depth, wl.lambda[0], ctx.offset.is_robust());
+        let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
         let wo = -ray.dir;
         if on(K, EMITTERS) {
             let emitter = scene.shape_light[hit.geom_id as usize];
@@ -102,10 +101,10 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         if bs.ended_companions {
             bsdf_ctx.companions_alive = false;
         }
-        // The lecture's continuation: overwrite the ray, clear has_hit, increment depth.
-        it.has_hit = false;
+        // The lecture's continuation: overwrite the ray, clear has_hit (the next
+        // iteration's `pending` is None), increment depth.
         depth += 1;
-        if depth > scene.settings.max_depth {
+        if depth > ctx.settings.max_depth {
             break;
         }
         ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));

@@ -12,7 +12,7 @@
 use super::{LightLeSample, LightLiSample, SceneBounds};
 use crate::math::warp::{uniform_sphere, UNIFORM_SPHERE_PDF};
 use crate::math::Frame;
-use crate::scene::SceneSky;
+use crate::sky::SceneSky;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;

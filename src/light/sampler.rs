@@ -4,13 +4,7 @@
 //! with Φ = 0 emits nothing at any wavelength, so the power sampler never picks it.
 use super::{Light, SceneBounds};
 use crate::math::Distribution1D;
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LightSamplerKind {
-    #[default]
-    Power,
-    Uniform,
-}
+use crate::settings::LightSamplerKind;
 
 #[derive(Clone, Debug)]
 pub enum LightSampler {

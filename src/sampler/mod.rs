@@ -16,33 +16,7 @@ pub mod sobol;
 pub use independent::IndependentSampler;
 pub use sobol::SobolSampler;
 
-/// Which sampler a render uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum SamplerKind {
-    /// Independent uniform numbers per (seed, pixel, sample).
-    Independent,
-    /// Owen-scrambled Sobol' points along a Morton curve.
-    #[default]
-    Sobol,
-}
-
-impl SamplerKind {
-    pub fn parse(name: &str) -> Result<SamplerKind, String> {
-        match name {
-            "independent" => Ok(SamplerKind::Independent),
-            "sobol" => Ok(SamplerKind::Sobol),
-            other => Err(format!("expected sobol or independent, got {other:?}")),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            SamplerKind::Independent => "independent",
-            SamplerKind::Sobol => "sobol",
-        }
-    }
-}
-
+use crate::settings::SamplerKind;
 use glam::Vec2;
 
 // The Sobol' sampler carries its per-pixel cache inline (about 0.5 kB). Samplers are made

@@ -16,8 +16,11 @@
 //! need what it lacks (`scripts/bench_kernels.py`).
 use super::{Scene, NO_LIGHT};
 use crate::bsdf::Material;
-use crate::integrator::IntegratorKind;
 use crate::light::Light;
+use crate::settings::{
+    flag_names, IntegratorKind, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS,
+    SPECULAR, STRIPPED,
+};
 
 /// The parts of the transport a scene uses. Each field is conservative: when it is true
 /// the part may be needed; when it is false the renderer can skip it without changing
@@ -54,92 +57,11 @@ pub struct Features {
     pub media: bool,
 }
 
-/// A set of [`Features`] a kernel is compiled for, as bits (a `const` generic).
-pub type KernelFlags = u32;
-
-/// Shadow rays / next-event estimation at diffuse and glossy hits.
-pub const SHADOWS: KernelFlags = 1 << 0;
-/// Specular continuation in the Whitted tracer.
-pub const SPECULAR: KernelFlags = 1 << 1;
-/// Emission of area lights found at hits.
-pub const EMITTERS: KernelFlags = 1 << 2;
-/// Radiance of the lights at infinity along escaping rays.
-pub const ESCAPE: KernelFlags = 1 << 3;
-/// Participating media (path tracer only).
-pub const MEDIA: KernelFlags = 1 << 4;
-/// The general kernel: every flag on.
-pub const ALL: KernelFlags = SHADOWS | SPECULAR | EMITTERS | ESCAPE | MEDIA;
-
-/// The flags this build was made without (`HERON_STRIP`, see the module docs).
-pub const STRIPPED: KernelFlags = (if cfg!(heron_strip_shadows) {
-    SHADOWS
-} else {
-    0
-}) | (if cfg!(heron_strip_specular) {
-    SPECULAR
-} else {
-    0
-}) | (if cfg!(heron_strip_emitters) {
-    EMITTERS
-} else {
-    0
-}) | (if cfg!(heron_strip_escape) { ESCAPE } else { 0 });
-
 /// The flags of `k` this build was made without (usually none, hence a function:
 /// clippy rejects a mask that is a constant zero).
 #[inline]
 fn stripped_of(k: KernelFlags) -> KernelFlags {
     k & STRIPPED
-}
-
-/// Whether kernel `k` has `flag`'s code. With `k` a const generic this folds to a
-/// constant, so a kernel without the flag has no trace of the code behind it.
-#[inline(always)]
-pub const fn on(k: KernelFlags, flag: KernelFlags) -> bool {
-    k & flag & !STRIPPED != 0
-}
-
-/// The flags' names joined by '+' ("none" for none), for messages and the render summary.
-pub fn flag_names(k: KernelFlags) -> String {
-    let names: Vec<&str> = [
-        (SHADOWS, "shadows"),
-        (SPECULAR, "specular"),
-        (EMITTERS, "emitters"),
-        (ESCAPE, "escape"),
-        (MEDIA, "media"),
-    ]
-    .iter()
-    .filter(|(f, _)| k & f != 0)
-    .map(|&(_, n)| n)
-    .collect();
-    if names.is_empty() {
-        "none".into()
-    } else {
-        names.join("+")
-    }
-}
-
-/// Which kernel a render runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum KernelChoice {
-    /// The kernel specialised to the scene's features.
-    #[default]
-    Auto,
-    /// The kernel with every feature compiled in.
-    General,
-    /// Exactly these flags, whatever the scene needs (not offered by the CLI): for tests
-    /// that show a missing flag changes the image, and for benchmarks.
-    Forced(KernelFlags),
-}
-
-impl KernelChoice {
-    pub fn parse(name: &str) -> Result<KernelChoice, String> {
-        match name {
-            "auto" => Ok(KernelChoice::Auto),
-            "general" => Ok(KernelChoice::General),
-            other => Err(format!("expected auto or general, got {other:?}")),
-        }
-    }
 }
 
 impl Features {

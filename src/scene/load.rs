@@ -25,26 +25,24 @@ use super::file::{
     PlaneFile, PointLightFile, QuadFile, SceneFile, ShapeFile, SphereFile, SpotLightFile,
     SunLightFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
 };
-use super::{RenderSettings, Scene};
+use super::Scene;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    ComplexIor, Conductor, Dielectric, Glossy, Lambertian, Material, Mirror, RoughConductor,
-    RoughDielectric,
+    Conductor, Dielectric, Glossy, Lambertian, Material, Mirror, RoughConductor, RoughDielectric,
 };
 use crate::camera::Camera;
 use crate::error::{HeronError, Result};
-use crate::geometry::{Mesh, Shape, ShapeKind};
+use crate::geometry::{Mesh, Shape, ShapeKind, MIN_RELATIVE_RADIUS};
 use crate::light::{DirectionalLight, Light, PointLight, SpotLight, SunLight};
+use crate::settings::{IntegratorKind, LightSamplerKind, OffsetMode, RenderSettings};
 use crate::spectrum::ior::Ior;
+use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
 use serde::de::DeserializeOwned;
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// The smallest sphere radius accepted, relative to the centre's largest coordinate.
-pub const MIN_RELATIVE_RADIUS: f32 = 1e-6;
 
 /// Reads, parses and validates the scene file at `path` (meshes are resolved relative to
 /// it). Every error names the file, the key path and what was expected.
@@ -59,7 +57,7 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 pub fn load_scene_from_str(text: &str, path: &Path) -> Result<Scene> {
     let file = parse_scene_file(text).map_err(|m| scene_error(path, m))?;
     let mut scene = build(path, file, SkyTables::Build)?;
-    scene.source_sha256 = crate::provenance::sha256_hex(text.as_bytes());
+    scene.source_sha256 = crate::files::sha256_hex(text.as_bytes());
     Ok(scene)
 }
 
@@ -646,7 +644,7 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
                 "{at}.medium: expected a mesh of one material around the medium, got a mesh whose groups use several"
             )));
         }
-        if !crate::stress::closed(shape) {
+        if !shape.is_closed() {
             return Err(err(format!(
                 "{at}.medium: expected a closed shape (a sphere, or a mesh whose every edge is shared by two triangles) around the medium, got an open {}",
                 match entry {
@@ -842,20 +840,20 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
             settings.seed = x;
         }
         if let Some(name) = &r.integrator {
-            settings.integrator = crate::integrator::IntegratorKind::parse(name)
-                .map_err(|e| err(format!("render.integrator: {e}")))?;
+            settings.integrator =
+                IntegratorKind::parse(name).map_err(|e| err(format!("render.integrator: {e}")))?;
         }
         if let Some(x) = r.rr_depth {
             settings.rr_depth = x;
         }
         if let Some(name) = &r.offset {
             settings.offset =
-                super::OffsetMode::parse(name).map_err(|e| err(format!("render.offset: {e}")))?;
+                OffsetMode::parse(name).map_err(|e| err(format!("render.offset: {e}")))?;
         }
         if let Some(name) = &r.light_sampler {
             settings.light_sampler = match name.as_str() {
-                "power" => crate::light::sampler::LightSamplerKind::Power,
-                "uniform" => crate::light::sampler::LightSamplerKind::Uniform,
+                "power" => LightSamplerKind::Power,
+                "uniform" => LightSamplerKind::Uniform,
                 other => {
                     return Err(err(format!(
                         "render.light_sampler: expected power or uniform, got {other:?}"
@@ -903,7 +901,7 @@ pub(crate) fn build(path: &Path, file: SceneFile, sky_tables: SkyTables) -> Resu
     )
     .map_err(|e| err(format!("camera: {e}")))?;
 
-    let inputs = crate::provenance::hash_inputs(&base_dir, inputs).map_err(err)?;
+    let inputs = crate::files::hash_inputs(&base_dir, inputs).map_err(err)?;
     let mut scene = Scene::from_parts(super::SceneParts {
         source: path.to_path_buf(),
         camera,
@@ -1006,7 +1004,7 @@ fn build_ior(
         IorSpec::Table(file) => {
             let p = base_dir.join(file);
             let csv =
-                crate::colorimetry::SpectrumCsv::read(&p).map_err(|e| format!("{at}: {e}"))?;
+                crate::spectrum::csv::SpectrumCsv::read(&p).map_err(|e| format!("{at}: {e}"))?;
             inputs.push(file.clone());
             Ior::Table(csv.to_dense())
         }
@@ -1141,8 +1139,8 @@ struct SkyPlan {
 
 impl SkyPlan {
     /// Tabulates the model over (θ, λ) for rendering.
-    fn tabulate(self) -> super::SceneSky {
-        super::SceneSky {
+    fn tabulate(self) -> crate::sky::SceneSky {
+        crate::sky::SceneSky {
             table: crate::sky::table::SkyTable::build(&self.sky),
             model: self.model,
             sun_dir: self.sun_dir,

@@ -11,90 +11,12 @@ pub use load::load_scene;
 use crate::accel::embree::Hit;
 use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::geometry::{Interaction, Ray, RayOffset, Shape};
-use crate::integrator::IntegratorKind;
-use crate::light::sampler::LightSamplerKind;
+use crate::geometry::{Interaction, Ray, Shape};
 use crate::light::{Light, LightSampler, SceneBounds};
+use crate::settings::RenderSettings;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 use std::path::PathBuf;
-
-/// Render settings a scene file may give; the CLI may override spp and seed.
-#[derive(Clone, Debug)]
-pub struct RenderSettings {
-    pub spp: u32,
-    /// Maximum path depth (the lecture's `depth` limit on continued rays).
-    pub max_depth: u32,
-    /// Ray offset ε for rays leaving surfaces (seed: 1e-4), where offsets are ε.
-    pub epsilon: f32,
-    pub seed: u64,
-    /// The scene's integrator (the CLI may override it).
-    pub integrator: IntegratorKind,
-    /// Path depth from which Russian roulette may end a path (path integrator).
-    pub rr_depth: u32,
-    pub light_sampler: LightSamplerKind,
-    /// How rays leave surfaces ([`OffsetMode`]).
-    pub offset: OffsetMode,
-}
-
-/// The `offset` setting: which [`RayOffset`] a render uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum OffsetMode {
-    /// The seed's ε for the `whitted` integrator, robust offsets for the physically
-    /// based ones.
-    #[default]
-    Auto,
-    Epsilon,
-    Robust,
-}
-
-impl OffsetMode {
-    pub const NAMES: &'static [&'static str] = &["auto", "epsilon", "robust"];
-
-    pub fn parse(name: &str) -> Result<OffsetMode, String> {
-        match name {
-            "auto" => Ok(OffsetMode::Auto),
-            "epsilon" => Ok(OffsetMode::Epsilon),
-            "robust" => Ok(OffsetMode::Robust),
-            other => {
-                let (last, rest) = Self::NAMES.split_last().unwrap();
-                Err(format!(
-                    "expected {} or {last}, got {other:?}",
-                    rest.join(", ")
-                ))
-            }
-        }
-    }
-}
-
-impl RenderSettings {
-    /// The ray offsets of a render by `integrator`: `offset`, with `auto` resolved by
-    /// the integrator.
-    #[inline]
-    pub fn ray_offset(&self, integrator: IntegratorKind) -> RayOffset {
-        match (self.offset, integrator) {
-            (OffsetMode::Epsilon, _) | (OffsetMode::Auto, IntegratorKind::Whitted) => {
-                RayOffset::Epsilon(self.epsilon)
-            }
-            _ => RayOffset::Robust,
-        }
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            spp: 16,
-            max_depth: 10,
-            epsilon: 1e-4,
-            seed: 0,
-            integrator: IntegratorKind::Whitted,
-            rr_depth: 5,
-            light_sampler: LightSamplerKind::Power,
-            offset: OffsetMode::Auto,
-        }
-    }
-}
 
 /// `Scene::shape_light` for a shape that does not emit.
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -124,7 +46,7 @@ pub struct Scene {
     /// Radiance seen along rays that leave the scene.
     pub background: DenseSpectrum,
     /// A rainbow sky, when the scene has one.
-    pub sky: Option<std::sync::Arc<SceneSky>>,
+    pub sky: Option<std::sync::Arc<crate::sky::SceneSky>>,
     pub settings: RenderSettings,
     /// The bounding sphere of the shapes.
     pub bounds: SceneBounds,
@@ -152,7 +74,7 @@ pub struct SceneParts {
     /// For each shape, its area light in `lights` or [`NO_LIGHT`]; empty: none emits.
     pub shape_light: Vec<u32>,
     pub background: DenseSpectrum,
-    pub sky: Option<std::sync::Arc<SceneSky>>,
+    pub sky: Option<std::sync::Arc<crate::sky::SceneSky>>,
     pub settings: RenderSettings,
 }
 
@@ -210,22 +132,14 @@ impl Scene {
         }
     }
 
-    /// The interaction record of `hit` (of `ray`) and the material there; `lambda` is
-    /// the path's hero wavelength, `robust` whether the render's offsets need the hit
-    /// point's error bound ([`Interaction::new`]).
+    /// The interaction record of `hit` (of `ray`) and the material there; `robust`
+    /// whether the render's offsets need the hit point's error bound
+    /// ([`Interaction::new`]).
     #[inline(always)]
-    pub fn interaction(
-        &self,
-        ray: &Ray,
-        hit: &Hit,
-        depth: u32,
-        lambda: f32,
-        robust: bool,
-    ) -> (Interaction, &Material) {
+    pub fn interaction(&self, ray: &Ray, hit: &Hit, robust: bool) -> (Interaction, &Material) {
         let shape = &self.shapes[hit.geom_id as usize];
         let material = &self.materials[shape.material as usize];
-        let it = Interaction::new(ray, hit, shape, material, depth, lambda, robust);
-        (it, material)
+        (Interaction::new(ray, hit, shape, robust), material)
     }
 
     /// Radiance arriving along a ray that leaves the scene in direction `dir`: the
@@ -242,27 +156,4 @@ impl Scene {
         }
         l
     }
-
-    /// Rebuilds the light sampler (after the lights or the kind changed).
-    pub fn rebuild_light_sampler(&mut self) {
-        self.light_sampler =
-            LightSampler::new(self.settings.light_sampler, &self.lights, &self.bounds);
-    }
-}
-
-/// A sky model ready for rendering: tabulated over (θ, λ), tied to the scene's sun.
-#[derive(Debug)]
-pub struct SceneSky {
-    /// The model's name, for messages.
-    pub model: String,
-    pub table: crate::sky::table::SkyTable,
-    /// Unit direction toward the sun.
-    pub sun_dir: glam::Vec3,
-    /// Per-wavelength factor on the table: the sun's irradiance times `scale` for the
-    /// physical models (their profile is radiance per unit solar irradiance), `scale`
-    /// alone for the Aristotelian and constant skies.
-    pub factor: DenseSpectrum,
-    /// True when the model already contains the background (aristotle, constant), so it
-    /// replaces it rather than adding to it.
-    pub replaces_background: bool,
 }

@@ -227,7 +227,7 @@ pub fn lee_csv(req: &LeeRequest) -> Result<String> {
 /// Writes the CSV to `path` through a temporary file renamed into place (no half-written
 /// file on error).
 pub fn write_csv(path: &std::path::Path, csv: &str) -> Result<()> {
-    crate::film::write_atomically(path, |tmp| {
+    crate::files::write_atomically(path, |tmp| {
         std::fs::write(tmp, csv).map_err(|e| format!("{}: {e}", path.display()))
     })
 }

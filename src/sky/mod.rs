@@ -50,6 +50,7 @@ pub use aristotle::AristotleSky;
 pub use constant::ConstantSky;
 pub use descartes::DescartesSky;
 pub use mie::MieSky;
+pub use table::SceneSky;
 
 use glam::Vec3;
 

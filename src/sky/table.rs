@@ -7,7 +7,8 @@
 //! every 5 nm over 360–830 nm. Interpolating between 5 nm rows moves a bow by at most
 //! its own dispersion over 5 nm (≈ 0.03°), well inside the sun's 0.53° disk.
 use super::Sky;
-use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN};
+use crate::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
+use glam::Vec3;
 use rayon::prelude::*;
 
 const FINE_FROM: f64 = 35.0;
@@ -99,6 +100,23 @@ impl SkyTable {
         let r1 = at(l + 1, i) + wt * (at(l + 1, i + 1) - at(l + 1, i));
         r0 + wl * (r1 - r0)
     }
+}
+
+/// A sky model ready for rendering: tabulated over (θ, λ), tied to the scene's sun.
+#[derive(Debug)]
+pub struct SceneSky {
+    /// The model's name, for messages.
+    pub model: String,
+    pub table: SkyTable,
+    /// Unit direction toward the sun.
+    pub sun_dir: Vec3,
+    /// Per-wavelength factor on the table: the sun's irradiance times `scale` for the
+    /// physical models (their profile is radiance per unit solar irradiance), `scale`
+    /// alone for the Aristotelian and constant skies.
+    pub factor: DenseSpectrum,
+    /// True when the model already contains the background (aristotle, constant), so it
+    /// replaces it rather than adding to it.
+    pub replaces_background: bool,
 }
 
 #[cfg(test)]

@@ -6,11 +6,19 @@
 //! ([`DenseSpectrum::from_table`]: Sprague for uniform rows, a not-a-knot cubic spline
 //! for irregular ones, as colour-science), and the interpolated table must keep n > 0
 //! and k ≥ 0.
-use crate::bsdf::ComplexIor;
-use crate::colorimetry::{interpolate_column, parse_columns};
+use super::csv::{interpolate_column, parse_columns};
+use super::DenseSpectrum;
 use crate::{HeronError, Result};
 use std::path::Path;
 use std::sync::OnceLock;
+
+/// A spectral complex refractive index n(λ) + i k(λ), relative to the outside (n = 1).
+/// Its Fresnel reflectance is `bsdf::conductor`'s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ComplexIor {
+    pub n: DenseSpectrum,
+    pub k: DenseSpectrum,
+}
 
 /// The catalogue's names, in the order error messages list them.
 pub const METAL_NAMES: &[&str] = &["Ag", "Al", "Au", "Cu"];

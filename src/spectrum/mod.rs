@@ -4,6 +4,7 @@
 //! Units: wavelengths are in nanometres in this API.
 pub mod cie;
 pub mod color;
+pub mod csv;
 pub mod dense;
 pub mod interp;
 pub mod ior;
@@ -13,7 +14,7 @@ pub mod sampled;
 pub mod uplift;
 
 pub use dense::DenseSpectrum;
-pub use sampled::{SampledSpectrum, SampledWavelengths, WavelengthSampler};
+pub use sampled::{SampledSpectrum, SampledWavelengths};
 
 /// Shortest wavelength heron transports, nm (pbrt-v4 and Mitsuba 3 use the same range).
 pub const LAMBDA_MIN: f32 = 360.0;

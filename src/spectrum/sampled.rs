@@ -5,6 +5,7 @@
 //! `SampledWavelengths`). Each lane keeps its own pdf; a lane whose pdf is 0 has been
 //! terminated and contributes nothing to the film.
 use super::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
+use crate::settings::WavelengthSampler;
 use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign};
 
 /// A value per wavelength lane (radiance, throughput, reflectance …).
@@ -119,19 +120,6 @@ impl<const N: usize> Div<f32> for SampledSpectrum<N> {
     fn div(self, s: f32) -> Self {
         self * (1.0 / s)
     }
-}
-
-/// How the hero wavelength is drawn; chosen once per render.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum WavelengthSampler {
-    /// Uniform over 360–830 nm.
-    Uniform,
-    /// p(λ) ∝ 1/cosh²(0.0072 (λ − 538 nm)) over 360–830 nm, the visible-importance
-    /// density of pbrt-v4 and Mitsuba 3, sampled by inverting its CDF (derived here:
-    /// ∫ sech²(a x) dx = tanh(a x)/a). The default: measured better than uniform with
-    /// 8 lanes and Sobol' points (BENCHMARKS.md "Defaults").
-    #[default]
-    Visible,
 }
 
 const VIS_A: f32 = 0.0072;

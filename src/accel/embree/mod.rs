@@ -33,14 +33,7 @@ pub use scene::{Scene, SceneBuilder, StreamScratch};
 
 use glam::Vec3;
 
-/// Errors reported by Embree, through the device error callback or return codes.
-#[derive(Debug, thiserror::Error)]
-pub enum EmbreeError {
-    #[error("embree: {code}: {message}")]
-    Device { code: String, message: String },
-    #[error("embree: {0}")]
-    Other(String),
-}
+pub use crate::error::EmbreeError;
 
 /// One ray for a query. `tnear` is the lecture's epsilon offset, `tfar` the cutoff.
 ///

@@ -1,0 +1,383 @@
+//! Render settings: the choices a scene file's `[render]` table, the CLI's flags and the
+//! Python module's keyword arguments make, as plain data at the bottom of the layer table
+//! (ARCHITECTURE.md, "Layers"), so that the scene, the integrators, the renderer and the
+//! provenance all read them without importing each other.
+//!
+//! Each enum's name list, `parse` and `name` live here; what a choice does lives in its
+//! layer (`WavelengthSampler::sample` in `spectrum`, `RayOffset::of` in `geometry`, the
+//! kernels in `integrator`).
+
+/// The integrators a scene or the CLI can choose.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum IntegratorKind {
+    /// The seed's Whitted tracer: shadow rays to the lights at diffuse and glossy
+    /// surfaces, specular continuation; the default for the course's scenes.
+    #[default]
+    Whitted,
+    /// Unidirectional path tracing with next-event estimation and MIS.
+    Path,
+    /// Paths from the lights, every diffuse or glossy vertex connected to the camera.
+    LightTrace,
+    /// Bidirectional path tracing, every strategy, power-heuristic MIS.
+    Bdpt,
+}
+
+impl IntegratorKind {
+    pub const NAMES: &'static [&'static str] = &["whitted", "path", "lighttrace", "bdpt"];
+
+    /// Whether the integrator adds to other pixels than the one it samples.
+    pub fn splats(self) -> bool {
+        matches!(self, IntegratorKind::LightTrace | IntegratorKind::Bdpt)
+    }
+
+    /// Whether it starts from the camera ray of the pixel sample (light tracing does
+    /// not, so the renderer traces no camera packets for it).
+    pub fn uses_camera_rays(self) -> bool {
+        !matches!(self, IntegratorKind::LightTrace)
+    }
+
+    pub fn parse(name: &str) -> Result<IntegratorKind, String> {
+        match name {
+            "whitted" => Ok(IntegratorKind::Whitted),
+            "path" => Ok(IntegratorKind::Path),
+            "lighttrace" => Ok(IntegratorKind::LightTrace),
+            "bdpt" => Ok(IntegratorKind::Bdpt),
+            other => Err(format!(
+                "expected one of {}, got {other:?}",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "whitted",
+            IntegratorKind::Path => "path",
+            IntegratorKind::LightTrace => "lighttrace",
+            IntegratorKind::Bdpt => "bdpt",
+        }
+    }
+}
+
+/// Which sampler a render uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Independent uniform numbers per (seed, pixel, sample).
+    Independent,
+    /// Owen-scrambled Sobol' points along a Morton curve.
+    #[default]
+    Sobol,
+}
+
+impl SamplerKind {
+    pub fn parse(name: &str) -> Result<SamplerKind, String> {
+        match name {
+            "independent" => Ok(SamplerKind::Independent),
+            "sobol" => Ok(SamplerKind::Sobol),
+            other => Err(format!("expected sobol or independent, got {other:?}")),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Sobol => "sobol",
+        }
+    }
+}
+
+/// How the hero wavelength is drawn; chosen once per render. The sampling itself is in
+/// `spectrum::sampled`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WavelengthSampler {
+    /// Uniform over 360–830 nm.
+    Uniform,
+    /// p(λ) ∝ 1/cosh²(0.0072 (λ − 538 nm)) over 360–830 nm, the visible-importance
+    /// density of pbrt-v4 and Mitsuba 3, sampled by inverting its CDF (derived here:
+    /// ∫ sech²(a x) dx = tanh(a x)/a). The default: measured better than uniform with
+    /// 8 lanes and Sobol' points (BENCHMARKS.md "Defaults").
+    #[default]
+    Visible,
+}
+
+/// How the light sampler of the path tracer and BDPT chooses a light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LightSamplerKind {
+    /// In proportion to each light's power.
+    #[default]
+    Power,
+    Uniform,
+}
+
+/// The `offset` setting: which ray offset a render uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OffsetMode {
+    /// The seed's ε for the `whitted` integrator, robust offsets for the physically
+    /// based ones.
+    #[default]
+    Auto,
+    Epsilon,
+    Robust,
+}
+
+impl OffsetMode {
+    pub const NAMES: &'static [&'static str] = &["auto", "epsilon", "robust"];
+
+    pub fn parse(name: &str) -> Result<OffsetMode, String> {
+        match name {
+            "auto" => Ok(OffsetMode::Auto),
+            "epsilon" => Ok(OffsetMode::Epsilon),
+            "robust" => Ok(OffsetMode::Robust),
+            other => {
+                let (last, rest) = Self::NAMES.split_last().unwrap();
+                Err(format!(
+                    "expected {} or {last}, got {other:?}",
+                    rest.join(", ")
+                ))
+            }
+        }
+    }
+
+    /// Whether rays leave surfaces by the seed's ε (else by robust offsets) in a render
+    /// by `integrator`: `auto` is ε for the seed's tracer only.
+    pub fn is_epsilon(self, integrator: IntegratorKind) -> bool {
+        matches!(
+            (self, integrator),
+            (OffsetMode::Epsilon, _) | (OffsetMode::Auto, IntegratorKind::Whitted)
+        )
+    }
+}
+
+/// A set of transport features a kernel is compiled for, as bits (a `const` generic);
+/// `scene::features` says which a scene needs.
+pub type KernelFlags = u32;
+
+/// Shadow rays / next-event estimation at diffuse and glossy hits.
+pub const SHADOWS: KernelFlags = 1 << 0;
+/// Specular continuation in the Whitted tracer.
+pub const SPECULAR: KernelFlags = 1 << 1;
+/// Emission of area lights found at hits.
+pub const EMITTERS: KernelFlags = 1 << 2;
+/// Radiance of the lights at infinity along escaping rays.
+pub const ESCAPE: KernelFlags = 1 << 3;
+/// Participating media (path tracer only).
+pub const MEDIA: KernelFlags = 1 << 4;
+/// The general kernel: every flag on.
+pub const ALL: KernelFlags = SHADOWS | SPECULAR | EMITTERS | ESCAPE | MEDIA;
+
+/// The flags this build was made without (`HERON_STRIP`, see `scene::features`).
+pub const STRIPPED: KernelFlags = (if cfg!(heron_strip_shadows) {
+    SHADOWS
+} else {
+    0
+}) | (if cfg!(heron_strip_specular) {
+    SPECULAR
+} else {
+    0
+}) | (if cfg!(heron_strip_emitters) {
+    EMITTERS
+} else {
+    0
+}) | (if cfg!(heron_strip_escape) { ESCAPE } else { 0 });
+
+/// Whether kernel `k` has `flag`'s code. With `k` a const generic this folds to a
+/// constant, so a kernel without the flag has no trace of the code behind it.
+#[inline(always)]
+pub const fn on(k: KernelFlags, flag: KernelFlags) -> bool {
+    k & flag & !STRIPPED != 0
+}
+
+/// The flags' names joined by '+' ("none" for none), for messages and the render summary.
+pub fn flag_names(k: KernelFlags) -> String {
+    let names: Vec<&str> = [
+        (SHADOWS, "shadows"),
+        (SPECULAR, "specular"),
+        (EMITTERS, "emitters"),
+        (ESCAPE, "escape"),
+        (MEDIA, "media"),
+    ]
+    .iter()
+    .filter(|(f, _)| k & f != 0)
+    .map(|&(_, n)| n)
+    .collect();
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join("+")
+    }
+}
+
+/// Which kernel a render runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum KernelChoice {
+    /// The kernel specialised to the scene's features.
+    #[default]
+    Auto,
+    /// The kernel with every feature compiled in.
+    General,
+    /// Exactly these flags, whatever the scene needs (not offered by the CLI): for tests
+    /// that show a missing flag changes the image, and for benchmarks.
+    Forced(KernelFlags),
+}
+
+impl KernelChoice {
+    pub fn parse(name: &str) -> Result<KernelChoice, String> {
+        match name {
+            "auto" => Ok(KernelChoice::Auto),
+            "general" => Ok(KernelChoice::General),
+            other => Err(format!("expected auto or general, got {other:?}")),
+        }
+    }
+}
+
+/// Everything that decides a render's pixels: the scene file's `[render]` table (the
+/// first eight fields) and the choices only flags or keyword arguments make, with their
+/// defaults. A scene holds the file's; a render holds the scene's with
+/// [`SettingsArgs`] applied. (What a render does besides, threads, checkpoints, shards,
+/// time limits, is `render::RenderOptions`'s.)
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub spp: u32,
+    /// Maximum path depth (the lecture's `depth` limit on continued rays).
+    pub max_depth: u32,
+    /// Ray offset ε for rays leaving surfaces (seed: 1e-4), where offsets are ε.
+    pub epsilon: f32,
+    pub seed: u64,
+    /// The integrator.
+    pub integrator: IntegratorKind,
+    /// Path depth from which Russian roulette may end a path (path integrator).
+    pub rr_depth: u32,
+    /// How the light sampler chooses (read when the scene is built).
+    pub light_sampler: LightSamplerKind,
+    /// How rays leave surfaces ([`OffsetMode`]).
+    pub offset: OffsetMode,
+    /// Wavelength lanes per path: 1, 4 or 8.
+    pub lanes: usize,
+    /// Trace camera rays as 8-wide packets (otherwise one by one).
+    pub packets: bool,
+    /// How hero wavelengths are drawn.
+    pub wavelengths: WavelengthSampler,
+    /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
+    /// (0: none).
+    pub spectral_bins: usize,
+    /// Where the random numbers come from.
+    pub sampler: SamplerKind,
+    /// The kernel specialised to the scene's features, or the general one.
+    pub kernel: KernelChoice,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            spp: 16,
+            max_depth: 10,
+            epsilon: 1e-4,
+            seed: 0,
+            integrator: IntegratorKind::Whitted,
+            rr_depth: 5,
+            light_sampler: LightSamplerKind::Power,
+            offset: OffsetMode::Auto,
+            // The defaults with the lowest RMSE·√t over the course scenes, the Cornell
+            // box and a rainbow (scripts/bench_defaults.py, BENCHMARKS.md "Defaults").
+            lanes: 8,
+            packets: true,
+            wavelengths: WavelengthSampler::Visible,
+            spectral_bins: 0,
+            sampler: SamplerKind::Sobol,
+            kernel: KernelChoice::Auto,
+        }
+    }
+}
+
+/// Changes to a scene's settings as the CLI's flags and the Python module's keyword
+/// arguments give them (numbers as given, names as strings); `None` keeps the scene's.
+/// [`RenderSettings::apply`] is the one place their rules are written. Its messages
+/// name the CLI's flags; the Python module renames them to its arguments.
+#[derive(Clone, Debug, Default)]
+pub struct SettingsArgs<'a> {
+    pub spp: Option<i64>,
+    pub seed: Option<u64>,
+    pub lanes: Option<i64>,
+    pub integrator: Option<&'a str>,
+    pub sampler: Option<&'a str>,
+    pub wavelengths: Option<&'a str>,
+    pub spectral_bins: Option<i64>,
+    pub max_depth: Option<i64>,
+    pub offset: Option<&'a str>,
+    pub kernel: Option<&'a str>,
+    /// `--no-packets` (CLI only).
+    pub no_packets: bool,
+}
+
+impl SettingsArgs<'_> {
+    /// The arguments' errors, without a scene: what [`RenderSettings::apply`] would say.
+    pub fn check(&self) -> Result<(), String> {
+        RenderSettings::default().apply(self)
+    }
+}
+
+impl RenderSettings {
+    /// Applies flags or keyword arguments; the first bad one is an error naming its flag,
+    /// and then nothing is changed.
+    pub fn apply(&mut self, a: &SettingsArgs) -> Result<(), String> {
+        let mut s = self.clone();
+        if let Some(v) = a.spp {
+            if v < 1 {
+                return Err("--spp: expected at least 1".into());
+            }
+            s.spp = u32::try_from(v)
+                .map_err(|_| format!("--spp: expected at most {}, got {v}", u32::MAX))?;
+        }
+        if let Some(v) = a.lanes {
+            s.lanes = match v {
+                1 | 4 | 8 => v as usize,
+                n => return Err(format!("--lanes: expected 1, 4 or 8, got {n}")),
+            };
+        }
+        if let Some(w) = a.wavelengths {
+            s.wavelengths = match w {
+                "visible" => WavelengthSampler::Visible,
+                "uniform" => WavelengthSampler::Uniform,
+                other => {
+                    return Err(format!(
+                        "--wavelengths: expected uniform or visible, got {other:?}"
+                    ))
+                }
+            };
+        }
+        if let Some(b) = a.spectral_bins {
+            if !(0..=470).contains(&b) {
+                return Err(format!(
+                    "--spectral-bins: expected 0 (none) or 1 to 470 bins, got {b}"
+                ));
+            }
+            s.spectral_bins = b as usize;
+        }
+        if let Some(d) = a.max_depth {
+            if d < 1 || d > u32::MAX as i64 {
+                return Err(format!("--max-depth: expected at least 1, got {d}"));
+            }
+            s.max_depth = d as u32;
+        }
+        if let Some(o) = a.offset {
+            s.offset = OffsetMode::parse(o).map_err(|e| format!("--offset: {e}"))?;
+        }
+        if let Some(i) = a.integrator {
+            s.integrator = IntegratorKind::parse(i).map_err(|e| format!("--integrator: {e}"))?;
+        }
+        if let Some(n) = a.sampler {
+            s.sampler = SamplerKind::parse(n).map_err(|e| format!("--sampler: {e}"))?;
+        }
+        if let Some(k) = a.kernel {
+            s.kernel = KernelChoice::parse(k).map_err(|e| format!("--kernel: {e}"))?;
+        }
+        if let Some(v) = a.seed {
+            s.seed = v;
+        }
+        if a.no_packets {
+            s.packets = false;
+        }
+        *self = s;
+        Ok(())
+    }
+}
