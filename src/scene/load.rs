@@ -1442,7 +1442,7 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
             Ok(MediumPlan::Mie(crate::medium::MieSpec {
                 population: nodes
                     .iter()
-                    .map(|n| crate::medium::lorenz_mie::PopulationNode {
+                    .map(|n| crate::medium::PopulationNode {
                         radius_m: n.radius_mm * 1e-3,
                         number_density: density * n.weight,
                     })

@@ -36,7 +36,7 @@
 //! The series converges to a_n, b_n geometrically in |R₁₁| < 1 (`tests/debye.rs` checks
 //! the sum to 1e-10); [`coefficients`] returns one term, scaled by (2n+1)/(n(n+1)) like
 //! [`mie::coefficients`], so [`mie::amplitudes`] gives its S₁, S₂.
-use super::mie::{self, MieCoefficients};
+use crate::optics::mie::{self, MieCoefficients};
 use num_complex::Complex64;
 
 /// The largest p accepted by the CLI and the scene (p = 0 … 20).
@@ -73,7 +73,7 @@ impl Interface {
 /// downward logarithmic derivative (stable for n > z, where upward ψ is not), χ_n by its
 /// (stable) upward recurrence, ξ′_n = ξ_{n−1} − n ξ_n / z.
 fn riccati_xi(z: f64, nmax: usize) -> (Vec<Complex64>, Vec<Complex64>) {
-    let d = mie::log_derivative_psi(z, nmax);
+    let d = mie::log_derivative(z, nmax);
     let mut psi = z.sin();
     let (mut chi0, mut chi1) = (-z.sin(), z.cos());
     let mut xi_prev = Complex64::new(psi, -chi1);

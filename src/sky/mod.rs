@@ -32,6 +32,9 @@
 //! weights ∝ number × a², so one radius gives that radius's profile unchanged. `debye`
 //! splits the `mie` solution into the Debye series' terms; `lee` computes Lee diagrams.
 //!
+//! The Lorenz–Mie series is [`crate::optics::mie`]; this module holds what makes it a
+//! sky (profiles, disk averages, tables).
+//!
 //! Polarisation: `S` means incident light polarised perpendicular to the scattering plane
 //! (Fresnel's s, Mie's S₁), `P` parallel to it (Fresnel's p, Mie's S₂); unpolarised light is
 //! their mean.
