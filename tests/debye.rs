@@ -1,7 +1,7 @@
-//! Debye series (src/sky/debye.rs): the terms sum to the Lorenz–Mie coefficients, and
+//! Debye series (src/optics/debye.rs): the terms sum to the Lorenz–Mie coefficients, and
 //! p = 2 and p = 3 alone are the primary and secondary bows.
-use heron::optics::mie;
-use heron::sky::{airy, debye, descartes, MieSky};
+use heron::optics::{debye, mie};
+use heron::sky::{airy, descartes, MieSky};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 

@@ -101,7 +101,7 @@ pub fn n_terms(x: f64) -> usize {
 /// beyond the turning point n ≈ |z| that the error of the D = 0 start has died out by
 /// n = |z| (it decays over a transition zone of width ~|z|^{1/3}): with only +15 (BHMIE)
 /// D₁ is wrong by 0.06 at z = 1333; with 8 |z|^{1/3} more it is exact to ~1e-15 (checked
-/// against scipy's spherical Bessel functions). Shared with `sky::debye` (real z).
+/// against scipy's spherical Bessel functions). Shared with [`super::debye`] (real z).
 pub fn log_derivative<M: RelativeIndex>(z: M, nstop: usize) -> Vec<M> {
     let az = z.modulus();
     let nmx = (nstop as f64).max(az).ceil() as usize + 16 + (8.0 * az.cbrt()) as usize;

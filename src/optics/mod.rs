@@ -7,6 +7,9 @@
 //!   relative index ([`mie::RelativeIndex`]): real for the rainbow skies (`crate::sky`,
 //!   which neglect water's absorption), complex for the media (`crate::medium`, which
 //!   include it).
+//! - [`debye`]: the Debye series of the Mie coefficients (Hovenac & Lock 1992), which
+//!   splits each partial wave into the waves leaving the sphere after p internal passes
+//!   (the `mie` sky's `debye` term).
 //!
 //! Layer 2 ("physics", `../shared/DESIGN.md`): this module imports nothing of heron's
 //! (only `num-complex`); `sky` and `medium` import it, never the reverse.
@@ -16,7 +19,9 @@
 //! (`crate::medium::PopulationNode`, radii with number densities) and its bulk
 //! coefficients (Frisvad, Christensen & Jensen 2007) are the medium's; the sky's
 //! normalisation of S₁, S₂ into a profile (`crate::sky::mie::phase_value`, with
-//! `crate::sky::Polarisation`) is the sky's.
+//! `crate::sky::Polarisation`) and the largest Debye term the CLI and scenes accept
+//! (`crate::sky::mie::MAX_DEBYE_TERM`) are the sky's.
+pub mod debye;
 pub mod mie;
 
 pub use mie::{amplitudes, MieCoefficients, MieSphere, RelativeIndex};

@@ -1197,10 +1197,10 @@ fn plan_sky(
         if model != "mie" {
             return Err(format!("sky.debye: applies to mie, not {model}"));
         }
-        if p > crate::sky::debye::MAX_TERM {
+        if p > crate::sky::mie::MAX_DEBYE_TERM {
             return Err(format!(
                 "sky.debye: expected a term p in 0..={}, got {p}",
-                crate::sky::debye::MAX_TERM
+                crate::sky::mie::MAX_DEBYE_TERM
             ));
         }
     }

@@ -4,7 +4,7 @@
 //! index m: water's imaginary index is < 3.4·10⁻⁸ below 700 nm and < 1.9·10⁻⁷ up to
 //! 830 nm (Hale & Querry 1973), so absorption is neglected in the skies (the media of
 //! `crate::medium` include it). With only Debye term p ([`MieSky::debye`]) the
-//! coefficients are [`super::debye::coefficients`] instead.
+//! coefficients are [`crate::optics::debye::coefficients`] instead.
 //!
 //! The sky profile is p = dσ/dΩ / (π a²) = |S₁|²/(π x²) for s light, |S₂|²/(π x²) for p light,
 //! (|S₁|² + |S₂|²)/(2π x²) unpolarised (same normalisation as `descartes` and `airy`), at
@@ -32,6 +32,9 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::sync::{Arc, RwLock};
+
+/// The largest Debye term p accepted by the CLI and the scene (p = 0 … 20).
+pub const MAX_DEBYE_TERM: u32 = 20;
 
 /// Profile value dσ/dΩ / (π a²) from S₁, S₂ for the polarisation.
 #[inline]
@@ -83,7 +86,8 @@ pub struct MieSky {
     pub droplet_radius_nm: f64,
     /// The radii (mm) averaged, with their cross-section weights (Σ = 1).
     pub drops: Vec<DropNode>,
-    /// Only this term of the Debye series ([`super::debye`]), or the full Mie solution.
+    /// Only this term of the Debye series ([`crate::optics::debye`]), or the full Mie
+    /// solution.
     pub debye: Option<u32>,
     /// Sun angular radius α, radians (> 0).
     pub sun_radius: f64,
@@ -192,7 +196,7 @@ impl MieSky {
             let x = to_x(d.radius_mm);
             let c = match self.debye {
                 None => optics::mie::coefficients(m, x),
-                Some(p) => super::debye::coefficients(m, x, p),
+                Some(p) => optics::debye::coefficients(m, x, p),
             };
             let one: Vec<f64> = theta
                 .par_iter()

@@ -121,10 +121,10 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
         return Err(bad("--debye applies to mie, not airy".into()));
     }
     if let Some(p) = req.debye {
-        if p > super::debye::MAX_TERM {
+        if p > super::mie::MAX_DEBYE_TERM {
             return Err(bad(format!(
                 "--debye: expected a term p in 0..={}, got {p}",
-                super::debye::MAX_TERM
+                super::mie::MAX_DEBYE_TERM
             )));
         }
     }

@@ -36,11 +36,8 @@
 //! The series converges to a_n, b_n geometrically in |R₁₁| < 1 (`tests/debye.rs` checks
 //! the sum to 1e-10); [`coefficients`] returns one term, scaled by (2n+1)/(n(n+1)) like
 //! [`mie::coefficients`], so [`mie::amplitudes`] gives its S₁, S₂.
-use crate::optics::mie::{self, MieCoefficients};
+use super::mie::{self, MieCoefficients};
 use num_complex::Complex64;
-
-/// The largest p accepted by the CLI and the scene (p = 0 … 20).
-pub const MAX_TERM: u32 = 20;
 
 /// One partial wave's interface coefficients for one polarisation.
 #[derive(Clone, Copy, Debug)]
