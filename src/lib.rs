@@ -23,6 +23,7 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod medium;
+pub mod optics;
 pub mod provenance;
 pub mod render;
 pub mod sampler;

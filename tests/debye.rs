@@ -1,6 +1,7 @@
-//! Debye series (src/sky/debye.rs): the terms sum to the Lorenz–Mie coefficients, and
+//! Debye series (src/optics/debye.rs): the terms sum to the Lorenz–Mie coefficients, and
 //! p = 2 and p = 3 alone are the primary and secondary bows.
-use heron::sky::{airy, debye, descartes, mie, MieSky};
+use heron::optics::{debye, mie};
+use heron::sky::{airy, descartes, MieSky};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -60,7 +61,7 @@ fn term_profile(m: f64, x: f64, p: u32, theta_deg: &[f64]) -> Vec<f64> {
         .iter()
         .map(|t| {
             let (s1, s2) = mie::amplitudes(&c, (PI - t.to_radians()).cos());
-            mie::phase_value(s1, s2, x, heron::sky::Polarisation::Unpolarised)
+            heron::sky::mie::phase_value(s1, s2, x, heron::sky::Polarisation::Unpolarised)
         })
         .collect()
 }

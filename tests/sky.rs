@@ -353,9 +353,9 @@ fn airy_agrees_with_mie_near_the_primary_bow() {
 #[test]
 fn mie_small_sphere_is_rayleigh_like_and_symmetric() {
     // x ≪ 1: |S1|² flat, |S2|² ∝ cos² of the scattering angle.
-    let c = heron::sky::mie::coefficients(1.33, 0.01);
-    let (s1a, s2a) = heron::sky::mie::amplitudes(&c, 1.0);
-    let (s1b, s2b) = heron::sky::mie::amplitudes(&c, 0.0);
+    let c = heron::optics::mie::coefficients(1.33, 0.01);
+    let (s1a, s2a) = heron::optics::mie::amplitudes(&c, 1.0);
+    let (s1b, s2b) = heron::optics::mie::amplitudes(&c, 0.0);
     assert!((s1a.norm() / s1b.norm() - 1.0).abs() < 1e-3);
     assert!((s2a.norm() - s1a.norm()).abs() < 1e-3 * s1a.norm());
     assert!(s2b.norm() < 1e-3 * s2a.norm());

@@ -49,7 +49,7 @@ fn sky_section_errors_name_the_key() {
             "sky.droplet_radius",
         ),
         ("[sky]\nmodel = \"descartes\"\ncolour = 1", "colour"),
-        // Drop-size distributions and Debye terms (src/drops, src/sky/debye.rs).
+        // Drop-size distributions and Debye terms (src/drops, src/optics/debye.rs).
         (
             "[sky]\nmodel = \"descartes\"\ndrops = { distribution = \"lognormal\", median_mm = 0.5, sigma = 0.1 }",
             "sky.drops",

@@ -1,5 +1,14 @@
 //! A homogeneous medium of water drops whose coefficients and phase function come from
-//! heron's own Lorenz–Mie code (`lorenz_mie`), tabulated once per scene.
+//! heron's own Lorenz–Mie code ([`crate::optics::mie`], BHMIE with a complex index),
+//! tabulated once per scene.
+//!
+//! Bulk coefficients of a population (Frisvad, Christensen & Jensen 2007, "Computing the
+//! scattering properties of participating media using Lorenz–Mie theory", ACM TOG 26(3),
+//! eqs. 7–9, for a non-absorbing host): with N(r) the number density of radius r,
+//! σ_t = ∫ C_ext(r) N(r) dr, σ_s = ∫ C_sca(r) N(r) dr, and the phase function
+//! p(θ) = ∫ (|S₁|² + |S₂|²)/2 N(r) dr / (k² σ_s), k = 2π/λ (in the host), normalised to 1
+//! over the sphere. Here the population is a list of nodes (radius, number density),
+//! [`PopulationNode`], a quadrature of N(r) that a drop-size distribution provides.
 //!
 //! For each wavelength node λ (every `lambda_step` nm from 360 nm to past 830 nm) and
 //! each node (r, N) of the drop population:
@@ -28,9 +37,8 @@
 //!
 //! Units: radii and lengths in metres; number densities per cubic metre; σ in m⁻¹. A
 //! scene with a Lorenz–Mie medium is therefore in metres.
-use super::lorenz_mie::{sphere, PopulationNode};
 use super::phase_table::{angle_grid, PhaseTable};
-use crate::sky::mie::amplitudes;
+use crate::optics::mie::{amplitudes, sphere};
 use crate::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -83,6 +91,16 @@ fn truncate(theta: &[f64], p: &mut [f64], st: f64, ss: f64, cutoff_deg: f64) -> 
     }
     let f = 1.0 - mass(p) / before;
     (st - f * ss, ss * (1.0 - f))
+}
+
+/// One node of a drop population: a radius and the number of drops per unit volume
+/// that it stands for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PopulationNode {
+    /// Radius in metres.
+    pub radius_m: f64,
+    /// Drops per cubic metre.
+    pub number_density: f64,
 }
 
 /// What a Lorenz–Mie medium is made of.

@@ -2,7 +2,7 @@
 //! enum dispatched by `match`.
 //!
 //! - `homogeneous`: water drops, σ_t(λ), σ_s(λ) and p(θ, λ) from heron's Lorenz–Mie code
-//!   (`lorenz_mie`, BHMIE with water's complex index), tabulated once per scene
+//!   ([`crate::optics::mie`], BHMIE with water's complex index), tabulated once per scene
 //!   (`phase_table`);
 //! - `henyey_greenstein`: constant σ_a, σ_s and the Henyey–Greenstein phase function.
 //!
@@ -28,11 +28,10 @@
 //! θ = 0 is forward. Being reciprocal, p is the same for light and importance.
 pub mod henyey_greenstein;
 pub mod homogeneous;
-pub mod lorenz_mie;
 pub mod phase_table;
 
 pub use henyey_greenstein::HgMedium;
-pub use homogeneous::{LorenzMieMedium, MieSpec};
+pub use homogeneous::{LorenzMieMedium, MieSpec, PopulationNode};
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};

@@ -1195,10 +1195,10 @@ fn plan_sky(
         if model != "mie" {
             return Err(format!("sky.debye: applies to mie, not {model}"));
         }
-        if p > crate::sky::debye::MAX_TERM {
+        if p > crate::sky::mie::MAX_DEBYE_TERM {
             return Err(format!(
                 "sky.debye: expected a term p in 0..={}, got {p}",
-                crate::sky::debye::MAX_TERM
+                crate::sky::mie::MAX_DEBYE_TERM
             ));
         }
     }
@@ -1440,7 +1440,7 @@ fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, Stri
             Ok(MediumPlan::Mie(crate::medium::MieSpec {
                 population: nodes
                     .iter()
-                    .map(|n| crate::medium::lorenz_mie::PopulationNode {
+                    .map(|n| crate::medium::PopulationNode {
                         radius_m: n.radius_mm * 1e-3,
                         number_density: density * n.weight,
                     })

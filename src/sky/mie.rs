@@ -1,21 +1,10 @@
-//! Lorenz–Mie scattering by a water sphere, per wavelength, tabulated over angle.
+//! The Lorenz–Mie sky: water drops' scattering per wavelength, tabulated over angle.
 //!
-//! Series (Bohren & Huffman, *Absorption and Scattering of Light by Small Particles*,
-//! 1983, §4.4 and their program BHMIE, appendix A), for a sphere of relative index m (real
-//! here: water's imaginary index is < 3.4·10⁻⁸ below 700 nm and < 1.9·10⁻⁷ up to 830 nm,
-//! Hale & Querry 1973, so absorption is neglected in the skies; the media of
-//! `crate::medium` include it) and size parameter x = 2πa/λ:
-//!
-//! - number of terms N = x + 4 x^{1/3} + 2 (Wiscombe 1980, "Improved Mie scattering
-//!   algorithms", Appl. Opt. 19, 1505);
-//! - logarithmic derivative D_n(mx) = ψ_n′/ψ_n by downward recurrence
-//!   D_{n−1} = n/(mx) − 1/(D_n + n/(mx)) from n = max(N, |mx|) + 16 + 8|mx|^{1/3} with
-//!   D = 0 (BHMIE's +15 is not enough for large spheres, see [`coefficients`]);
-//! - Riccati–Bessel ψ_n(x), χ_n(x) by upward recurrence, ξ_n = ψ_n − iχ_n;
-//! - a_n = [(D_n/m + n/x) ψ_n − ψ_{n−1}] / [(D_n/m + n/x) ξ_n − ξ_{n−1}],
-//!   b_n = [(m D_n + n/x) ψ_n − ψ_{n−1}] / [(m D_n + n/x) ξ_n − ξ_{n−1}];
-//! - S₁ = Σ (2n+1)/(n(n+1)) (a_n π_n + b_n τ_n), S₂ = Σ (2n+1)/(n(n+1)) (a_n τ_n + b_n π_n)
-//!   with π_n, τ_n by their upward recurrences in μ = cos(scattering angle).
+//! The series is [`crate::optics::mie`] (Bohren & Huffman's BHMIE) with a real relative
+//! index m: water's imaginary index is < 3.4·10⁻⁸ below 700 nm and < 1.9·10⁻⁷ up to
+//! 830 nm (Hale & Querry 1973), so absorption is neglected in the skies (the media of
+//! `crate::medium` include it). With only Debye term p ([`MieSky::debye`]) the
+//! coefficients are [`crate::optics::debye::coefficients`] instead.
 //!
 //! The sky profile is p = dσ/dΩ / (π a²) = |S₁|²/(π x²) for s light, |S₂|²/(π x²) for p light,
 //! (|S₁|² + |S₂|²)/(2π x²) unpolarised (same normalisation as `descartes` and `airy`), at
@@ -35,6 +24,7 @@
 //! linearly between the two nearest (for rendering).
 use super::{disk_kernel, disk_quadrature, Polarisation};
 use crate::drops::{DropNode, DropSizeDistribution};
+use crate::optics::{self, mie::amplitudes};
 use crate::spectrum::ior::Ior;
 use glam::Vec3;
 use num_complex::Complex64;
@@ -43,80 +33,8 @@ use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::sync::{Arc, RwLock};
 
-/// Coefficients (2n+1)/(n(n+1)) a_n and (2n+1)/(n(n+1)) b_n, n = 1…N.
-pub struct MieCoefficients {
-    pub a: Vec<Complex64>,
-    pub b: Vec<Complex64>,
-}
-
-/// Number of terms N = x + 4 x^{1/3} + 2 (Wiscombe 1980), rounded.
-pub fn n_terms(x: f64) -> usize {
-    (x + 4.0 * x.cbrt() + 2.0).round() as usize
-}
-
-/// The scaled Mie coefficients for a sphere of real relative index `m`, size parameter `x`.
-pub fn coefficients(m: f64, x: f64) -> MieCoefficients {
-    let nstop = n_terms(x);
-    let d = log_derivative_psi(m * x, nstop);
-    let (mut psi0, mut psi1) = (x.cos(), x.sin());
-    let (mut chi0, mut chi1) = (-x.sin(), x.cos());
-    let mut xi1 = Complex64::new(psi1, -chi1);
-    let mut a = Vec::with_capacity(nstop);
-    let mut b = Vec::with_capacity(nstop);
-    for (n, &dn) in d.iter().enumerate().take(nstop + 1).skip(1) {
-        let nf = n as f64;
-        let psi = (2.0 * nf - 1.0) * psi1 / x - psi0;
-        let chi = (2.0 * nf - 1.0) * chi1 / x - chi0;
-        let xi = Complex64::new(psi, -chi);
-        let da = dn / m + nf / x;
-        let db = m * dn + nf / x;
-        let an = (da * psi - psi1) / (da * xi - xi1);
-        let bn = (db * psi - psi1) / (db * xi - xi1);
-        let f = (2.0 * nf + 1.0) / (nf * (nf + 1.0));
-        a.push(an * f);
-        b.push(bn * f);
-        psi0 = psi1;
-        psi1 = psi;
-        chi0 = chi1;
-        chi1 = chi;
-        xi1 = xi;
-    }
-    MieCoefficients { a, b }
-}
-
-/// The logarithmic derivatives D_n(z) = ψ_n′(z)/ψ_n(z) for n = 0…(at least `nstop`), by
-/// the downward recurrence D_{n−1} = n/z − 1/(D_n + n/z) from D = 0. It starts far enough
-/// beyond the turning point n ≈ z that the error of the D = 0 start has died out by n = z
-/// (it decays over a transition zone of width ~z^{1/3}): with only +15 (BHMIE) D₁ is wrong
-/// by 0.06 at z = 1333; with 8 z^{1/3} more it is exact to ~1e-15 (checked against
-/// scipy's spherical Bessel functions). Shared with `debye`.
-pub fn log_derivative_psi(z: f64, nstop: usize) -> Vec<f64> {
-    let nmx = (nstop as f64).max(z.abs()).ceil() as usize + 16 + (8.0 * z.abs().cbrt()) as usize;
-    let mut d = vec![0.0f64; nmx + 1];
-    for n in (1..=nmx).rev() {
-        let nf = n as f64;
-        d[n - 1] = nf / z - 1.0 / (d[n] + nf / z);
-    }
-    d
-}
-
-/// S₁ and S₂ at μ = cos(scattering angle).
-pub fn amplitudes(c: &MieCoefficients, mu: f64) -> (Complex64, Complex64) {
-    let (mut pi0, mut pi1) = (0.0f64, 1.0f64);
-    let (mut s1r, mut s1i, mut s2r, mut s2i) = (0.0, 0.0, 0.0, 0.0);
-    for (i, (an, bn)) in c.a.iter().zip(&c.b).enumerate() {
-        let nf = (i + 1) as f64;
-        let pi = pi1;
-        let tau = nf * mu * pi - (nf + 1.0) * pi0;
-        s1r += an.re * pi + bn.re * tau;
-        s1i += an.im * pi + bn.im * tau;
-        s2r += an.re * tau + bn.re * pi;
-        s2i += an.im * tau + bn.im * pi;
-        pi1 = ((2.0 * nf + 1.0) * mu * pi - (nf + 1.0) * pi0) / nf;
-        pi0 = pi;
-    }
-    (Complex64::new(s1r, s1i), Complex64::new(s2r, s2i))
-}
+/// The largest Debye term p accepted by the CLI and the scene (p = 0 … 20).
+pub const MAX_DEBYE_TERM: u32 = 20;
 
 /// Profile value dσ/dΩ / (π a²) from S₁, S₂ for the polarisation.
 #[inline]
@@ -168,7 +86,8 @@ pub struct MieSky {
     pub droplet_radius_nm: f64,
     /// The radii (mm) averaged, with their cross-section weights (Σ = 1).
     pub drops: Vec<DropNode>,
-    /// Only this term of the Debye series ([`super::debye`]), or the full Mie solution.
+    /// Only this term of the Debye series ([`crate::optics::debye`]), or the full Mie
+    /// solution.
     pub debye: Option<u32>,
     /// Sun angular radius α, radians (> 0).
     pub sun_radius: f64,
@@ -276,8 +195,8 @@ impl MieSky {
         for d in &self.drops {
             let x = to_x(d.radius_mm);
             let c = match self.debye {
-                None => coefficients(m, x),
-                Some(p) => super::debye::coefficients(m, x, p),
+                None => optics::mie::coefficients(m, x),
+                Some(p) => optics::debye::coefficients(m, x, p),
             };
             let one: Vec<f64> = theta
                 .par_iter()
@@ -386,29 +305,5 @@ pub(crate) fn disk_average(theta: &[f64], point: &[f64], i: usize, alpha: f64) -
             .iter()
             .map(|&(t, w)| w * interp(theta, point, t0 - alpha * t))
             .sum()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn coefficients_of_a_large_sphere_match_bessel_functions() {
-        // a_1, a_2 and a_991 for m = 1.333, x = 1000 from scipy 1.17's spherical Bessel
-        // functions (B&H eq. 4.53); BHMIE's D_n start (|mx| + 15) gets a_1 wrong by 0.04.
-        let c = coefficients(1.333, 1000.0);
-        for (n, re, im) in [
-            (1usize, 0.021_980_618_542_767_68, 0.146_620_158_747_850_98),
-            (2, 0.013_566_660_569_453_484, -0.115_683_215_249_433_31),
-            (991, 0.995_495_644_479_244_2, -0.066_963_171_236_870_18),
-        ] {
-            let nf = n as f64;
-            let a = c.a[n - 1] * (nf * (nf + 1.0) / (2.0 * nf + 1.0));
-            assert!(
-                (a.re - re).abs() < 1e-10 && (a.im - im).abs() < 1e-10,
-                "a_{n} = {a}"
-            );
-        }
     }
 }

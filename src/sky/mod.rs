@@ -29,8 +29,12 @@
 //!
 //! Drop-size distributions (`airy`, `mie`; [`crate::drops`]): the profile is
 //! ⟨dσ/dΩ⟩ / ⟨π a²⟩ over the distribution, i.e. the per-radius profiles averaged with
-//! weights ∝ number × a², so one radius gives that radius's profile unchanged. `debye`
-//! splits the `mie` solution into the Debye series' terms; `lee` computes Lee diagrams.
+//! weights ∝ number × a², so one radius gives that radius's profile unchanged. `mie` can
+//! keep one term of the Debye series ([`crate::optics::debye`]); `lee` computes Lee
+//! diagrams.
+//!
+//! The single-particle physics (Lorenz–Mie, Debye) is [`crate::optics`]; this module holds
+//! what makes it a sky (profiles, disk averages, tables).
 //!
 //! Polarisation: `S` means incident light polarised perpendicular to the scattering plane
 //! (Fresnel's s, Mie's S₁), `P` parallel to it (Fresnel's p, Mie's S₂); unpolarised light is
@@ -38,7 +42,6 @@
 pub mod airy;
 pub mod aristotle;
 pub mod constant;
-pub mod debye;
 pub mod descartes;
 pub mod lee;
 pub mod mie;

@@ -121,10 +121,10 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
         return Err(bad("--debye applies to mie, not airy".into()));
     }
     if let Some(p) = req.debye {
-        if p > super::debye::MAX_TERM {
+        if p > super::mie::MAX_DEBYE_TERM {
             return Err(bad(format!(
                 "--debye: expected a term p in 0..={}, got {p}",
-                super::debye::MAX_TERM
+                super::mie::MAX_DEBYE_TERM
             )));
         }
     }
@@ -311,10 +311,10 @@ pub fn mie_phase_csv(m: f64, x: f64, from: f64, to: f64, step: f64) -> Result<St
         )));
     }
     let thetas = angles(from, to, step)?;
-    let c = super::mie::coefficients(m, x);
+    let c = crate::optics::mie::coefficients(m, x);
     let mut out = String::from("angle_deg,s1_re,s1_im,s2_re,s2_im\n");
     for t in thetas {
-        let (s1, s2) = super::mie::amplitudes(&c, t.to_radians().cos());
+        let (s1, s2) = crate::optics::mie::amplitudes(&c, t.to_radians().cos());
         writeln!(
             out,
             "{t},{:.17e},{:.17e},{:.17e},{:.17e}",

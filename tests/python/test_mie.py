@@ -1,4 +1,4 @@
-"""heron's Lorenz–Mie series (src/sky/mie.rs) against miepython 3.3.0 (pinned).
+"""heron's Lorenz–Mie series (src/optics/mie.rs) against miepython 3.3.0 (pinned).
 
 heron prints the amplitude functions of a sphere through a hidden debug subcommand,
 

@@ -39,9 +39,6 @@
 use super::mie::{self, MieCoefficients};
 use num_complex::Complex64;
 
-/// The largest p accepted by the CLI and the scene (p = 0 … 20).
-pub const MAX_TERM: u32 = 20;
-
 /// One partial wave's interface coefficients for one polarisation.
 #[derive(Clone, Copy, Debug)]
 pub struct Interface {
@@ -73,7 +70,7 @@ impl Interface {
 /// downward logarithmic derivative (stable for n > z, where upward ψ is not), χ_n by its
 /// (stable) upward recurrence, ξ′_n = ξ_{n−1} − n ξ_n / z.
 fn riccati_xi(z: f64, nmax: usize) -> (Vec<Complex64>, Vec<Complex64>) {
-    let d = mie::log_derivative_psi(z, nmax);
+    let d = mie::log_derivative(z, nmax);
     let mut psi = z.sin();
     let (mut chi0, mut chi1) = (-z.sin(), z.cos());
     let mut xi_prev = Complex64::new(psi, -chi1);
