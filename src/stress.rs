@@ -279,7 +279,7 @@ fn check_eval(
     r: &mut CaseReport,
     at: &dyn Fn() -> String,
 ) {
-    let f = m.eval(wo, wi, wl, ctx);
+    let f = m.eval(wo, wi, wl, ctx).f;
     let pdf = m.pdf(wo, wi, wl, ctx);
     if !(finite(&f) && pdf >= 0.0 && pdf.is_finite()) {
         r.fail(Failure::NonFinite, || {
@@ -376,7 +376,7 @@ fn shape_sample(
     let origin = p - 2.0 * size * dir;
     let ray = Ray::new(origin, dir, 0.0, f32::INFINITY);
     r.rays += 1;
-    let Some(hit) = accel.intersect1(&crate::integrator::query(&ray)) else {
+    let Some(hit) = accel.intersect1(&ray.query()) else {
         return;
     };
     let wl = SampledWavelengths::<LANES>::sample(WavelengthSampler::Visible, rng.uniform());
@@ -443,7 +443,7 @@ fn shape_sample(
             continue;
         }
         r.rays += 1;
-        let next = accel.intersect1(&crate::integrator::query(&out));
+        let next = accel.intersect1(&out.query());
         if let Some(kind) = left.classify(&out, next.as_ref()) {
             r.fail(kind, || {
                 let met = next.map_or("nothing".to_string(), |h2| {

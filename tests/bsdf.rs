@@ -197,11 +197,14 @@ fn bsdf_chi2<const N: usize>(
                 let uc = r.uniform();
                 let u = Vec2::new(r.uniform(), r.uniform());
                 let s = m.sample(wo, uc, u, wl, &ctx)?;
-                let f = m.eval(wo, s.wi, wl, &ctx);
-                let f_ok = (0..N).all(|i| {
-                    let (a, b) = (s.f.0[i], f.0[i]);
-                    a.is_finite() && a >= 0.0 && (a - b).abs() <= 1e-3 * a.max(b) + 1e-30
-                });
+                let e = m.eval(wo, s.wi, wl, &ctx);
+                let f = e.f;
+                // eval reports the end of the companions exactly when sample does.
+                let f_ok = e.ended_companions == s.ended_companions
+                    && (0..N).all(|i| {
+                        let (a, b) = (s.f.0[i], f.0[i]);
+                        a.is_finite() && a >= 0.0 && (a - b).abs() <= 1e-3 * a.max(b) + 1e-30
+                    });
                 let ok = s.wi.is_finite()
                     && (s.wi.length() - 1.0).abs() < 1e-4
                     && !s.is_specular()
@@ -211,8 +214,14 @@ fn bsdf_chi2<const N: usize>(
                     nbad += 1;
                     if bad.len() < 4 {
                         bad.push(format!(
-                            "wi {:?}: f {:?} vs eval {:?}, pdf {}, flags {:?}",
-                            s.wi, s.f.0, f.0, s.pdf, s.flags
+                            "wi {:?}: f {:?} vs eval {:?}, ended {} vs {}, pdf {}, flags {:?}",
+                            s.wi,
+                            s.f.0,
+                            f.0,
+                            s.ended_companions,
+                            e.ended_companions,
+                            s.pdf,
+                            s.flags
                         ));
                     }
                 }
@@ -537,8 +546,8 @@ fn reflection_is_reciprocal() {
                 if wi.z * wo.z < 0.0 {
                     wi.z = -wi.z;
                 }
-                let a = m.eval(wo, wi, &wl1(), &c).0[0];
-                let b = m.eval(wi, wo, &wl1(), &c).0[0];
+                let a = m.eval(wo, wi, &wl1(), &c).f.0[0];
+                let b = m.eval(wi, wo, &wl1(), &c).f.0[0];
                 let h = (wo + wi).normalize();
                 let rel =
                     if dielectric && wo.z < 0.0 && (wo.dot(h).abs() - COS_CRITICAL).abs() < 1e-3 {
@@ -588,9 +597,9 @@ fn transmission_obeys_the_adjoint_relation() {
             if wi.z * wo.z > 0.0 {
                 wi.z = -wi.z;
             }
-            let f_rad = m.eval(wo, wi, &wl1(), &rad).0[0];
-            let f_imp_swapped = m.eval(wi, wo, &wl1(), &imp).0[0];
-            let f_rad_swapped = m.eval(wi, wo, &wl1(), &rad).0[0];
+            let f_rad = m.eval(wo, wi, &wl1(), &rad).f.0[0];
+            let f_imp_swapped = m.eval(wi, wo, &wl1(), &imp).f.0[0];
+            let f_rad_swapped = m.eval(wi, wo, &wl1(), &rad).f.0[0];
             let (no, ni) = if wo.z > 0.0 {
                 (n_out, n_in)
             } else {
@@ -664,7 +673,7 @@ fn pdf_is_zero_exactly_where_eval_is() {
             let c = ctx::<1>(mode);
             check(
                 &format!("{name}, {mode:?}"),
-                &|wo, wi| !m.eval(wo, wi, &wl1(), &c).is_zero(),
+                &|wo, wi| !m.eval(wo, wi, &wl1(), &c).f.is_zero(),
                 &|wo, wi| m.pdf(wo, wi, &wl1(), &c),
             );
         }
@@ -676,7 +685,7 @@ fn pdf_is_zero_exactly_where_eval_is() {
         c.companions_alive = alive;
         check(
             &format!("RoughDielectric N-SF11, 4 lanes, alive = {alive}"),
-            &|wo, wi| !m.eval(wo, wi, &wl4(), &c).is_zero(),
+            &|wo, wi| !m.eval(wo, wi, &wl4(), &c).f.is_zero(),
             &|wo, wi| m.pdf(wo, wi, &wl4(), &c),
         );
     }
@@ -695,7 +704,7 @@ fn pdf_is_zero_exactly_where_eval_is() {
     let c = ctx::<1>(TransportMode::Radiance).with_lobes(NON_DELTA);
     check(
         "Glossy over glass, non-delta lobes",
-        &|wo, wi| !m.eval(wo, wi, &wl1(), &c).is_zero(),
+        &|wo, wi| !m.eval(wo, wi, &wl1(), &c).f.is_zero(),
         &|wo, wi| m.pdf(wo, wi, &wl1(), &c),
     );
 }
@@ -735,7 +744,7 @@ fn albedo_by_sampling<const N: usize>(
 /// chi-square helper (error per cell below 1e-8).
 fn albedo_by_quadrature(m: &Material, wo: Vec3, c: &BsdfContext) -> f64 {
     Spherical::sphere(Vec3::Z).integrate(
-        |wi| m.eval(wo, wi, &wl1(), c).0[0] as f64 * wi.z.abs() as f64,
+        |wi| m.eval(wo, wi, &wl1(), c).f.0[0] as f64 * wi.z.abs() as f64,
         1e-8,
     )
 }
@@ -1020,8 +1029,11 @@ fn rough_dielectric_dispersion_semantics() {
         let wt = refracted(wo, n0).unwrap();
         let wi = (wt + Vec3::new(0.05, -0.03, 0.0)).normalize();
         assert!(wi.z * wo.z < 0.0);
-        let f_alive = m.eval(wo, wi, &wl, &alive);
-        let f_dead = m.eval(wo, wi, &wl, &dead);
+        let e_alive = m.eval(wo, wi, &wl, &alive);
+        let e_dead = m.eval(wo, wi, &wl, &dead);
+        // The evaluation says it ended the companions, once.
+        assert!(e_alive.ended_companions && !e_dead.ended_companions);
+        let (f_alive, f_dead) = (e_alive.f, e_dead.f);
         assert!(f_dead.0[0] > 0.0);
         assert!(
             (f_alive.0[0] - 4.0 * f_dead.0[0]).abs() <= 1e-5 * f_alive.0[0],
@@ -1032,7 +1044,9 @@ fn rough_dielectric_dispersion_semantics() {
         assert!(f_alive.0[1..].iter().all(|&v| v == 0.0), "{:?}", f_alive.0);
         // A reflection pair keeps every lane, lane i with F(λi).
         let wr = (mirror_dir(wo) + Vec3::new(0.04, 0.02, 0.0)).normalize();
-        let f = m.eval(wo, wr, &wl, &alive);
+        let e = m.eval(wo, wr, &wl, &alive);
+        assert!(!e.ended_companions);
+        let f = e.f;
         let h = (wo + wr).normalize();
         let h = if h.z < 0.0 { -h } else { h };
         let cos = wo.dot(h).abs();
@@ -1073,7 +1087,9 @@ fn rough_dielectric_dispersion_semantics() {
         }
         assert!(nt > 1000 && nr > 1000, "{nt} {nr}");
         // A non-dispersive index keeps every lane on a transmission too.
-        let f = glass_m.eval(wo, refracted(wo, 1.5).unwrap(), &wl, &alive);
+        let e = glass_m.eval(wo, refracted(wo, 1.5).unwrap(), &wl, &alive);
+        assert!(!e.ended_companions);
+        let f = e.f;
         assert!(
             f.0.iter()
                 .all(|&v| v > 0.0 && (v - f.0[0]).abs() < 1e-6 * v),
@@ -1099,7 +1115,7 @@ fn delta_materials_have_no_density() {
         let c = ctx::<1>(TransportMode::Radiance);
         for _ in 0..1000 {
             let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
-            assert!(m.eval(wo, wi, &wl1(), &c).is_zero());
+            assert!(m.eval(wo, wi, &wl1(), &c).f.is_zero());
             assert_eq!(m.pdf(wo, wi, &wl1(), &c), 0.0);
             let s = m.sample(wo, rng.uniform(), Vec2::ZERO, &wl1(), &c).unwrap();
             assert!(s.is_specular());

@@ -7,10 +7,10 @@
 //! user's table. A metal's reflectance depends on wavelength but its direction does
 //! not, so every lane is kept.
 use super::fresnel::fresnel_conductor;
-use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags};
+use super::{reflect_local, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 impl ComplexIor {
     /// R(cos θ) per lane.
@@ -36,11 +36,29 @@ pub struct Conductor {
 
 const LOBE: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::REFLECTION);
 
-impl Conductor {
+impl BsdfModel for Conductor {
     #[inline]
-    pub fn sample<const N: usize>(
+    fn flags(&self) -> LobeFlags {
+        LOBE
+    }
+
+    #[inline]
+    fn eval<const N: usize>(
+        &self,
+        _: Vec3,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> BsdfEval<N> {
+        BsdfEval::zero()
+    }
+
+    #[inline]
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
+        _: f32,
+        _: Vec2,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
@@ -57,5 +75,16 @@ impl Conductor {
             eta: 1.0,
             ended_companions: false,
         })
+    }
+
+    #[inline]
+    fn pdf<const N: usize>(
+        &self,
+        _: Vec3,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> f32 {
+        0.0
     }
 }

@@ -20,10 +20,12 @@
 //! both branches then end the companions. This is the one place in heron where that
 //! decision is written.
 use super::fresnel::fresnel_dielectric;
-use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags, TransportMode};
+use super::{
+    reflect_local, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags, TransportMode,
+};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
@@ -94,8 +96,11 @@ impl Dielectric {
     pub fn fresnel_r(&self, wo: Vec3, lambda: f32) -> f32 {
         fresnel_dielectric(wo.z.abs(), self.ior1_over_ior2(lambda, wo.z > 0.0))
     }
+}
 
-    pub fn flags(&self) -> LobeFlags {
+impl BsdfModel for Dielectric {
+    #[inline]
+    fn flags(&self) -> LobeFlags {
         let t = if self.is_dispersive() {
             TRANS | LobeFlags::WAVELENGTH_DEPENDENT
         } else {
@@ -105,10 +110,22 @@ impl Dielectric {
     }
 
     #[inline]
-    pub fn sample<const N: usize>(
+    fn eval<const N: usize>(
+        &self,
+        _: Vec3,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> BsdfEval<N> {
+        BsdfEval::zero()
+    }
+
+    #[inline]
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
         uc: f32,
+        _: Vec2,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
@@ -176,6 +193,17 @@ impl Dielectric {
             eta: etap,
             ended_companions: split,
         })
+    }
+
+    #[inline]
+    fn pdf<const N: usize>(
+        &self,
+        _: Vec3,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> f32 {
+        0.0
     }
 }
 

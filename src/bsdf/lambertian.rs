@@ -3,9 +3,9 @@
 //!
 //! Two-sided, as the seed's shading with the normal turned toward the viewer is: light
 //! and viewer on the same side of the surface, either side.
-use super::{same_hemisphere, BsdfContext, BsdfSample, LobeFlags};
+use super::{same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
 use crate::math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{DenseSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -17,24 +17,31 @@ pub struct Lambertian {
 
 const LOBE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
 
-impl Lambertian {
+impl BsdfModel for Lambertian {
     #[inline]
-    pub fn eval<const N: usize>(
+    fn flags(&self) -> LobeFlags {
+        LOBE
+    }
+
+    #[inline]
+    fn eval<const N: usize>(
         &self,
         wo: Vec3,
         wi: Vec3,
         wl: &SampledWavelengths<N>,
-    ) -> SampledSpectrum<N> {
+        _: &BsdfContext,
+    ) -> BsdfEval<N> {
         if !same_hemisphere(wo, wi) {
-            return SampledSpectrum::zero();
+            return BsdfEval::zero();
         }
-        wl.eval(&self.rho_d) * FRAC_1_PI
+        BsdfEval::keep(wl.eval(&self.rho_d) * FRAC_1_PI)
     }
 
     #[inline]
-    pub fn sample<const N: usize>(
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
+        _: f32,
         u: Vec2,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
@@ -59,12 +66,18 @@ impl Lambertian {
             ended_companions: false,
         })
     }
-}
 
-#[inline]
-pub fn pdf(wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f32 {
-    if !ctx.lobes.allows(LOBE) || !same_hemisphere(wo, wi) {
-        return 0.0;
+    #[inline]
+    fn pdf<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        _: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> f32 {
+        if !ctx.lobes.allows(LOBE) || !same_hemisphere(wo, wi) {
+            return 0.0;
+        }
+        cosine_hemisphere_pdf(wi.z.abs())
     }
-    cosine_hemisphere_pdf(wi.z.abs())
 }

@@ -1,9 +1,9 @@
 //! Perfect specular reflector (seed, "Reflected rays"): the law of reflection,
 //! ωr = 2(ωi·n)n − ωi, with ωi pointing away from the surface. As a BSDF it is the
 //! delta ρs δ(ωi − ωr)/|cos θi|, so the throughput changes by ρs.
-use super::{reflect_local, BsdfContext, BsdfSample, LobeFlags};
+use super::{reflect_local, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
 use crate::spectrum::{DenseSpectrum, SampledWavelengths};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 pub use super::reflect;
 
@@ -15,11 +15,29 @@ pub struct Mirror {
 
 const LOBE: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::REFLECTION);
 
-impl Mirror {
+impl BsdfModel for Mirror {
     #[inline]
-    pub fn sample<const N: usize>(
+    fn flags(&self) -> LobeFlags {
+        LOBE
+    }
+
+    #[inline]
+    fn eval<const N: usize>(
+        &self,
+        _: Vec3,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> BsdfEval<N> {
+        BsdfEval::zero()
+    }
+
+    #[inline]
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
+        _: f32,
+        _: Vec2,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
@@ -35,5 +53,16 @@ impl Mirror {
             eta: 1.0,
             ended_companions: false,
         })
+    }
+
+    #[inline]
+    fn pdf<const N: usize>(
+        &self,
+        _: Vec3,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> f32 {
+        0.0
     }
 }

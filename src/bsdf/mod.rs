@@ -6,14 +6,18 @@
 //! seed; ωo is where the light goes (toward the camera for radiance), ωi where it comes
 //! from. A direction with z < 0 is on the inside (the back) of the surface.
 //!
-//! Integrators and `heron trace` only call [`Material::eval`], [`Material::sample`],
-//! [`Material::pdf`] and [`Material::flags`]: no integrator holds a material's formula.
+//! Every model implements the one signature of [`BsdfModel`] (`flags`, `eval`,
+//! `sample`, `pdf`; pbrt-v4's `BxDF`, Mitsuba 3's `BSDF`), and [`Material`] only
+//! dispatches to it. Integrators and `heron trace` only call [`Material::eval`],
+//! [`Material::sample`], [`Material::pdf`] and [`Material::flags`]: no integrator holds a
+//! material's formula, nor its rule for ending the companion wavelengths.
 //!
 //! **Wavelengths.** The result is a [`SampledSpectrum`], one value per lane. A scattering
 //! event whose *direction* depends on wavelength (refraction by a dispersive interface)
 //! cannot send every lane the same way: the sampled direction is the hero's (lane 0)
 //! and the other lanes end there. The ending is folded into f (hero × N, others × 0) and
-//! reported in [`BsdfSample::ended_companions`], so the integrator stops treating the
+//! reported in [`BsdfSample::ended_companions`] (and, for an evaluation in a given
+//! direction, [`BsdfEval::ended_companions`]), so the integrator stops treating the
 //! companions as alive ([`BsdfContext::companions_alive`]); see
 //! [`crate::spectrum::SampledSpectrum::terminate_secondary`] for why this is unbiased.
 //! Lobes whose direction does not depend on wavelength (any reflection) keep every lane,
@@ -164,6 +168,73 @@ impl BsdfContext {
     }
 }
 
+/// f(ωo, ωi) per lane and whether scattering from ωo into ωi ends the companion lanes
+/// (a dispersive transmission with the companions alive: f is then hero × N, others ×
+/// 0), so that a bidirectional connection through this event knows, as a path sampled
+/// through it does from [`BsdfSample::ended_companions`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfEval<const N: usize> {
+    pub f: SampledSpectrum<N>,
+    pub ended_companions: bool,
+}
+
+impl<const N: usize> BsdfEval<N> {
+    /// A value that keeps every lane.
+    #[inline]
+    pub fn keep(f: SampledSpectrum<N>) -> Self {
+        BsdfEval {
+            f,
+            ended_companions: false,
+        }
+    }
+
+    /// Nothing: a delta lobe, or a direction the model does not scatter into.
+    #[inline]
+    pub fn zero() -> Self {
+        Self::keep(SampledSpectrum::zero())
+    }
+}
+
+/// The one signature of every material model, in the local frame (z = outward normal;
+/// ωo, ωi pointing away from the surface). pbrt-v4 `BxDF::Flags/f/Sample_f/PDF`,
+/// Mitsuba 3 `BSDF::flags/eval/sample/pdf`.
+pub trait BsdfModel {
+    /// Every lobe the model may scatter into.
+    fn flags(&self) -> LobeFlags;
+
+    /// f(ωo, ωi) per lane (zero for delta lobes), and whether the event ends the
+    /// companions.
+    fn eval<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> BsdfEval<N>;
+
+    /// Samples ωi for ωo from `uc` (the choice of lobe) and `u` (the direction); None
+    /// when the sample carries no energy. The pdf is the hero's, conditioned on
+    /// `ctx.lobes`. `wo.z` is not zero.
+    fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> Option<BsdfSample<N>>;
+
+    /// Density (hero wavelength, solid angle) with which `sample` under `ctx.lobes`
+    /// returns ωi; zero for delta lobes.
+    fn pdf<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> f32;
+}
+
 /// A sampled direction (pbrt-v4 `BSDFSample`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BsdfSample<const N: usize> {
@@ -257,23 +328,30 @@ pub enum Material {
     RoughDielectric(RoughDielectric),
 }
 
+/// `match` over the models, the same call in every arm.
+macro_rules! dispatch {
+    ($self:expr, $m:ident => $call:expr) => {
+        match $self {
+            Material::Lambertian($m) => $call,
+            Material::Mirror($m) => $call,
+            Material::Dielectric($m) => $call,
+            Material::Glossy($m) => $call,
+            Material::Conductor($m) => $call,
+            Material::RoughConductor($m) => $call,
+            Material::RoughDielectric($m) => $call,
+        }
+    };
+}
+
 impl Material {
     /// Every lobe this material may scatter into.
     #[inline]
     pub fn flags(&self) -> LobeFlags {
-        match self {
-            Material::Lambertian(_) => LobeFlags::DIFFUSE | LobeFlags::REFLECTION,
-            Material::Mirror(_) | Material::Conductor(_) => {
-                LobeFlags::SPECULAR | LobeFlags::REFLECTION
-            }
-            Material::Dielectric(d) => d.flags(),
-            Material::Glossy(g) => g.flags(),
-            Material::RoughConductor(_) => LobeFlags::GLOSSY | LobeFlags::REFLECTION,
-            Material::RoughDielectric(d) => d.flags(),
-        }
+        dispatch!(self, m => m.flags())
     }
 
-    /// f(ωo, ωi) per lane, local frame. Zero for delta lobes.
+    /// f(ωo, ωi) per lane, local frame (zero for delta lobes), and whether the event
+    /// ends the companions.
     #[inline]
     pub fn eval<const N: usize>(
         &self,
@@ -281,21 +359,12 @@ impl Material {
         wi: Vec3,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
-    ) -> SampledSpectrum<N> {
-        match self {
-            Material::Lambertian(m) => m.eval(wo, wi, wl),
-            Material::Mirror(_) | Material::Conductor(_) | Material::Dielectric(_) => {
-                SampledSpectrum::zero()
-            }
-            Material::Glossy(m) => m.eval(wo, wi, wl),
-            Material::RoughConductor(m) => m.eval(wo, wi, wl),
-            Material::RoughDielectric(m) => m.eval(wo, wi, wl, ctx),
-        }
+    ) -> BsdfEval<N> {
+        dispatch!(self, m => m.eval(wo, wi, wl, ctx))
     }
 
-    /// Samples ωi for ωo from `uc` (the choice of lobe) and `u` (the direction); None
-    /// when the sample carries no energy. The pdf is the hero's, conditioned on
-    /// `ctx.lobes`.
+    /// Samples ωi for ωo ([`BsdfModel::sample`]); None also for a grazing ωo (z = 0),
+    /// which no model can scatter.
     #[inline]
     pub fn sample<const N: usize>(
         &self,
@@ -308,15 +377,7 @@ impl Material {
         if wo.z == 0.0 {
             return None;
         }
-        match self {
-            Material::Lambertian(m) => m.sample(wo, u, wl, ctx),
-            Material::Mirror(m) => m.sample(wo, wl, ctx),
-            Material::Dielectric(m) => m.sample(wo, uc, wl, ctx),
-            Material::Glossy(m) => m.sample(wo, uc, u, wl, ctx),
-            Material::Conductor(m) => m.sample(wo, wl, ctx),
-            Material::RoughConductor(m) => m.sample(wo, u, wl, ctx),
-            Material::RoughDielectric(m) => m.sample(wo, uc, u, wl, ctx),
-        }
+        dispatch!(self, m => m.sample(wo, uc, u, wl, ctx))
     }
 
     /// Density (hero wavelength, solid angle) with which `sample` under `ctx.lobes`
@@ -329,13 +390,7 @@ impl Material {
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> f32 {
-        match self {
-            Material::Lambertian(_) => lambertian::pdf(wo, wi, ctx),
-            Material::Mirror(_) | Material::Conductor(_) | Material::Dielectric(_) => 0.0,
-            Material::Glossy(m) => m.pdf(wo, wi, wl, ctx),
-            Material::RoughConductor(m) => m.pdf(wo, wi, ctx),
-            Material::RoughDielectric(m) => m.pdf(wo, wi, wl, ctx),
-        }
+        dispatch!(self, m => m.pdf(wo, wi, wl, ctx))
     }
 
     /// The smooth refractive interface of this material, if it has one (a dielectric, or

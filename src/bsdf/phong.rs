@@ -16,7 +16,10 @@
 //! the Phong part from the lights and continues through the base, as the course does;
 //! with ρd > 0 that combination can reflect more than it receives (the course's scenes
 //! use ρd = 0). The path tracer samples the same sum, base weight 1.
-use super::{reflect_local, same_hemisphere, BsdfContext, BsdfSample, Dielectric, LobeFlags};
+use super::{
+    reflect_local, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, Dielectric,
+    LobeFlags,
+};
 use crate::math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::math::Frame;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
@@ -61,20 +64,6 @@ fn lobe_pdf(s: f32, wr: Vec3, wi: Vec3) -> f32 {
 }
 
 impl Glossy {
-    pub fn flags(&self) -> LobeFlags {
-        let mut f = LobeFlags::NONE;
-        if self.rho_d.max_value() > 0.0 {
-            f = f | DIFFUSE;
-        }
-        if self.rho_s > 0.0 {
-            f = f | LOBE;
-        }
-        if let Some(b) = &self.base {
-            f = f | b.flags();
-        }
-        f
-    }
-
     /// Selection weights of the diffuse term, the lobe and the base under `ctx.lobes`:
     /// the mean of ρd over the lanes (so that a lane whose ρd is positive is never left
     /// without a sampling strategy), ρs, and 1 for the base's R + T.
@@ -110,21 +99,6 @@ impl Glossy {
     }
 
     #[inline]
-    pub fn eval<const N: usize>(
-        &self,
-        wo: Vec3,
-        wi: Vec3,
-        wl: &SampledWavelengths<N>,
-    ) -> SampledSpectrum<N> {
-        if !same_hemisphere(wo, wi) {
-            return SampledSpectrum::zero();
-        }
-        let fd = wl.eval(&self.rho_d) * FRAC_1_PI;
-        let fs = phong_specular(self.rho_s, self.shininess, wi, wo, Vec3::Z);
-        fd + SampledSpectrum::splat(fs)
-    }
-
-    #[inline]
     fn pdf_mix(&self, wo: Vec3, wi: Vec3, wd: f32, ws: f32, total: f32) -> f32 {
         if !same_hemisphere(wo, wi) || total <= 0.0 {
             return 0.0;
@@ -133,9 +107,42 @@ impl Glossy {
             + ws * lobe_pdf(self.shininess, reflect_local(wo), wi))
             / total
     }
+}
+
+impl BsdfModel for Glossy {
+    #[inline]
+    fn flags(&self) -> LobeFlags {
+        let mut f = LobeFlags::NONE;
+        if self.rho_d.max_value() > 0.0 {
+            f = f | DIFFUSE;
+        }
+        if self.rho_s > 0.0 {
+            f = f | LOBE;
+        }
+        if let Some(b) = &self.base {
+            f = f | b.flags();
+        }
+        f
+    }
 
     #[inline]
-    pub fn pdf<const N: usize>(
+    fn eval<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        wl: &SampledWavelengths<N>,
+        _: &BsdfContext,
+    ) -> BsdfEval<N> {
+        if !same_hemisphere(wo, wi) {
+            return BsdfEval::zero();
+        }
+        let fd = wl.eval(&self.rho_d) * FRAC_1_PI;
+        let fs = phong_specular(self.rho_s, self.shininess, wi, wo, Vec3::Z);
+        BsdfEval::keep(fd + SampledSpectrum::splat(fs))
+    }
+
+    #[inline]
+    fn pdf<const N: usize>(
         &self,
         wo: Vec3,
         wi: Vec3,
@@ -147,7 +154,7 @@ impl Glossy {
     }
 
     #[inline]
-    pub fn sample<const N: usize>(
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
         uc: f32,
@@ -167,7 +174,7 @@ impl Glossy {
             let pb = wb / total;
             let b = self.base.as_ref()?;
             let uc = ((uc - pd - ps) / pb).min(1.0 - f32::EPSILON / 2.0);
-            let mut s = b.sample(wo, uc, wl, ctx)?;
+            let mut s = b.sample(wo, uc, u, wl, ctx)?;
             s.pdf *= pb;
             return Some(s);
         }

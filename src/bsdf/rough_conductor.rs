@@ -7,9 +7,9 @@
 //! normals (Heitz 2018): pdf = D_ωo(ωm)/(4 |ωo·ωm|). Single scattering only, so energy
 //! is lost at high roughness (tests/bsdf.rs states how much).
 use super::microfacet::TrowbridgeReitz;
-use super::{reflect, same_hemisphere, BsdfContext, BsdfSample, LobeFlags};
+use super::{reflect, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
 use crate::spectrum::metals::ComplexIor;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::SampledWavelengths;
 use glam::{Vec2, Vec3};
 
 #[derive(Clone, Debug)]
@@ -34,24 +34,38 @@ impl RoughConductor {
         let h = h.normalize();
         Some(if h.z < 0.0 { -h } else { h })
     }
+}
+
+impl BsdfModel for RoughConductor {
+    #[inline]
+    fn flags(&self) -> LobeFlags {
+        LOBE
+    }
 
     #[inline]
-    pub fn eval<const N: usize>(
+    fn eval<const N: usize>(
         &self,
         wo: Vec3,
         wi: Vec3,
         wl: &SampledWavelengths<N>,
-    ) -> SampledSpectrum<N> {
+        _: &BsdfContext,
+    ) -> BsdfEval<N> {
         let Some(wm) = Self::half(wo, wi) else {
-            return SampledSpectrum::zero();
+            return BsdfEval::zero();
         };
         let d = &self.distribution;
         let k = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z.abs() * wi.z.abs());
-        self.ior.reflectance(wo.dot(wm).abs(), wl) * k
+        BsdfEval::keep(self.ior.reflectance(wo.dot(wm).abs(), wl) * k)
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f32 {
+    fn pdf<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        _: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> f32 {
         if !ctx.lobes.allows(LOBE) {
             return 0.0;
         }
@@ -62,9 +76,10 @@ impl RoughConductor {
     }
 
     #[inline]
-    pub fn sample<const N: usize>(
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
+        _: f32,
         u: Vec2,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,

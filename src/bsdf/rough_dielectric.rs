@@ -21,8 +21,8 @@
 use super::fresnel::fresnel_dielectric_signed;
 use super::microfacet::TrowbridgeReitz;
 use super::{
-    reflect, refract_eta, same_hemisphere, BsdfContext, BsdfSample, Dielectric, LobeFlags,
-    TransportMode,
+    reflect, refract_eta, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample,
+    Dielectric, LobeFlags, TransportMode,
 };
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -69,14 +69,6 @@ fn half(wo: Vec3, wi: Vec3, eta: f32) -> Option<(Vec3, f32, bool)> {
 }
 
 impl RoughDielectric {
-    pub fn flags(&self) -> LobeFlags {
-        if self.interface.is_dispersive() {
-            REFL | TRANS | LobeFlags::WAVELENGTH_DEPENDENT
-        } else {
-            REFL | TRANS
-        }
-    }
-
     /// Probabilities of reflection and transmission for Fresnel reflectance `r`.
     #[inline]
     fn choice(r: f32, ctx: &BsdfContext) -> (f32, f32) {
@@ -125,21 +117,32 @@ impl RoughDielectric {
         }
         f
     }
+}
+
+impl BsdfModel for RoughDielectric {
+    #[inline]
+    fn flags(&self) -> LobeFlags {
+        if self.interface.is_dispersive() {
+            REFL | TRANS | LobeFlags::WAVELENGTH_DEPENDENT
+        } else {
+            REFL | TRANS
+        }
+    }
 
     #[inline]
-    pub fn eval<const N: usize>(
+    fn eval<const N: usize>(
         &self,
         wo: Vec3,
         wi: Vec3,
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
-    ) -> SampledSpectrum<N> {
+    ) -> BsdfEval<N> {
         let eta = self.interface.eta(wl.lambda[0]);
         if eta == 1.0 {
-            return SampledSpectrum::zero();
+            return BsdfEval::zero();
         }
         let Some((wm, etap, is_reflection)) = half(wo, wi, eta) else {
-            return SampledSpectrum::zero();
+            return BsdfEval::zero();
         };
         let split = ctx.companions_alive && self.interface.is_dispersive();
         let cos_om = wo.dot(wm);
@@ -147,18 +150,21 @@ impl RoughDielectric {
         let d = &self.distribution;
         if is_reflection {
             let k = d.d(wm) * d.g(wo, wi) / (4.0 * wi.z.abs() * wo.z.abs());
-            return self.fresnel_lanes(cos_om, r, wl, split) * k;
+            return BsdfEval::keep(self.fresnel_lanes(cos_om, r, wl, split) * k);
         }
         let mut f =
             SampledSpectrum::splat((1.0 - r) * self.transmission_value(wo, wi, wm, etap, ctx.mode));
         if split {
             f.terminate_secondary();
         }
-        f
+        BsdfEval {
+            f,
+            ended_companions: split,
+        }
     }
 
     #[inline]
-    pub fn pdf<const N: usize>(
+    fn pdf<const N: usize>(
         &self,
         wo: Vec3,
         wi: Vec3,
@@ -187,7 +193,7 @@ impl RoughDielectric {
     }
 
     #[inline]
-    pub fn sample<const N: usize>(
+    fn sample<const N: usize>(
         &self,
         wo: Vec3,
         uc: f32,
@@ -200,7 +206,7 @@ impl RoughDielectric {
             // Equal indices are no interface, however rough: light passes straight
             // through, a delta (pbrt-v4 `DielectricBxDF` does the same). The microfacet
             // lobe would divide by the zero half vector ωo + ωi (found by heron stress).
-            return self.interface.sample(wo, uc, wl, ctx);
+            return self.interface.sample(wo, uc, u, wl, ctx);
         }
         let d = &self.distribution;
         let wm = d.sample_wm(wo, u);

@@ -1,4 +1,5 @@
 //! The ray of the lecture: origin, direction and the interval [t_min, t_max].
+use crate::accel::embree::RayQuery;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,5 +25,16 @@ impl Ray {
     #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
         self.origin + t * self.dir
+    }
+
+    /// The Embree query of this ray.
+    #[inline]
+    pub fn query(&self) -> RayQuery {
+        RayQuery {
+            origin: self.origin,
+            dir: self.dir,
+            tnear: self.t_min,
+            tfar: self.t_max,
+        }
     }
 }

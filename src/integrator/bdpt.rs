@@ -30,8 +30,8 @@
 //! bounce), then per camera bounce lobe 1D and direction 2D, then for each (s = 1, t)
 //! connection the light choice 1D and point 2D. Subpaths are at most [`MAX_VERTICES`]
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
-use super::lighttrace::pixel_of;
-use super::{query, Context, TraceCounters};
+use super::toolkit::{next_hit, occluded, pixel_of, LightPathStart};
+use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::film::Splats;
@@ -219,10 +219,8 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             companions_alive: alive,
             lobes: LobeFlags::ALL,
         };
-        let ends = alive
-            && wo_l.z * wi_l.z < 0.0
-            && material.flags().contains(LobeFlags::WAVELENGTH_DEPENDENT);
-        (material.eval(wo_l, wi_l, self.wl, &ctx), ends)
+        let e = material.eval(wo_l, wi_l, self.wl, &ctx);
+        (e.f, e.ended_companions)
     }
 
     /// Area density with which vertex `v` (reached from `prev`) samples `next`.
@@ -287,8 +285,8 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             return scene.escaped_radiance(-w, self.wl);
         }
         match scene.lights.get(v.light as usize) {
-            Some(Light::Area(a)) => a.l(v.n, w, self.wl),
-            _ => SampledSpectrum::zero(),
+            Some(light) => light.l(v.n, w, self.wl),
+            None => SampledSpectrum::zero(),
         }
     }
 
@@ -318,14 +316,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(mode);
         bsdf_ctx.companions_alive = N > 1 && !ended;
         loop {
-            let hit = match pending.take() {
-                Some(h) => h,
-                None => {
-                    counters.rays += 1;
-                    self.ctx.accel.intersect1(&query(&ray))
-                }
-            };
-            let Some(hit) = hit else {
+            let Some(hit) = next_hit(self.ctx, &ray, &mut pending, counters) else {
                 // A camera path that escapes ends on the lights at infinity.
                 if mode == TransportMode::Radiance && !scene.infinite_lights.is_empty() {
                     let mut v = Vertex::EMPTY;
@@ -398,20 +389,11 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         counters: &mut TraceCounters,
     ) -> usize {
         let scene = self.scene();
-        let u_light = sampler.get_1d();
-        let u_pos = sampler.get_2d();
-        let u_dir = sampler.get_2d();
-        let Some((li, pmf)) = scene.light_sampler.sample(u_light) else {
+        let Some(start) = LightPathStart::sample(self.ctx, self.wl, sampler) else {
             return 0;
         };
+        let (li, pmf, le) = (start.index, start.pmf, &start.le);
         let light = &scene.lights[li];
-        let Some(le) = light.sample_le(u_pos, u_dir, self.wl, &scene.bounds) else {
-            return 0;
-        };
-        if !(le.pdf_pos > 0.0) || !(le.pdf_dir > 0.0) || le.l.is_zero() {
-            return 0;
-        }
-        let cos = le.normal.map_or(1.0, |n| n.dot(le.dir).abs());
         let mut v = Vertex::EMPTY;
         v.kind = Kind::Light;
         v.light = li as u32;
@@ -427,7 +409,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         v.pdf_fwd = le.pdf_pos * pmf;
         v.delta = light.is_delta();
         path[0] = v;
-        let beta = le.l * (cos / (pmf * le.pdf_pos * le.pdf_dir));
+        let beta = start.beta();
         let ray = self.ctx.offset.spawn(&le.spawn_point(), le.dir);
         let n = self.random_walk(
             ray,
@@ -510,7 +492,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         g
     }
 
-    /// The shadow ray between two vertices ([`super::occluded`]).
+    /// The shadow ray between two vertices ([`occluded`]).
     fn blocked(
         &self,
         from: &SpawnPoint,
@@ -519,7 +501,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         to: &SpawnPoint,
         counters: &mut TraceCounters,
     ) -> bool {
-        super::occluded(self.ctx, from, w, dist, to, counters)
+        occluded(self.ctx, from, w, dist, to, counters)
     }
 
     /// The power-heuristic weight of strategy (s, t); `sampled` replaces the

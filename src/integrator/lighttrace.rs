@@ -19,21 +19,13 @@
 //!
 //! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
 //! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
-use super::{occluded, query, Context, TraceCounters};
+use super::toolkit::{next_hit, occluded, pixel_of, roulette, LightPathStart};
+use super::{Context, TraceCounters};
 use crate::bsdf::{BsdfContext, TransportMode};
 use crate::film::Splats;
 use crate::geometry::SpawnPoint;
-use crate::light::Light;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-
-/// The pixel index of a film position.
-#[inline]
-pub(crate) fn pixel_of(cam: &crate::camera::Camera, raster: (f32, f32)) -> u32 {
-    let x = (raster.0 as u32).min(cam.width - 1);
-    let y = (raster.1 as u32).min(cam.height - 1);
-    y * cam.width + x
-}
 
 /// Traces one light path and splats its connections to the camera; returns nothing for
 /// the pixel sample's own pixel.
@@ -47,30 +39,20 @@ pub fn radiance<const N: usize>(
     let scene = ctx.scene;
     let cam = &scene.camera;
     let settings = ctx.settings;
-    let u_light = sampler.get_1d();
-    let u_pos = sampler.get_2d();
-    let u_dir = sampler.get_2d();
     let zero = SampledSpectrum::<N>::zero();
-    let Some((li, pmf)) = scene.light_sampler.sample(u_light) else {
+    let Some(start) = LightPathStart::sample(ctx, wl, sampler) else {
         return zero;
     };
-    let light = &scene.lights[li];
-    let Some(le) = light.sample_le(u_pos, u_dir, wl, &scene.bounds) else {
-        return zero;
-    };
-    if !(le.pdf_pos > 0.0) || !(le.pdf_dir > 0.0) || le.l.is_zero() {
-        return zero;
-    }
-    let cos_l = le.normal.map_or(1.0, |n| n.dot(le.dir).abs());
+    let (le, pmf) = (&start.le, start.pmf);
     // Rays leave a light's surface as they leave any surface; other lights' origins are
     // in free space.
     let light_point = le.spawn_point();
     let eye = SpawnPoint::free(cam.eye);
 
     // An emitting surface seen by the camera: the light's own vertex.
-    if let (Light::Area(a), Some(n)) = (light, le.normal) {
+    if let Some(n) = le.normal {
         if let Some(cs) = cam.sample_wi(le.origin) {
-            let emitted = a.l(n, cs.wi, wl);
+            let emitted = scene.lights[start.index].l(n, cs.wi, wl);
             if !emitted.is_zero() && !occluded(ctx, &light_point, cs.wi, cs.dist, &eye, counters) {
                 let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
                 splats.add(pixel_of(cam, cs.raster), &(emitted * k), wl);
@@ -78,7 +60,7 @@ pub fn radiance<const N: usize>(
         }
     }
 
-    let mut beta = le.l * (cos_l / (pmf * le.pdf_pos * le.pdf_dir));
+    let mut beta = start.beta();
     // The light path's throughput carries the light's flux, whose size depends on the
     // scene's units (an area light's flux scales with its area); the roulette compares
     // the throughput with where it started, so that a scene scaled by 1e-4 is not
@@ -87,11 +69,7 @@ pub fn radiance<const N: usize>(
     let mut ray = ctx.offset.spawn(&light_point, le.dir);
     let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(TransportMode::Importance);
     let mut depth = 0u32;
-    loop {
-        counters.rays += 1;
-        let Some(hit) = ctx.accel.intersect1(&query(&ray)) else {
-            break;
-        };
+    while let Some(hit) = next_hit(ctx, &ray, &mut None, counters) {
         let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
         // The path has scattered `depth` times before this vertex; scattering here
         // toward the camera is one more.
@@ -108,7 +86,7 @@ pub fn radiance<const N: usize>(
         if flags.has_non_specular() {
             if let Some(cs) = cam.sample_wi(it.position) {
                 let wi = frame.to_local(cs.wi);
-                let f = material.eval(wo, wi, wl, &bsdf_ctx);
+                let f = material.eval(wo, wi, wl, &bsdf_ctx).f;
                 if !f.is_zero() && !occluded(ctx, &it.spawn_point(), cs.wi, cs.dist, &eye, counters)
                 {
                     let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
@@ -132,12 +110,8 @@ pub fn radiance<const N: usize>(
         ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
         // Russian roulette on the importance throughput, relative to the light's.
         let rr = beta.max_value() / beta_start;
-        if rr < 1.0 && depth >= settings.rr_depth {
-            let q = (1.0 - rr).max(0.0);
-            if u_rr < q {
-                break;
-            }
-            beta /= 1.0 - q;
+        if !roulette(&mut beta, rr, depth, settings.rr_depth, u_rr) {
+            break;
         }
     }
     zero

@@ -14,11 +14,12 @@
 pub mod bdpt;
 pub mod lighttrace;
 pub mod path;
+pub mod toolkit;
 pub mod whitted;
 
-use crate::accel::embree::{self, Hit, RayQuery};
+use crate::accel::embree::{self, Hit};
 use crate::film::Splats;
-use crate::geometry::{Ray, RayOffset, SpawnPoint};
+use crate::geometry::{Ray, RayOffset};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
@@ -132,34 +133,4 @@ pub fn kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> RadianceF
         IntegratorKind::LightTrace => lighttrace_any::<N>,
         IntegratorKind::Bdpt => bdpt_any::<N>,
     }
-}
-
-#[inline]
-pub(crate) fn query(ray: &Ray) -> RayQuery {
-    RayQuery {
-        origin: ray.origin,
-        dir: ray.dir,
-        tnear: ray.t_min,
-        tfar: ray.t_max,
-    }
-}
-
-/// Whether the shadow ray from `from` toward `to`, which lies along unit `wi` at
-/// distance `dist` (infinite: a light at infinity), is blocked, with the cutoffs of the
-/// render's [`RayOffset`] (the seed's: t_min = ε, t_max = dist − ε). Points too close to
-/// tell apart count as blocked.
-#[inline]
-pub(crate) fn occluded(
-    ctx: &Context,
-    from: &SpawnPoint,
-    wi: glam::Vec3,
-    dist: f32,
-    to: &SpawnPoint,
-    counters: &mut TraceCounters,
-) -> bool {
-    let Some(q) = ctx.offset.shadow(from, wi, dist, to) else {
-        return true;
-    };
-    counters.shadow_rays += 1;
-    ctx.accel.occluded1(&q)
 }

@@ -39,18 +39,22 @@
 //! pairs: a light sample's weight has the denominator mean_λ r_u (p_light + p_λ(ω) T_λ),
 //! where T_λ is the phase sample's chance of flying to the light unscattered. When a
 //! dispersive refraction has ended the companions, the hero's own densities are used.
-use super::{occluded, query, Context, TraceCounters};
+use super::toolkit::{
+    light_pdf, next_hit, occluded, roulette, sample_light, transmittance, MAX_CROSSINGS,
+};
+use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
-use crate::bsdf::BsdfContext;
-use crate::geometry::Ray;
-use crate::geometry::SpawnPoint;
-use crate::light::{Light, SurfacePoint};
+use crate::bsdf::{BsdfContext, Material};
+use crate::geometry::{Interaction, Ray, SpawnPoint};
+use crate::light::SurfacePoint;
 use crate::math::warp::power_heuristic;
-use crate::medium::NO_MEDIUM;
+use crate::math::Frame;
+use crate::medium::{Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
-use crate::scene::NO_LIGHT;
+use crate::scene::{Scene, NO_LIGHT};
 use crate::settings::{on, KernelFlags, EMITTERS, ESCAPE, MEDIA, SHADOWS};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::{Vec2, Vec3};
 
 /// Radiance arriving along the camera ray `ray` at the wavelengths `wl`.
 ///
@@ -67,149 +71,31 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
     let scene = ctx.scene;
-    let settings = ctx.settings;
-    let mut l = SampledSpectrum::<N>::zero();
-    let mut beta = SampledSpectrum::<N>::splat(1.0);
-    let mut bsdf_ctx = BsdfContext::radiance::<N>();
-    // State of the previous bounce, for MIS when a BSDF sample reaches a light.
-    let mut specular_bounce = true;
-    let mut prev_p = ray.origin;
-    let mut prev_pdf = 0.0f32;
-    let mut eta_scale = 1.0f32;
-    let mut depth = 0u32;
+    let mut s = PathState::<N>::start(ray.origin);
     let mut pending = first_hit;
-    // Media state: the current medium, the rescaled path probabilities (unidirectional
-    // r_u; r_l for a light reached from the last medium vertex, before its light pdf),
-    // whether the last scattering vertex was in a medium, and the boundaries crossed
-    // without a bounce (bounded, against a ray caught between coincident boundaries).
-    let mut medium = NO_MEDIUM;
-    let mut r_u = SampledSpectrum::<N>::splat(1.0);
-    let mut r_l = SampledSpectrum::<N>::splat(1.0);
-    let mut prev_medium = false;
-    let mut crossings = 0u32;
     loop {
-        let hit = match pending.take() {
-            Some(h) => h,
-            None => {
-                counters.rays += 1;
-                ctx.accel.intersect1(&query(&ray))
-            }
-        };
-        if on(K, MEDIA) && medium != NO_MEDIUM {
-            let m = &scene.media[medium as usize];
+        let hit = next_hit(ctx, &ray, &mut pending, counters);
+        if on(K, MEDIA) && s.medium != NO_MEDIUM {
             // A closed boundary always stops a ray inside; a ray that escapes it leaked.
-            let Some(h) = hit else { break };
-            let sigma_t = m.sigma_t(wl);
-            let u_dist = sampler.get_1d();
-            let s0 = sigma_t.0[0];
-            let t = if s0 > 0.0 {
-                -(1.0 - u_dist).ln() / s0
-            } else {
-                f32::INFINITY
-            };
-            if t < h.t {
-                // A collision: scattering with probability σ_s/σ_t per lane, in the weight.
-                let tr = exp_neg(sigma_t, t);
-                let pdf = tr.0[0] * s0;
-                beta *= m.sigma_s(wl) * tr / pdf;
-                r_u *= sigma_t * tr / pdf;
-                if depth == settings.max_depth || beta.is_zero() {
-                    break;
-                }
-                depth += 1;
-                let p = ray.at(t);
-                let u_light = sampler.get_1d();
-                let u_light_point = sampler.get_2d();
-                let u_node = sampler.get_1d();
-                let u_dir = sampler.get_2d();
-                let u_rr = sampler.get_1d();
-                let alive = bsdf_ctx.companions_alive;
-                if on(K, SHADOWS) {
-                    if let Some((li, pmf)) = scene.light_sampler.sample(u_light) {
-                        let light = &scene.lights[li];
-                        if let Some(ls) = light.sample_li(p, u_light_point, wl) {
-                            if ls.pdf > 0.0 && !ls.l.is_zero() {
-                                let f = m.phase(ray.dir, ls.wi, wl);
-                                let tr_l = if f.is_zero() {
-                                    None
-                                } else {
-                                    transmittance(
-                                        ctx,
-                                        &SpawnPoint::free(p),
-                                        ls.wi,
-                                        ls.dist,
-                                        &ls.target(),
-                                        medium,
-                                        wl,
-                                        counters,
-                                    )
-                                };
-                                if let Some(tr_l) = tr_l {
-                                    let p_l = pmf * ls.pdf;
-                                    let denom = if ls.delta {
-                                        lane_mean(r_u * p_l, alive)
-                                    } else {
-                                        lane_mean(
-                                            r_u * (SampledSpectrum::splat(p_l) + f * tr_l),
-                                            alive,
-                                        )
-                                    };
-                                    if denom > 0.0 {
-                                        l += beta * f * tr_l * ls.l / denom;
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-                let (wi, pv) = m.sample_phase(ray.dir, u_node, u_dir, wl);
-                let pdf = pv.0[0];
-                if !(pdf > 0.0) {
-                    break;
-                }
-                beta *= pv / pdf;
-                r_l = r_u / pdf;
-                r_u *= pv / pdf;
-                specular_bounce = false;
-                prev_medium = true;
-                prev_p = p;
-                prev_pdf = pdf;
-                ray = crate::geometry::Ray::new(p, wi, 0.0, f32::INFINITY);
-                if beta.is_zero() {
-                    break;
-                }
-                let rr = beta.max_value() * eta_scale / lane_mean(r_u, alive);
-                if rr < 1.0 && depth >= settings.rr_depth {
-                    let q = (1.0 - rr).max(0.0);
-                    if u_rr < q {
-                        break;
-                    }
-                    beta /= 1.0 - q;
-                }
-                continue;
+            let Some(h) = &hit else { break };
+            match medium_segment::<N, K>(ctx, &mut s, &mut ray, h, wl, sampler, counters) {
+                Segment::Scattered => continue,
+                Segment::Ended => break,
+                Segment::Crossed => {}
             }
-            // Flew to the boundary (or a surface inside) unscattered.
-            let tr = exp_neg(sigma_t, h.t);
-            let pdf = tr.0[0];
-            if !(pdf > 0.0) {
-                break;
-            }
-            beta *= tr / pdf;
-            r_u *= tr / pdf;
-            r_l /= pdf;
         }
         if on(K, MEDIA) {
             if let Some(h) = &hit {
                 if scene.shape_interface[h.geom_id as usize] {
                     // An index-matched boundary: cross it, switching media, no bounce.
                     let (it, _) = scene.interaction(&ray, h, ctx.offset.is_robust());
-                    medium = if ray.dir.dot(it.n_outward) < 0.0 {
+                    s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
                         scene.shape_medium[h.geom_id as usize]
                     } else {
                         NO_MEDIUM
                     };
-                    crossings += 1;
-                    if crossings > MAX_CROSSINGS {
+                    s.crossings += 1;
+                    if s.crossings > MAX_CROSSINGS {
                         break;
                     }
                     ray = ctx.offset.spawn(&it.spawn_point(), ray.dir);
@@ -219,186 +105,409 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         }
         // The lanes' mean of r_u (1 without media) divides every contribution found.
         let mis = if on(K, MEDIA) {
-            lane_mean(r_u, bsdf_ctx.companions_alive)
+            lane_mean(s.r_u, s.bsdf_ctx.companions_alive)
         } else {
             1.0
         };
         let Some(hit) = hit else {
-            if !on(K, ESCAPE) {
-                break;
-            }
-            for &i in &scene.infinite_lights {
-                let light = &scene.lights[i as usize];
-                let le = light.le(ray.dir, wl);
-                if le.is_zero() {
-                    continue;
-                }
-                if specular_bounce {
-                    l += beta * le / mis;
-                } else {
-                    let p_l =
-                        scene.light_sampler.pmf(i as usize) * light.pdf_li(prev_p, ray.dir, None);
-                    if on(K, MEDIA) && prev_medium {
-                        let d = lane_mean(r_u + r_l * p_l, bsdf_ctx.companions_alive);
-                        l += beta * le / d;
-                    } else {
-                        l += beta * le * (power_heuristic(prev_pdf, p_l) / mis);
+            if on(K, ESCAPE) {
+                for &i in &scene.infinite_lights {
+                    let le = scene.lights[i as usize].le(ray.dir, wl);
+                    if !le.is_zero() {
+                        let (prev_p, dir) = (s.prev_p, ray.dir);
+                        s.add_found_light::<K>(le, mis, || {
+                            light_pdf(ctx, i as usize, prev_p, dir, None)
+                        });
                     }
                 }
             }
             break;
         };
-        let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
-        let wo = -ray.dir;
-
-        // Emission of an area light the path has reached.
-        let emitter = if on(K, EMITTERS) {
-            scene.shape_light[hit.geom_id as usize]
-        } else {
-            NO_LIGHT
-        };
-        if emitter != NO_LIGHT {
-            let light = &scene.lights[emitter as usize];
-            if let Light::Area(a) = light {
-                let le = a.l(it.n_outward, wo, wl);
-                if !le.is_zero() {
-                    if specular_bounce {
-                        l += beta * le / mis;
-                    } else {
-                        let sp = SurfacePoint {
-                            p: it.position,
-                            n: it.n_outward,
-                        };
-                        let p_l = scene.light_sampler.pmf(emitter as usize)
-                            * light.pdf_li(prev_p, ray.dir, Some(&sp));
-                        if on(K, MEDIA) && prev_medium {
-                            let d = lane_mean(r_u + r_l * p_l, bsdf_ctx.companions_alive);
-                            l += beta * le / d;
-                        } else {
-                            l += beta * le * (power_heuristic(prev_pdf, p_l) / mis);
-                        }
-                    }
-                }
-            }
-        }
-        if depth == settings.max_depth {
+        if !surface_vertex::<N, K>(ctx, &mut s, &mut ray, &hit, mis, wl, sampler, counters) {
             break;
-        }
-        depth += 1;
-
-        let u_light = sampler.get_1d();
-        let u_light_point = sampler.get_2d();
-        let u_lobe = sampler.get_1d();
-        let u_dir = sampler.get_2d();
-        let u_rr = sampler.get_1d();
-
-        let frame = it.frame();
-        let wo_local = frame.to_local(wo);
-        let flags = material.flags();
-
-        // Next-event estimation.
-        if on(K, SHADOWS) && flags.has_non_specular() {
-            if let Some((li, pmf)) = scene.light_sampler.sample(u_light) {
-                let light = &scene.lights[li];
-                if let Some(ls) = light.sample_li(it.position, u_light_point, wl) {
-                    let wi_local = frame.to_local(ls.wi);
-                    if ls.pdf > 0.0 && !ls.l.is_zero() {
-                        let f = material.eval(wo_local, wi_local, wl, &bsdf_ctx) * wi_local.z.abs();
-                        // Through media: the transmittance of the shadow ray (None: blocked).
-                        let tr_l = if f.is_zero() {
-                            None
-                        } else if on(K, MEDIA) {
-                            let from = if ls.wi.dot(it.n_outward) < 0.0 {
-                                scene.shape_medium[hit.geom_id as usize]
-                            } else {
-                                medium_outside(medium, scene, hit.geom_id)
-                            };
-                            transmittance(
-                                ctx,
-                                &it.spawn_point(),
-                                ls.wi,
-                                ls.dist,
-                                &ls.target(),
-                                from,
-                                wl,
-                                counters,
-                            )
-                        } else if occluded(
-                            ctx,
-                            &it.spawn_point(),
-                            ls.wi,
-                            ls.dist,
-                            &ls.target(),
-                            counters,
-                        ) {
-                            None
-                        } else {
-                            Some(SampledSpectrum::splat(1.0))
-                        };
-                        if let Some(tr_l) = tr_l {
-                            let p_l = pmf * ls.pdf;
-                            let w = if ls.delta {
-                                1.0
-                            } else {
-                                power_heuristic(
-                                    p_l,
-                                    material.pdf(wo_local, wi_local, wl, &bsdf_ctx),
-                                )
-                            };
-                            let f = if on(K, MEDIA) { f * tr_l } else { f };
-                            l += beta * f * ls.l * (w / (p_l * mis));
-                        }
-                    }
-                }
-            }
-        }
-
-        // The continuation.
-        let Some(bs) = material.sample(wo_local, u_lobe, u_dir, wl, &bsdf_ctx) else {
-            break;
-        };
-        beta *= bs.weight();
-        specular_bounce = bs.is_specular();
-        prev_medium = false;
-        prev_pdf = bs.pdf;
-        prev_p = it.position;
-        if bs.ended_companions {
-            bsdf_ctx.companions_alive = false;
-        }
-        if bs.is_transmission() {
-            eta_scale *= bs.eta * bs.eta;
-        }
-        ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
-        if on(K, MEDIA) && bs.is_transmission() {
-            // Through a dielectric around a medium (a glass of milk) into or out of it.
-            let g = hit.geom_id as usize;
-            medium = if ray.dir.dot(it.n_outward) < 0.0 {
-                scene.shape_medium[g]
-            } else {
-                medium_outside(medium, scene, hit.geom_id)
-            };
-        }
-        if beta.is_zero() {
-            break;
-        }
-
-        // Russian roulette (pbrt-v4 §13.4.2): on the throughput with refractions' η²
-        // undone, so a path inside glass is not ended for having crossed into it (and,
-        // with media, divided by the lanes' mean r_u, as contributions are).
-        let rr = beta.max_value() * eta_scale / mis;
-        if rr < 1.0 && depth >= settings.rr_depth {
-            let q = (1.0 - rr).max(0.0);
-            if u_rr < q {
-                break;
-            }
-            beta /= 1.0 - q;
         }
     }
-    l
+    s.l
 }
 
-/// The most boundaries a path or shadow ray crosses between two bounces.
-const MAX_CROSSINGS: u32 = 256;
+/// What a path carries from one vertex to the next.
+struct PathState<const N: usize> {
+    /// Radiance found so far.
+    l: SampledSpectrum<N>,
+    /// Throughput.
+    beta: SampledSpectrum<N>,
+    bsdf_ctx: BsdfContext,
+    /// For MIS when a BSDF or phase sample reaches a light: whether the last vertex
+    /// scattered by a delta lobe, where it was, the density of its direction, and
+    /// whether it was in a medium.
+    specular_bounce: bool,
+    prev_p: Vec3,
+    prev_pdf: f32,
+    prev_medium: bool,
+    /// The product of the refractions' η², undone by the roulette.
+    eta_scale: f32,
+    /// Scattering events so far.
+    depth: u32,
+    /// The medium the path is in, the rescaled path probabilities (unidirectional r_u;
+    /// r_l for a light reached from the last medium vertex, before its light pdf), and
+    /// the boundaries crossed without a bounce (bounded, against a ray caught between
+    /// coincident boundaries).
+    medium: u32,
+    r_u: SampledSpectrum<N>,
+    r_l: SampledSpectrum<N>,
+    crossings: u32,
+}
+
+impl<const N: usize> PathState<N> {
+    #[inline(always)]
+    fn start(origin: Vec3) -> Self {
+        PathState {
+            l: SampledSpectrum::zero(),
+            beta: SampledSpectrum::splat(1.0),
+            bsdf_ctx: BsdfContext::radiance::<N>(),
+            specular_bounce: true,
+            prev_p: origin,
+            prev_pdf: 0.0,
+            prev_medium: false,
+            eta_scale: 1.0,
+            depth: 0,
+            medium: NO_MEDIUM,
+            r_u: SampledSpectrum::splat(1.0),
+            r_l: SampledSpectrum::splat(1.0),
+            crossings: 0,
+        }
+    }
+
+    /// Adds radiance `le` from a light the path reached by BSDF or phase sampling:
+    /// whole after a delta lobe, else weighted against light sampling, whose density
+    /// `p_light` gives (the power heuristic after a surface, the balance heuristic over
+    /// the lanes after a medium vertex); `mis` is the lanes' mean r_u.
+    #[inline(always)]
+    fn add_found_light<const K: KernelFlags>(
+        &mut self,
+        le: SampledSpectrum<N>,
+        mis: f32,
+        p_light: impl FnOnce() -> f32,
+    ) {
+        if self.specular_bounce {
+            self.l += self.beta * le / mis;
+            return;
+        }
+        let p_l = p_light();
+        if on(K, MEDIA) && self.prev_medium {
+            let d = lane_mean(self.r_u + self.r_l * p_l, self.bsdf_ctx.companions_alive);
+            self.l += self.beta * le / d;
+        } else {
+            self.l += self.beta * le * (power_heuristic(self.prev_pdf, p_l) / mis);
+        }
+    }
+}
+
+/// How a segment through a medium ended.
+enum Segment {
+    /// It scattered in the medium; the ray now leaves that vertex.
+    Scattered,
+    /// The path ended there.
+    Ended,
+    /// It reached the surface it was traced to, unscattered.
+    Crossed,
+}
+
+/// The segment of `ray` inside the current medium up to `h`: a free flight sampled by
+/// the hero's σ_t, then either scattering (next-event estimation and a phase sample) or
+/// the surface, with the lanes' weights and rescaled probabilities updated.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn medium_segment<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    h: &Hit,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+) -> Segment {
+    let m = &ctx.scene.media[s.medium as usize];
+    let sigma_t = m.sigma_t(wl);
+    let u_dist = sampler.get_1d();
+    let s0 = sigma_t.0[0];
+    let t = if s0 > 0.0 {
+        -(1.0 - u_dist).ln() / s0
+    } else {
+        f32::INFINITY
+    };
+    if t >= h.t {
+        // Flew to the boundary (or a surface inside) unscattered.
+        let tr = exp_neg(sigma_t, h.t);
+        let pdf = tr.0[0];
+        if !(pdf > 0.0) {
+            return Segment::Ended;
+        }
+        s.beta *= tr / pdf;
+        s.r_u *= tr / pdf;
+        s.r_l /= pdf;
+        return Segment::Crossed;
+    }
+    // A collision: scattering with probability σ_s/σ_t per lane, in the weight.
+    let tr = exp_neg(sigma_t, t);
+    let pdf = tr.0[0] * s0;
+    s.beta *= m.sigma_s(wl) * tr / pdf;
+    s.r_u *= sigma_t * tr / pdf;
+    if s.depth == ctx.settings.max_depth || s.beta.is_zero() {
+        return Segment::Ended;
+    }
+    s.depth += 1;
+    let p = ray.at(t);
+    let u_light = sampler.get_1d();
+    let u_light_point = sampler.get_2d();
+    let u_node = sampler.get_1d();
+    let u_dir = sampler.get_2d();
+    let u_rr = sampler.get_1d();
+    let alive = s.bsdf_ctx.companions_alive;
+    if on(K, SHADOWS) {
+        if let Some(ld) =
+            medium_direct_light(ctx, s, m, ray.dir, p, u_light, u_light_point, wl, counters)
+        {
+            s.l += ld;
+        }
+    }
+    let (wi, pv) = m.sample_phase(ray.dir, u_node, u_dir, wl);
+    let pdf = pv.0[0];
+    if !(pdf > 0.0) {
+        return Segment::Ended;
+    }
+    s.beta *= pv / pdf;
+    s.r_l = s.r_u / pdf;
+    s.r_u *= pv / pdf;
+    s.specular_bounce = false;
+    s.prev_medium = true;
+    s.prev_p = p;
+    s.prev_pdf = pdf;
+    *ray = Ray::new(p, wi, 0.0, f32::INFINITY);
+    if s.beta.is_zero() {
+        return Segment::Ended;
+    }
+    let rr = s.beta.max_value() * s.eta_scale / lane_mean(s.r_u, alive);
+    if !roulette(&mut s.beta, rr, s.depth, ctx.settings.rr_depth, u_rr) {
+        return Segment::Ended;
+    }
+    Segment::Scattered
+}
+
+/// Next-event estimation at a scattering event in medium `m` at `p` (the ray arrived
+/// along `dir`): a light sample, its transmittance through the media on the way, and the
+/// balance heuristic over (technique, hero) pairs against phase sampling, whose density
+/// toward the light is p_λ(ω) T_λ (the chance of flying there unscattered).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn medium_direct_light<const N: usize>(
+    ctx: &Context,
+    s: &PathState<N>,
+    m: &Medium,
+    dir: Vec3,
+    p: Vec3,
+    u_light: f32,
+    u_light_point: Vec2,
+    wl: &SampledWavelengths<N>,
+    counters: &mut TraceCounters,
+) -> Option<SampledSpectrum<N>> {
+    let cl = sample_light(ctx, p, u_light, u_light_point, wl)?;
+    let ls = &cl.sample;
+    let f = m.phase(dir, ls.wi, wl);
+    if f.is_zero() {
+        return None;
+    }
+    let from = SpawnPoint::free(p);
+    let tr_l = transmittance(
+        ctx,
+        &from,
+        ls.wi,
+        ls.dist,
+        &ls.target(),
+        s.medium,
+        wl,
+        counters,
+    )?;
+    let alive = s.bsdf_ctx.companions_alive;
+    let denom = if ls.delta {
+        lane_mean(s.r_u * cl.pdf, alive)
+    } else {
+        lane_mean(s.r_u * (SampledSpectrum::splat(cl.pdf) + f * tr_l), alive)
+    };
+    (denom > 0.0).then(|| s.beta * f * tr_l * ls.l / denom)
+}
+
+/// A surface vertex: the emission found there, next-event estimation, and the BSDF's
+/// continuation with Russian roulette. Returns false when the path ends.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn surface_vertex<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: &Hit,
+    mis: f32,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+) -> bool {
+    let scene = ctx.scene;
+    let (it, material) = scene.interaction(ray, hit, ctx.offset.is_robust());
+    let wo = -ray.dir;
+
+    // Emission of an area light the path has reached.
+    let emitter = if on(K, EMITTERS) {
+        scene.shape_light[hit.geom_id as usize]
+    } else {
+        NO_LIGHT
+    };
+    if emitter != NO_LIGHT {
+        let le = scene.lights[emitter as usize].l(it.n_outward, wo, wl);
+        if !le.is_zero() {
+            let (prev_p, dir) = (s.prev_p, ray.dir);
+            let sp = SurfacePoint {
+                p: it.position,
+                n: it.n_outward,
+            };
+            s.add_found_light::<K>(le, mis, || {
+                light_pdf(ctx, emitter as usize, prev_p, dir, Some(&sp))
+            });
+        }
+    }
+    if s.depth == ctx.settings.max_depth {
+        return false;
+    }
+    s.depth += 1;
+
+    let u_light = sampler.get_1d();
+    let u_light_point = sampler.get_2d();
+    let u_lobe = sampler.get_1d();
+    let u_dir = sampler.get_2d();
+    let u_rr = sampler.get_1d();
+
+    let frame = it.frame();
+    let wo_local = frame.to_local(wo);
+    if on(K, SHADOWS) && material.flags().has_non_specular() {
+        let v = SurfaceVertex {
+            it: &it,
+            geom: hit.geom_id,
+            material,
+            frame: &frame,
+            wo_local,
+        };
+        if let Some(ld) =
+            surface_direct_light::<N, K>(ctx, s, &v, mis, u_light, u_light_point, wl, counters)
+        {
+            s.l += ld;
+        }
+    }
+
+    // The continuation.
+    let Some(bs) = material.sample(wo_local, u_lobe, u_dir, wl, &s.bsdf_ctx) else {
+        return false;
+    };
+    s.beta *= bs.weight();
+    s.specular_bounce = bs.is_specular();
+    s.prev_medium = false;
+    s.prev_pdf = bs.pdf;
+    s.prev_p = it.position;
+    if bs.ended_companions {
+        s.bsdf_ctx.companions_alive = false;
+    }
+    if bs.is_transmission() {
+        s.eta_scale *= bs.eta * bs.eta;
+    }
+    *ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
+    if on(K, MEDIA) && bs.is_transmission() {
+        // Through a dielectric around a medium (a glass of milk) into or out of it.
+        s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
+            scene.shape_medium[hit.geom_id as usize]
+        } else {
+            medium_outside(s.medium, scene, hit.geom_id)
+        };
+    }
+    if s.beta.is_zero() {
+        return false;
+    }
+    // Russian roulette (pbrt-v4 §13.4.2): on the throughput with refractions' η²
+    // undone, so a path inside glass is not ended for having crossed into it (and,
+    // with media, divided by the lanes' mean r_u, as contributions are).
+    let rr = s.beta.max_value() * s.eta_scale / mis;
+    roulette(&mut s.beta, rr, s.depth, ctx.settings.rr_depth, u_rr)
+}
+
+/// Where a surface vertex is and what scatters there.
+struct SurfaceVertex<'a> {
+    it: &'a Interaction,
+    geom: u32,
+    material: &'a Material,
+    frame: &'a Frame,
+    wo_local: Vec3,
+}
+
+/// Next-event estimation at a surface vertex: a light sample, weighted by the power
+/// heuristic against the BSDF's density (delta lights: weight 1), through the media on
+/// the way (kernels with `MEDIA`) or past occluders.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn surface_direct_light<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    s: &PathState<N>,
+    v: &SurfaceVertex,
+    mis: f32,
+    u_light: f32,
+    u_light_point: Vec2,
+    wl: &SampledWavelengths<N>,
+    counters: &mut TraceCounters,
+) -> Option<SampledSpectrum<N>> {
+    let it = v.it;
+    let cl = sample_light(ctx, it.position, u_light, u_light_point, wl)?;
+    let ls = &cl.sample;
+    let wi_local = v.frame.to_local(ls.wi);
+    let f = v.material.eval(v.wo_local, wi_local, wl, &s.bsdf_ctx).f * wi_local.z.abs();
+    if f.is_zero() {
+        return None;
+    }
+    // Through media: the transmittance of the shadow ray (None: blocked).
+    let tr_l = if on(K, MEDIA) {
+        let from = if ls.wi.dot(it.n_outward) < 0.0 {
+            ctx.scene.shape_medium[v.geom as usize]
+        } else {
+            medium_outside(s.medium, ctx.scene, v.geom)
+        };
+        transmittance(
+            ctx,
+            &it.spawn_point(),
+            ls.wi,
+            ls.dist,
+            &ls.target(),
+            from,
+            wl,
+            counters,
+        )?
+    } else if occluded(
+        ctx,
+        &it.spawn_point(),
+        ls.wi,
+        ls.dist,
+        &ls.target(),
+        counters,
+    ) {
+        return None;
+    } else {
+        SampledSpectrum::splat(1.0)
+    };
+    let w = if ls.delta {
+        1.0
+    } else {
+        power_heuristic(
+            cl.pdf,
+            v.material.pdf(v.wo_local, wi_local, wl, &s.bsdf_ctx),
+        )
+    };
+    let f = if on(K, MEDIA) { f * tr_l } else { f };
+    Some(s.beta * f * ls.l * (w / (cl.pdf * mis)))
+}
 
 /// exp(−σ_t d) per lane.
 #[inline]
@@ -420,68 +529,10 @@ fn lane_mean<const N: usize>(s: SampledSpectrum<N>, companions_alive: bool) -> f
 /// The medium on the outer side of shape `geom`'s surface for a path now in `current`:
 /// none when the path was in the shape's own medium (media do not nest), else `current`.
 #[inline]
-fn medium_outside(current: u32, scene: &crate::scene::Scene, geom: u32) -> u32 {
+fn medium_outside(current: u32, scene: &Scene, geom: u32) -> u32 {
     if current == scene.shape_medium[geom as usize] {
         NO_MEDIUM
     } else {
         current
     }
-}
-
-/// The transmittance of the shadow ray from `from` (in `medium`) toward `to` along unit
-/// `wi` at distance `dist`: exp(−σ_t ℓ) for each stretch ℓ inside a medium, continuing
-/// through index-matched medium boundaries; `None` when any other surface blocks it.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn transmittance<const N: usize>(
-    ctx: &Context,
-    from: &SpawnPoint,
-    wi: glam::Vec3,
-    dist: f32,
-    to: &SpawnPoint,
-    mut medium: u32,
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-) -> Option<SampledSpectrum<N>> {
-    let scene = ctx.scene;
-    let mut tr = SampledSpectrum::<N>::splat(1.0);
-    let mut q = ctx.offset.shadow(from, wi, dist, to)?;
-    for _ in 0..MAX_CROSSINGS {
-        // Robust shadow rays to a point have an unnormalised direction (t in its units).
-        let scale = q.dir.length();
-        // A closest-hit query: the nearest surface is either an occluder or a boundary
-        // to cross (an any-hit query could not tell which). Counted as a shadow ray.
-        counters.shadow_rays += 1;
-        let hit = ctx.accel.intersect1(&q);
-        let Some(h) = hit else {
-            if medium != NO_MEDIUM {
-                let len = q.tfar * scale;
-                if !len.is_finite() {
-                    return None;
-                }
-                tr *= scene.media[medium as usize].transmittance(len, wl);
-            }
-            return Some(tr);
-        };
-        let g = h.geom_id as usize;
-        if !scene.shape_interface[g] {
-            return None;
-        }
-        if medium != NO_MEDIUM {
-            tr *= scene.media[medium as usize].transmittance(h.t * scale, wl);
-        }
-        let ray = crate::geometry::Ray::new(q.origin, q.dir, q.tnear, q.tfar);
-        let (it, _) = scene.interaction(&ray, &h, ctx.offset.is_robust());
-        medium = if wi.dot(it.n_outward) < 0.0 {
-            scene.shape_medium[g]
-        } else {
-            NO_MEDIUM
-        };
-        let rest = if dist.is_finite() {
-            (to.p - it.position).length()
-        } else {
-            f32::INFINITY
-        };
-        q = ctx.offset.shadow(&it.spawn_point(), wi, rest, to)?;
-    }
-    None
 }

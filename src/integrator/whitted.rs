@@ -14,7 +14,8 @@
 //! surface with both (the course's glossy over glass) does both, each at full weight.
 //! Light reaching a diffuse surface through glass or off other diffuse surfaces is
 //! missing: that is the `path` integrator's job.
-use super::{occluded, query, Context, TraceCounters};
+use super::toolkit::{next_hit, occluded};
+use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, LobeFlags};
 use crate::geometry::{Interaction, Ray};
@@ -54,14 +55,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     let mut depth = 0u32;
     let mut bsdf_ctx = BsdfContext::radiance::<N>().with_lobes(DELTA);
     loop {
-        let hit = match pending.take() {
-            Some(h) => h,
-            None => {
-                counters.rays += 1;
-                ctx.accel.intersect1(&query(&ray))
-            }
-        };
-        let Some(hit) = hit else {
+        let Some(hit) = next_hit(ctx, &ray, &mut pending, counters) else {
             if on(K, ESCAPE) {
                 l += beta * scene.escaped_radiance(ray.dir, wl);
             }
@@ -72,9 +66,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         if on(K, EMITTERS) {
             let emitter = scene.shape_light[hit.geom_id as usize];
             if emitter != NO_LIGHT {
-                if let Light::Area(a) = &scene.lights[emitter as usize] {
-                    l += beta * a.l(it.n_outward, wo, wl);
-                }
+                l += beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
             }
         }
         let flags = material.flags();
@@ -83,7 +75,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         if on(K, SHADOWS) && flags.has_non_specular() {
             let mut lr = SampledSpectrum::<N>::zero();
             direct_lighting(ctx, &it, wl, sampler, counters, |wi, li_cos| {
-                lr += material.eval(wo_local, frame.to_local(wi), wl, &bsdf_ctx) * li_cos;
+                lr += material.eval(wo_local, frame.to_local(wi), wl, &bsdf_ctx).f * li_cos;
             });
             l += beta * lr;
         }

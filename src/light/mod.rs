@@ -189,6 +189,22 @@ impl Light {
         }
     }
 
+    /// Radiance an emitting surface of this light sends from a point with outward
+    /// normal `n` into direction `w` (pbrt-v4 `Light::L`); zero for lights without a
+    /// surface. Integrators read emission here, whatever the light.
+    #[inline]
+    pub fn l<const N: usize>(
+        &self,
+        n: Vec3,
+        w: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        match self {
+            Light::Area(a) => a.l(n, w, wl),
+            _ => SampledSpectrum::zero(),
+        }
+    }
+
     /// Radiance a ray leaving the scene in direction `dir` receives from this light
     /// (zero for lights that are not at infinity or not seen).
     #[inline]
