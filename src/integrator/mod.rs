@@ -7,14 +7,17 @@
 //! - `lighttrace`: paths from the lights, connected to the camera and splatted;
 //! - `bdpt`: bidirectional path tracing with every connection strategy and MIS.
 //!
-//! Both see materials and lights only through their methods (`bsdf`, `light`), and draw
-//! every random number through the [`Sampler`] interface. `render.rs` owns tiles,
-//! packets, passes and the film, and calls the [`kernel`] chosen for the render once per
-//! pixel sample.
+//! All four see materials and lights only through their methods (`Material::eval`,
+//! `sample`, `pdf`, `flags`; `Light::sample_li`, `pdf_li`, `l`, `le`, `sample_le`), take
+//! what they share from `toolkit` (the next hit, a light chosen and sampled with its
+//! density, that density for MIS, Russian roulette, the start of a light path, the
+//! camera's pixel, shadow rays and media transmittance), and draw every random number
+//! through the [`Sampler`] interface. `render.rs` owns tiles, packets, passes and the
+//! film, and calls the [`kernel`] chosen for the render once per pixel sample.
 pub mod bdpt;
 pub mod lighttrace;
 pub mod path;
-pub mod toolkit;
+pub(crate) mod toolkit;
 pub mod whitted;
 
 use crate::accel::embree::{self, Hit};
