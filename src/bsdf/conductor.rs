@@ -7,7 +7,7 @@
 //! user's table. A metal's reflectance depends on wavelength but its direction does
 //! not, so every lane is kept.
 use super::fresnel::fresnel_conductor;
-use super::{reflect_local, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
+use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags};
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -43,17 +43,6 @@ impl BsdfModel for Conductor {
     }
 
     #[inline]
-    fn eval<const N: usize>(
-        &self,
-        _: Vec3,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-        _: &BsdfContext,
-    ) -> BsdfEval<N> {
-        BsdfEval::zero()
-    }
-
-    #[inline]
     fn sample<const N: usize>(
         &self,
         wo: Vec3,
@@ -75,16 +64,5 @@ impl BsdfModel for Conductor {
             eta: 1.0,
             ended_companions: false,
         })
-    }
-
-    #[inline]
-    fn pdf<const N: usize>(
-        &self,
-        _: Vec3,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-        _: &BsdfContext,
-    ) -> f32 {
-        0.0
     }
 }

@@ -20,9 +20,7 @@
 //! both branches then end the companions. This is the one place in heron where that
 //! decision is written.
 use super::fresnel::fresnel_dielectric;
-use super::{
-    reflect_local, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags, TransportMode,
-};
+use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags, TransportMode};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -110,17 +108,6 @@ impl BsdfModel for Dielectric {
     }
 
     #[inline]
-    fn eval<const N: usize>(
-        &self,
-        _: Vec3,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-        _: &BsdfContext,
-    ) -> BsdfEval<N> {
-        BsdfEval::zero()
-    }
-
-    #[inline]
     fn sample<const N: usize>(
         &self,
         wo: Vec3,
@@ -193,17 +180,6 @@ impl BsdfModel for Dielectric {
             eta: etap,
             ended_companions: split,
         })
-    }
-
-    #[inline]
-    fn pdf<const N: usize>(
-        &self,
-        _: Vec3,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-        _: &BsdfContext,
-    ) -> f32 {
-        0.0
     }
 }
 

@@ -1,7 +1,7 @@
 //! Perfect specular reflector (seed, "Reflected rays"): the law of reflection,
 //! ωr = 2(ωi·n)n − ωi, with ωi pointing away from the surface. As a BSDF it is the
 //! delta ρs δ(ωi − ωr)/|cos θi|, so the throughput changes by ρs.
-use super::{reflect_local, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
+use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags};
 use crate::spectrum::{DenseSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -19,17 +19,6 @@ impl BsdfModel for Mirror {
     #[inline]
     fn flags(&self) -> LobeFlags {
         LOBE
-    }
-
-    #[inline]
-    fn eval<const N: usize>(
-        &self,
-        _: Vec3,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-        _: &BsdfContext,
-    ) -> BsdfEval<N> {
-        BsdfEval::zero()
     }
 
     #[inline]
@@ -53,16 +42,5 @@ impl BsdfModel for Mirror {
             eta: 1.0,
             ended_companions: false,
         })
-    }
-
-    #[inline]
-    fn pdf<const N: usize>(
-        &self,
-        _: Vec3,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-        _: &BsdfContext,
-    ) -> f32 {
-        0.0
     }
 }

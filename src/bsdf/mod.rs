@@ -203,14 +203,19 @@ pub trait BsdfModel {
     fn flags(&self) -> LobeFlags;
 
     /// f(ωo, ωi) per lane (zero for delta lobes), and whether the event ends the
-    /// companions.
+    /// companions. The default, zero, is the value of a model with delta lobes only
+    /// (mirror, smooth conductor, smooth dielectric); every other model overrides it,
+    /// and `tests/bsdf.rs` holds each sampled f against it.
+    #[inline]
     fn eval<const N: usize>(
         &self,
-        wo: Vec3,
-        wi: Vec3,
-        wl: &SampledWavelengths<N>,
-        ctx: &BsdfContext,
-    ) -> BsdfEval<N>;
+        _wo: Vec3,
+        _wi: Vec3,
+        _wl: &SampledWavelengths<N>,
+        _ctx: &BsdfContext,
+    ) -> BsdfEval<N> {
+        BsdfEval::zero()
+    }
 
     /// Samples ωi for ωo from `uc` (the choice of lobe) and `u` (the direction); None
     /// when the sample carries no energy. The pdf is the hero's, conditioned on
@@ -225,14 +230,17 @@ pub trait BsdfModel {
     ) -> Option<BsdfSample<N>>;
 
     /// Density (hero wavelength, solid angle) with which `sample` under `ctx.lobes`
-    /// returns ωi; zero for delta lobes.
+    /// returns ωi. The default, zero, is a delta-only model's, as for `eval`.
+    #[inline]
     fn pdf<const N: usize>(
         &self,
-        wo: Vec3,
-        wi: Vec3,
-        wl: &SampledWavelengths<N>,
-        ctx: &BsdfContext,
-    ) -> f32;
+        _wo: Vec3,
+        _wi: Vec3,
+        _wl: &SampledWavelengths<N>,
+        _ctx: &BsdfContext,
+    ) -> f32 {
+        0.0
+    }
 }
 
 /// A sampled direction (pbrt-v4 `BSDFSample`).
