@@ -15,7 +15,6 @@
 //! cfgs that switch those flags off in every kernel; such a build refuses scenes that
 //! need what it lacks (`scripts/bench_kernels.py`).
 use super::{Scene, NO_LIGHT};
-use crate::bsdf::Material;
 use crate::light::Light;
 use crate::settings::{
     flag_names, IntegratorKind, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS,
@@ -39,9 +38,6 @@ pub struct Features {
     /// When false, every path ends at its first hit (depth 1), so the renderer can skip
     /// the continuation loop, reflection/refraction and Fresnel code.
     pub specular: bool,
-    /// Some shape uses the seed's modified Phong model. When false, the renderer can
-    /// skip the glossy lobe ((s + 2)/(2π) (ωo·ωr)^s) in its shading.
-    pub glossy: bool,
     /// Next-event estimation in the path tracer: some shape has a non-specular material
     /// and some light emits, the environment included (the path tracer samples it; the
     /// seed's tracer, whose shadow rays `shadows` is about, does not).
@@ -93,7 +89,6 @@ impl Features {
             // Media scatter light from the lights too.
             nee: (non_specular || !scene.media.is_empty()) && scene.lights.iter().any(emits),
             specular: used().any(|m| m.flags().is_specular()),
-            glossy: used().any(|m| matches!(m, Material::Glossy(_))),
             emitters: scene.shape_light.iter().any(|&l| l != NO_LIGHT),
             escape: !scene.infinite_lights.is_empty(),
             media: !scene.media.is_empty(),
