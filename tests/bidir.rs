@@ -4,6 +4,7 @@
 mod common;
 
 use common::chi2::{Chi2, Spherical};
+use common::render::{mean_se, render_with, run_lanes};
 use glam::Vec3;
 use heron::film::Film;
 use heron::render::{render, RenderOptions, Renderer};
@@ -23,24 +24,6 @@ fn load_file(name: &str) -> Scene {
 fn resize(scene: &mut Scene, w: u32, h: u32) {
     let c = &scene.camera;
     scene.camera = heron::camera::Camera::new(c.eye, c.look_at, c.up, c.d, w, h).unwrap();
-}
-
-fn run(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64, lanes: usize) -> Film {
-    let mut o = RenderOptions::from_scene(scene);
-    o.settings.integrator = kind;
-    o.settings.spp = spp;
-    o.settings.seed = seed;
-    o.settings.lanes = lanes;
-    let (film, stats) = render(scene, &o).unwrap();
-    assert_eq!(stats.nonfinite, 0, "{kind:?}: non-finite samples");
-    film
-}
-
-fn mean_se(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
 }
 
 /// The largest |z| over block×block regions and the three channels of the per-pixel
@@ -132,7 +115,7 @@ intensity = { spectrum = "E", scale = 3.0 }
         Path::new("splat.toml"),
     )
     .unwrap();
-    let film = run(&scene, IntegratorKind::LightTrace, 256, 3, 4);
+    let film = run_lanes(&scene, IntegratorKind::LightTrace, 256, 3, 4);
     let cam = &scene.camera;
     let light = Vec3::new(0.3, 1.0, 0.2);
     let mut d = Vec::new();
@@ -168,9 +151,9 @@ intensity = { spectrum = "E", scale = 3.0 }
 fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_the_cornell_box() {
     let mut scene = load_file("cornell-box.toml");
     resize(&mut scene, 64, 64);
-    let p = run(&scene, IntegratorKind::Path, 512, 1, 4);
+    let p = run_lanes(&scene, IntegratorKind::Path, 512, 1, 4);
     for (kind, seed) in [(IntegratorKind::LightTrace, 2), (IntegratorKind::Bdpt, 3)] {
-        let f = run(&scene, kind, 512, seed, 4);
+        let f = run_lanes(&scene, kind, 512, seed, 4);
         let (z, n) = worst_region_z(&f, &p, None, 8);
         // 192 regions and channels: |z| < 4.2 holds for all of them with probability
         // ≈ 0.995 (normal approximation).
@@ -188,8 +171,8 @@ fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_the_cornell_box() {
 fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_caustic_glass() {
     let mut scene = load_file("caustic-glass.toml");
     resize(&mut scene, 64, 48);
-    let p = run(&scene, IntegratorKind::Path, 1024, 1, 4);
-    let b = run(&scene, IntegratorKind::Bdpt, 256, 2, 4);
+    let p = run_lanes(&scene, IntegratorKind::Path, 1024, 1, 4);
+    let b = run_lanes(&scene, IntegratorKind::Bdpt, 256, 2, 4);
     let (z, n) = worst_region_z(&b, &p, None, 8);
     assert!(n > 100 && z < 4.2, "bdpt: worst |z| {z} over {n} regions");
     let r = Renderer::new(&scene).unwrap();
@@ -216,7 +199,7 @@ fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_caustic_glass() {
             mask.push(diffuse);
         }
     }
-    let l = run(&scene, IntegratorKind::LightTrace, 1024, 3, 4);
+    let l = run_lanes(&scene, IntegratorKind::LightTrace, 1024, 3, 4);
     let (z, n) = worst_region_z(&l, &p, Some(&mask), 8);
     assert!(
         n > 60 && z < 4.2,
@@ -232,8 +215,8 @@ fn bidirectional_dispersion_is_unbiased() {
     let mut scene = load_file("caustic-dispersion.toml");
     resize(&mut scene, 48, 36);
     for kind in [IntegratorKind::Bdpt, IntegratorKind::LightTrace] {
-        let a = run(&scene, kind, 512, 11, 4);
-        let b = run(&scene, kind, 512, 12, 1);
+        let a = run_lanes(&scene, kind, 512, 11, 4);
+        let b = run_lanes(&scene, kind, 512, 12, 1);
         for ch in 0..3 {
             let d: Vec<f64> = a
                 .xyz
@@ -327,8 +310,8 @@ angular_radius = 1.0
     );
     let a = load_scene_from_str(&with, Path::new("portal.toml")).unwrap();
     let b = load_scene_from_str(base, Path::new("portal.toml")).unwrap();
-    let fa = run(&a, IntegratorKind::LightTrace, 256, 1, 4);
-    let fb = run(&b, IntegratorKind::LightTrace, 4096, 2, 4);
+    let fa = run_lanes(&a, IntegratorKind::LightTrace, 256, 1, 4);
+    let fb = run_lanes(&b, IntegratorKind::LightTrace, 4096, 2, 4);
     let (z, n) = worst_region_z(&fa, &fb, None, 4);
     assert!(n > 15 && z < 4.0, "worst |z| {z} over {n} regions");
     let (ma, mb) = (
@@ -354,15 +337,14 @@ fn newton() -> (Scene, Film) {
         .replace("max_depth = 8", "max_depth = 3");
     assert!(text.contains("spectrum = \"E\", scale = 100.0"));
     let scene = load_scene_from_str(&text, &scenes().join("newton-prism.toml")).unwrap();
-    let mut o = RenderOptions::from_scene(&scene);
-    // 128 spp at 256²: 8.4M light paths, about 180k per 10 nm bin after the prism ends
-    // the companions, so each bin's flux has a standard error near 0.25%.
-    o.settings.spp = 128;
-    o.settings.lanes = 4;
-    o.settings.spectral_bins = 47;
-    o.settings.seed = 5;
-    let (film, stats) = render(&scene, &o).unwrap();
-    assert_eq!(stats.nonfinite, 0);
+    let film = render_with(&scene, |o| {
+        // 128 spp at 256²: 8.4M light paths, about 180k per 10 nm bin after the prism
+        // ends the companions, so each bin's flux has a standard error near 0.25%.
+        o.settings.spp = 128;
+        o.settings.lanes = 4;
+        o.settings.spectral_bins = 47;
+        o.settings.seed = 5;
+    });
     (scene, film)
 }
 

@@ -21,6 +21,7 @@
 mod common;
 
 use common::chi2::{assert_all, Chi2, Outcome, Spherical};
+use common::render::{mean_se, mean_se_y, y_of};
 use glam::{Vec2, Vec3};
 use heron::film::Film;
 use heron::medium::{HgMedium, LorenzMieMedium, Medium, MieSpec, PopulationNode};
@@ -165,24 +166,9 @@ fn load_in(dir: &Path, toml: &str) -> Scene {
     load_scene_from_str(toml, &dir.join("media-test.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// A path-traced render with the scene's seed (only the path tracer renders media).
 fn run(scene: &Scene, spp: u32) -> Film {
-    let mut o = RenderOptions::from_scene(scene);
-    o.settings.integrator = IntegratorKind::Path;
-    o.settings.spp = spp;
-    let (film, stats) = render(scene, &o).unwrap();
-    assert_eq!(stats.nonfinite, 0, "non-finite samples");
-    film
-}
-
-fn mean_se(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
-}
-
-fn y_of(film: &Film) -> Vec<f64> {
-    film.xyz.iter().map(|c| c[1] as f64).collect()
+    common::render::run(scene, IntegratorKind::Path, spp, scene.settings.seed)
 }
 
 /// A folder of its own for a test's files (OBJ meshes).
@@ -233,7 +219,7 @@ fn write_box(dir: &Path, name: &str, lo: [f32; 3], hi: [f32; 3]) {
 /// Asserts the image mean is `expected` within 4 standard errors, and the standard
 /// error is small enough for the check to mean something.
 fn assert_mean(film: &Film, expected: f64, max_se: f64, what: &str) {
-    let (m, se) = mean_se(&y_of(film));
+    let (m, se) = mean_se_y(film);
     println!("{what}: mean {m:.5} ± {se:.5}, expected {expected:.5}");
     assert!(se < max_se, "{what}: standard error {se} above {max_se}");
     assert!(

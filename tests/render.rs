@@ -1,6 +1,9 @@
 //! Rendering tests on scenes built in code: energy conservation (white furnace) for the
 //! seed's specular materials, the analytic diffuse shading under point and directional
 //! lights, no shadow acne at grazing light, and determinism across thread counts.
+mod common;
+
+use common::render::render_with;
 use glam::Vec3;
 use heron::bsdf::{Dielectric, Glossy, Lambertian, Material, Mirror};
 use heron::camera::Camera;
@@ -72,12 +75,9 @@ fn sphere(center: Vec3, radius: f32, material: u32) -> Shape {
     }
 }
 
+/// A render with the scene's settings on `threads` threads.
 fn run(scene: &Scene, threads: usize) -> Film {
-    let mut o = RenderOptions::from_scene(scene);
-    o.threads = threads;
-    let (film, stats) = render(scene, &o).unwrap();
-    assert_eq!(stats.nonfinite, 0);
-    film
+    render_with(scene, |o| o.threads = threads)
 }
 
 fn lambertian(rho: f32) -> Material {

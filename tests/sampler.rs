@@ -6,9 +6,11 @@
 //! Each seed's render is an independent estimate for both samplers (a new seed draws new
 //! Owen scrambles, which is what makes scrambled Sobol' randomised QMC), so the spread
 //! over seeds gives the standard errors even though Sobol's pixels are correlated.
+mod common;
+
+use common::render::render_with;
 use heron::camera::Camera;
 use heron::film::Film;
-use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene;
 use heron::scene::Scene;
 use heron::settings::IntegratorKind;
@@ -34,16 +36,14 @@ struct Setting {
 }
 
 fn run(scene: &Scene, s: &Setting, sampler: SamplerKind, seed: u64) -> Film {
-    let mut o = RenderOptions::from_scene(scene);
-    o.settings.integrator = s.integrator;
-    o.settings.lanes = s.lanes;
-    o.settings.wavelengths = s.wavelengths;
-    o.settings.spp = s.spp;
-    o.settings.sampler = sampler;
-    o.settings.seed = seed;
-    let (film, stats) = render(scene, &o).unwrap();
-    assert_eq!(stats.nonfinite, 0);
-    film
+    render_with(scene, |o| {
+        o.settings.integrator = s.integrator;
+        o.settings.lanes = s.lanes;
+        o.settings.wavelengths = s.wavelengths;
+        o.settings.spp = s.spp;
+        o.settings.sampler = sampler;
+        o.settings.seed = seed;
+    })
 }
 
 /// Per seed, the mean X, Y, Z of each of `r`×`r` regions; and the mean over seeds of the

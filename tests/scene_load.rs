@@ -152,7 +152,6 @@ fn default_scene_has_the_lecture_numbers() {
             shadows: true,
             nee: true,
             specular: false,
-            glossy: false,
             emitters: false,
             escape: true,
             media: false,
@@ -187,7 +186,6 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
             shadows: true,
             nee: true,
             specular: true,
-            glossy: false,
             emitters: false,
             escape: true,
             media: false,
@@ -218,7 +216,6 @@ fn default_mirror_glass_glossy_change_only_the_sphere() {
             shadows: true,
             nee: true,
             specular: true,
-            glossy: true,
             emitters: false,
             escape: true,
             media: false,
@@ -273,8 +270,16 @@ fn cornell_box_has_one_shape_per_mesh_material() {
     assert_eq!(glass.ior, heron::spectrum::ior::Ior::Constant(1.5));
     assert!(matches!(by_name("mirror"), Material::Mirror(_)));
     assert_eq!(s.lights.len(), 1);
-    let f = Features::of(&s);
-    assert!(f.shadows && f.specular && !f.glossy);
+    // Lit diffuse walls and two specular spheres; no area light, nothing beyond the box.
+    assert_eq!(
+        Features::of(&s),
+        Features {
+            shadows: true,
+            nee: true,
+            specular: true,
+            ..Features::default()
+        }
+    );
 }
 
 // ------------------------------------------------------------------------------------
@@ -911,12 +916,13 @@ fn features_follow_the_materials_in_use() {
             ..none
         }
     );
+    // Glossy: its Phong lobe is lit by shadow rays; over a refractive base it also
+    // continues specularly.
     assert_eq!(
         scene(mats, &sphere("g"), light),
         Features {
             shadows: true,
             nee: true,
-            glossy: true,
             ..none
         }
     );
@@ -926,7 +932,6 @@ fn features_follow_the_materials_in_use() {
             shadows: true,
             nee: true,
             specular: true,
-            glossy: true,
             ..none
         }
     );

@@ -14,6 +14,9 @@
 //! with the standard error from the spread of the pixels, which are independent
 //! estimates of the same quantity. Scenes use the spectrum E (constant 1), so every
 //! wavelength has the same expected radiance and the film's Y is that radiance.
+mod common;
+
+use common::render::{mean_se, mean_se_y, run, run_lanes};
 use heron::film::Film;
 use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
@@ -25,31 +28,6 @@ fn load(toml: &str) -> Scene {
     load_scene_from_str(toml, Path::new("transport-test.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn run(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64) -> Film {
-    let mut o = RenderOptions::from_scene(scene);
-    o.settings.integrator = kind;
-    o.settings.spp = spp;
-    o.settings.seed = seed;
-    let (film, stats) = render(scene, &o).unwrap();
-    assert_eq!(stats.nonfinite, 0, "non-finite samples");
-    film
-}
-
-/// Mean and standard error of independent values.
-fn mean_se_of(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
-}
-
-/// Mean and standard error of the film's Y over all pixels.
-fn mean_se(film: &Film) -> (f64, f64) {
-    mean_se_of(&film.xyz.iter().map(|c| c[1] as f64).collect::<Vec<_>>())
-}
-
-/// The camera constant d for a view that the sphere of radius r at distance D fills:
-/// the image's half-diagonal must stay inside the sphere's angular radius.
 const CLOSE_UP: &str = r#"
 [camera]
 eye = [0.0, 0.0, 3.0]
@@ -83,10 +61,10 @@ position = [0.0, 0.0, 0.0]
 intensity = { spectrum = "E", scale = 3.14159265 }
 "#,
     );
-    let (m, se) = mean_se(&run(&scene, IntegratorKind::Path, 32, 1));
+    let (m, se) = mean_se_y(&run(&scene, IntegratorKind::Path, 32, 1));
     assert!((m - 1.0).abs() < 3.0 * se, "mean {m} ± {se}, expected 1");
     // The Whitted tracer has no interreflection: it sees only ρI/(πR²) = 1/2.
-    let (w, wse) = mean_se(&run(&scene, IntegratorKind::Whitted, 4, 1));
+    let (w, wse) = mean_se_y(&run(&scene, IntegratorKind::Whitted, 4, 1));
     assert!((w - 0.5).abs() < 3.0 * wse.max(1e-6), "whitted {w} ± {wse}");
 }
 
@@ -113,7 +91,7 @@ fn convex_diffuse_object_in_a_uniform_environment_has_radiance_rho() {
         let scene = furnace(&format!(
             "[materials.m]\ntype = \"lambertian\"\nrho_d = {rho}"
         ));
-        let (m, se) = mean_se(&run(&scene, IntegratorKind::Path, 16, 2));
+        let (m, se) = mean_se_y(&run(&scene, IntegratorKind::Path, 16, 2));
         assert!((m - rho).abs() < 3.0 * se, "ρ = {rho}: mean {m} ± {se}");
         assert!(se < 0.01, "the test must resolve 3%: se {se}");
     }
@@ -122,7 +100,7 @@ fn convex_diffuse_object_in_a_uniform_environment_has_radiance_rho() {
 #[test]
 fn glass_spheres_disappear_in_a_uniform_environment() {
     let smooth = furnace("[materials.m]\ntype = \"dielectric\"\nior = 1.5");
-    let (m, se) = mean_se(&run(&smooth, IntegratorKind::Path, 16, 3));
+    let (m, se) = mean_se_y(&run(&smooth, IntegratorKind::Path, 16, 3));
     assert!((m - 1.0).abs() < 3.0 * se, "smooth glass: mean {m} ± {se}");
     // Rough glass loses what single-scattering microfacets lose (light that would
     // scatter again among the microfacets). At α = 0.3 the BSDF's albedo is 0.99 for
@@ -134,7 +112,7 @@ fn glass_spheres_disappear_in_a_uniform_environment() {
     // at 0.852 ± 0.002 (spp 16, seed 4). The bound below leaves room for noise but not
     // for a model that creates energy or loses much more.
     let rough = furnace("[materials.m]\ntype = \"dielectric\"\nior = 1.5\nroughness = 0.3");
-    let (m, se) = mean_se(&run(&rough, IntegratorKind::Path, 16, 4));
+    let (m, se) = mean_se_y(&run(&rough, IntegratorKind::Path, 16, 4));
     assert!(
         m < 1.0 + 3.0 * se && m > 0.82,
         "rough glass: mean {m} ± {se}"
@@ -216,7 +194,7 @@ angular_radius = 2.0
                         d.push(p.xyz[i][ch] as f64 - w.xyz[i][ch] as f64);
                     }
                 }
-                let (m, se) = mean_se_of(&d);
+                let (m, se) = mean_se(&d);
                 if se == 0.0 {
                     assert_eq!(m, 0.0);
                     continue;
@@ -306,15 +284,8 @@ emission = { spectrum = "E", scale = 20.0 }
     );
     let mut films = Vec::new();
     for (lanes, seed) in [(4usize, 11u64), (1, 12)] {
-        let mut o = RenderOptions::from_scene(&scene);
-        o.settings.integrator = IntegratorKind::Path;
         // At 1024 spp, dropping the hero's factor N shows up at 5.3 standard errors.
-        o.settings.spp = 1024;
-        o.settings.lanes = lanes;
-        o.settings.seed = seed;
-        let (film, stats) = render(&scene, &o).unwrap();
-        assert_eq!(stats.nonfinite, 0);
-        films.push(film);
+        films.push(run_lanes(&scene, IntegratorKind::Path, 1024, seed, lanes));
     }
     for ch in 0..3 {
         let d: Vec<f64> = films[0]
@@ -323,9 +294,7 @@ emission = { spectrum = "E", scale = 20.0 }
             .zip(&films[1].xyz)
             .map(|(a, b)| a[ch] as f64 - b[ch] as f64)
             .collect();
-        let n = d.len() as f64;
-        let m = d.iter().sum::<f64>() / n;
-        let se = (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let (m, se) = mean_se(&d);
         assert!(
             m.abs() < 4.0 * se,
             "channel {ch}: mean difference {m} ± {se}"

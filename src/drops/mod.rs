@@ -126,12 +126,7 @@ fn ln_gamma_interval(k_lo: f64, k_hi: f64, depth: f64) -> (f64, f64) {
 
 impl DropSizeDistribution {
     /// Checks the parameters (finite, positive, μ ≥ 1, σ ≤ 1, radii ≤ 10 mm); the error
-    /// names the key as `prefix.key`.
-    pub fn validate(&self, prefix: &str) -> Result<(), String> {
-        self.validate_named(&|k| format!("{prefix}.{k}"))
-    }
-
-    /// As [`DropSizeDistribution::validate`], each key's name given by `name`.
+    /// names each key as `name` gives it (`prefix.key` in a scene, the flag on the CLI).
     pub fn validate_named(&self, name: &dyn Fn(&str) -> String) -> Result<(), String> {
         let pos = |key: &str, v: f64, max: f64| -> Result<(), String> {
             if v.is_finite() && v > 0.0 && v <= max {

@@ -26,16 +26,6 @@ pub fn spectral_channel_name(lambda: f32) -> String {
     format!("S0.{}nm", format!("{lambda:.6}").replace('.', ","))
 }
 
-/// Writes the EXR file; see [`stage_exr`] to write several outputs together.
-pub fn write_exr(
-    film: &Film,
-    path: &Path,
-    channels: ExrChannels,
-    provenance: &Provenance,
-) -> crate::Result<()> {
-    stage_exr(film, path, channels, provenance)?.commit()
-}
-
 /// Writes the EXR file to a temporary file, to be committed later. `provenance` goes
 /// into the header as text attributes `heron.<key>` ([`crate::provenance`]).
 pub fn stage_exr(

@@ -5,11 +5,6 @@ use crate::files::Staged;
 use crate::spectrum::color::srgb_encode;
 use std::path::Path;
 
-/// Writes the PNG file; see [`stage_png`] to write several outputs together.
-pub fn write_png(film: &Film, path: &Path) -> crate::Result<()> {
-    stage_png(film, path)?.commit()
-}
-
 /// Writes the PNG file to a temporary file, to be committed later.
 pub fn stage_png(film: &Film, path: &Path) -> crate::Result<Staged> {
     let mut bytes = Vec::with_capacity(film.xyz.len() * 3);

@@ -255,7 +255,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         } else {
             let d2 = (next.p - v.p).length_squared();
             let light = &scene.lights[v.light as usize];
-            light.pdf_le(v.p, w, v.n, &scene.bounds).1 / d2
+            light.pdf_le(w, v.n, &scene.bounds).1 / d2
         };
         if next.on_surface() {
             pdf *= next.n.dot(w).abs();
@@ -273,7 +273,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         }
         let light = &scene.lights[v.light as usize];
         let choice = scene.light_sampler.pmf(v.light as usize);
-        choice * light.pdf_le(v.p, w, v.n, &scene.bounds).0
+        choice * light.pdf_le(w, v.n, &scene.bounds).0
     }
 
     /// Radiance the light vertex (or emitting surface, or escaped end) `v` sends toward

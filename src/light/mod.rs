@@ -236,13 +236,12 @@ impl Light {
         }
     }
 
-    /// (position density, direction density) with which `sample_le` emits a ray from
-    /// `origin` in unit direction `dir`, the origin on a surface of outward normal `n`
-    /// (area lights). Positions of lights at infinity are densities per unit area across
+    /// (position density, direction density) with which `sample_le` emits a ray in unit
+    /// direction `dir` from a point on a surface of outward normal `n` (area lights; the
+    /// densities do not depend on where on the light the ray starts). Positions of lights at infinity are densities per unit area across
     /// the rays ([`Light::pdf_le_position`]); delta positions have density 1, delta
     /// directions density 0 (pbrt-v4 `Light::PDF_Le`).
-    pub fn pdf_le(&self, origin: Vec3, dir: Vec3, n: Vec3, bounds: &SceneBounds) -> (f32, f32) {
-        let _ = origin;
+    pub fn pdf_le(&self, dir: Vec3, n: Vec3, bounds: &SceneBounds) -> (f32, f32) {
         match self {
             Light::Point(_) => (1.0, crate::math::warp::UNIFORM_SPHERE_PDF),
             Light::Spot(s) => (1.0, s.pdf_dir(dir)),

@@ -37,14 +37,6 @@ impl Distribution1D {
         }
     }
 
-    pub fn len(&self) -> usize {
-        self.func.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.func.is_empty()
-    }
-
     pub fn integral(&self) -> f32 {
         self.integral
     }

@@ -3,19 +3,27 @@
 //! Only materials that some shape uses count: a material defined in the file but bound
 //! to no shape never meets a ray.
 //!
-//! [`Features::kernel`] turns the features into [`KernelFlags`], which the renderer
-//! uses, once per render, to pick an integrator monomorphised over them (a `const K:
-//! u32` generic next to the lane count N): code behind a flag that is off is not in that
-//! kernel at all, so a scene without shadow rays, specular paths, area lights or
-//! anything to see beyond the scene pays for none of their tests. `--kernel general`
-//! runs the kernel with every flag on, which must give the same image byte for byte.
+//! [`Features::kernel`] turns the features into [`KernelFlags`] (defined in
+//! `crate::settings`), which the renderer uses, once per render, to pick an integrator
+//! monomorphised over them (a `const K: u32` generic next to the lane count N): code
+//! behind a flag that is off is not in that kernel at all. The flags:
+//!
+//! - `SHADOWS`: shadow rays (Whitted) or next-event estimation (path tracer);
+//! - `SPECULAR`: specular continuation past the first hit (Whitted only);
+//! - `EMITTERS`: emission of area lights found at hits;
+//! - `ESCAPE`: radiance of the lights at infinity along escaping rays;
+//! - `MEDIA`: participating media, free flights and transmittance (path tracer only).
+//!
+//! So a scene without shadow rays, specular paths, area lights, anything to see beyond
+//! the scene or media pays for none of their tests. Light tracing and BDPT always run
+//! their one general kernel. `--kernel general` runs the kernel with every flag on,
+//! which must give the same image byte for byte.
 //!
 //! For measuring what a kernel costs against a build without a feature's code, the
-//! build script turns `HERON_STRIP=shadows,specular,emitters,escape` (any subset) into
-//! cfgs that switch those flags off in every kernel; such a build refuses scenes that
-//! need what it lacks (`scripts/bench_kernels.py`).
+//! build script turns `HERON_STRIP=shadows,specular,emitters,escape` (any subset; `MEDIA`
+//! cannot be stripped) into cfgs that switch those flags off in every kernel; such a
+//! build refuses scenes that need what it lacks (`scripts/bench_kernels.py`).
 use super::{Scene, NO_LIGHT};
-use crate::bsdf::Material;
 use crate::light::Light;
 use crate::settings::{
     flag_names, IntegratorKind, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS,
@@ -39,9 +47,6 @@ pub struct Features {
     /// When false, every path ends at its first hit (depth 1), so the renderer can skip
     /// the continuation loop, reflection/refraction and Fresnel code.
     pub specular: bool,
-    /// Some shape uses the seed's modified Phong model. When false, the renderer can
-    /// skip the glossy lobe ((s + 2)/(2π) (ωo·ωr)^s) in its shading.
-    pub glossy: bool,
     /// Next-event estimation in the path tracer: some shape has a non-specular material
     /// and some light emits, the environment included (the path tracer samples it; the
     /// seed's tracer, whose shadow rays `shadows` is about, does not).
@@ -93,7 +98,6 @@ impl Features {
             // Media scatter light from the lights too.
             nee: (non_specular || !scene.media.is_empty()) && scene.lights.iter().any(emits),
             specular: used().any(|m| m.flags().is_specular()),
-            glossy: used().any(|m| matches!(m, Material::Glossy(_))),
             emitters: scene.shape_light.iter().any(|&l| l != NO_LIGHT),
             escape: !scene.infinite_lights.is_empty(),
             media: !scene.media.is_empty(),
@@ -101,8 +105,9 @@ impl Features {
     }
 
     /// The kernel flags `kind` needs for these features. The Whitted tracer is
-    /// specialised on all four; the path tracer on shadows (its next-event estimation),
-    /// emitters and escape; light tracing and BDPT always run their general kernel.
+    /// specialised on shadows, specular, emitters and escape; the path tracer on shadows
+    /// (its next-event estimation), emitters, escape and media; light tracing and BDPT
+    /// always run their general kernel.
     pub fn kernel(&self, kind: IntegratorKind) -> KernelFlags {
         let bit = |on: bool, f: KernelFlags| if on { f } else { 0 };
         match kind {

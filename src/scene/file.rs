@@ -568,9 +568,9 @@ impl Colour {
 
 impl Reflectance {
     /// Spectral reflectance: a single number g is the neutral reflectance, exactly g at
-    /// every wavelength; `[r, g, b]` is uplifted after Smits (1999) (`[g, g, g]` comes
-    /// out within 1e-3 of g, the precision of Smits' table); a named spectrum is itself
-    /// times its scale.
+    /// every wavelength; `[r, g, b]` is uplifted after Jakob & Hanika (2019)
+    /// (`rgb_to_reflectance`; `[g, g, g]` comes out as the constant spectrum g, within
+    /// 1e-6); a named spectrum is itself times its scale.
     pub fn spectrum(&self) -> DenseSpectrum {
         match &self.0 {
             Colour::Grey(g) => DenseSpectrum::constant(*g),
@@ -585,9 +585,9 @@ impl Reflectance {
 
 impl Emission {
     /// Emission spectrum: a single number g is g times the sRGB white point, D65 scaled
-    /// to luminance Y = 1 (exactly; `rgb_to_illuminant([g, g, g])` is the same within
-    /// Smits' 1e-3); `[r, g, b]` is uplifted with `rgb_to_illuminant`; a named spectrum is
-    /// itself times its scale.
+    /// to luminance Y = 1 (exactly, as `rgb_to_illuminant([g, g, g])` gives it too: its
+    /// grey uplifts to the constant 1); `[r, g, b]` is uplifted with `rgb_to_illuminant`;
+    /// a named spectrum is itself times its scale.
     pub fn spectrum(&self) -> DenseSpectrum {
         match &self.0 {
             Colour::Grey(g) => {

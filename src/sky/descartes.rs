@@ -167,25 +167,6 @@ pub fn order_profile(theta: f64, n: f64, k: u32, alpha: f64, pol: Polarisation) 
     sum
 }
 
-/// Point-sun profile of one order (no disk): (1/π) Σ b |db/dθ| F / sin θ; infinite at the
-/// caustic. For tests and plots.
-pub fn point_profile(theta: f64, n: f64, k: u32, pol: Polarisation) -> f64 {
-    let mut sum = 0.0;
-    for (bl, br) in branches(n, k) {
-        let (tl, tr) = (theta_of_b(bl, n, k), theta_of_b(br, n, k));
-        if theta <= tl.min(tr) || theta >= tl.max(tr) {
-            continue;
-        }
-        let b = invert(bl, br, theta, n, k);
-        let h = 1e-7;
-        let (ba, bb) = ((b - h).max(bl), (b + h).min(br));
-        let dtdb = (theta_of_b(bb, n, k) - theta_of_b(ba, n, k)) / (bb - ba);
-        let (fs, fp) = fresnel_factors(b, n, k);
-        sum += b * pol.mix(fs, fp) / (theta.sin() * dtdb.abs()) / PI;
-    }
-    sum
-}
-
 /// Geometric-optics sky of water drops for the chosen orders, averaged over the sun's
 /// disk. Normalisation: dσ/dΩ / (π a²) (see the module `sky`), independent of the drop size.
 #[derive(Clone, Debug)]

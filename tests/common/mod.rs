@@ -3,3 +3,4 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod render;

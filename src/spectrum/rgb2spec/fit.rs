@@ -210,11 +210,6 @@ impl ColourModel {
         mat_vec(&self.rgb_to_xyz, rgb)
     }
 
-    /// Linear sRGB of an XYZ colour through the film's matrix.
-    pub fn rgb_of_xyz(&self, xyz: [f64; 3]) -> [f64; 3] {
-        mat_vec(&XYZ_TO_SRGB.map(|row| row.map(f64::from)), xyz)
-    }
-
     /// CIELAB of an XYZ colour relative to [`Self::white`], and ∂Lab/∂XYZ.
     pub fn lab(&self, xyz: [f64; 3]) -> ([f64; 3], Mat3) {
         let (fx, dx) = lab_f(xyz[0] / self.white[0]);

@@ -1,0 +1,64 @@
+//! Renders and image statistics for the tests that check rendered images against
+//! analytic answers or against each other (`tests/bidir.rs`, `tests/media.rs`,
+//! `tests/transport.rs`, `tests/render.rs`, `tests/sampler.rs`).
+//!
+//! Every render here asserts that no sample was non-finite: a NaN or infinite sample is
+//! left out of the image (and counted), so an image could look right while the
+//! integrator is broken.
+use heron::film::Film;
+use heron::render::{render, RenderOptions};
+use heron::scene::Scene;
+use heron::settings::IntegratorKind;
+
+/// Renders `scene` with its own settings (`RenderOptions::from_scene`) as `set` changes
+/// them, and asserts that every sample was finite.
+pub fn render_with(scene: &Scene, set: impl FnOnce(&mut RenderOptions)) -> Film {
+    let mut o = RenderOptions::from_scene(scene);
+    set(&mut o);
+    let (film, stats) = render(scene, &o).unwrap();
+    assert_eq!(
+        stats.nonfinite, 0,
+        "{:?}: non-finite samples",
+        o.settings.integrator
+    );
+    film
+}
+
+/// Renders `scene` with integrator `kind`, `spp` samples per pixel and `seed`; every
+/// other setting is the scene's.
+pub fn run(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64) -> Film {
+    render_with(scene, |o| {
+        o.settings.integrator = kind;
+        o.settings.spp = spp;
+        o.settings.seed = seed;
+    })
+}
+
+/// [`run`] with `lanes` wavelength lanes per path.
+pub fn run_lanes(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64, lanes: usize) -> Film {
+    render_with(scene, |o| {
+        o.settings.integrator = kind;
+        o.settings.spp = spp;
+        o.settings.seed = seed;
+        o.settings.lanes = lanes;
+    })
+}
+
+/// Mean and standard error of independent values.
+pub fn mean_se(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+/// The film's Y, pixel by pixel.
+pub fn y_of(film: &Film) -> Vec<f64> {
+    film.xyz.iter().map(|c| c[1] as f64).collect()
+}
+
+/// Mean and standard error of the film's Y over all pixels, which are independent
+/// estimates when every pixel sees the same radiance.
+pub fn mean_se_y(film: &Film) -> (f64, f64) {
+    mean_se(&y_of(film))
+}
