@@ -516,20 +516,22 @@ fn water_drop_scene() -> Scene {
     Scene::from_parts(SceneParts {
         source: "test".into(),
         camera: Camera::new(Vec3::new(0.0, 0.0, -5.0), Vec3::ZERO, Vec3::Y, 1.0, 8, 8).unwrap(),
-        shapes: vec![Shape {
-            kind: ShapeKind::Sphere {
+        shapes: vec![Shape::new(
+            ShapeKind::Sphere {
                 center: Vec3::ZERO,
                 radius: 1.0,
             },
-            material: 0,
-        }],
+            0,
+        )],
         materials: vec![Material::Dielectric(Dielectric::new(
             ior::named("water").unwrap(),
             true,
         ))],
         material_names: vec!["water".into()],
         lights: vec![],
-        shape_light: vec![],
+        source_sha256: String::new(),
+        inputs: vec![],
+        media: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
         settings: RenderSettings {

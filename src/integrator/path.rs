@@ -200,11 +200,11 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         }
         if on(K, MEDIA) {
             if let Some(h) = &hit {
-                if scene.shape_interface[h.geom_id as usize] {
+                if scene.shapes[h.geom_id as usize].interface {
                     // An index-matched boundary: cross it, switching media, no bounce.
                     let (it, _) = scene.interaction(&ray, h, ctx.offset.is_robust());
                     medium = if ray.dir.dot(it.n_outward) < 0.0 {
-                        scene.shape_medium[h.geom_id as usize]
+                        scene.shapes[h.geom_id as usize].medium
                     } else {
                         NO_MEDIUM
                     };
@@ -253,7 +253,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
 
         // Emission of an area light the path has reached.
         let emitter = if on(K, EMITTERS) {
-            scene.shape_light[hit.geom_id as usize]
+            scene.shapes[hit.geom_id as usize].light
         } else {
             NO_LIGHT
         };
@@ -309,7 +309,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
                             None
                         } else if on(K, MEDIA) {
                             let from = if ls.wi.dot(it.n_outward) < 0.0 {
-                                scene.shape_medium[hit.geom_id as usize]
+                                scene.shapes[hit.geom_id as usize].medium
                             } else {
                                 medium_outside(medium, scene, hit.geom_id)
                             };
@@ -373,7 +373,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
             // Through a dielectric around a medium (a glass of milk) into or out of it.
             let g = hit.geom_id as usize;
             medium = if ray.dir.dot(it.n_outward) < 0.0 {
-                scene.shape_medium[g]
+                scene.shapes[g].medium
             } else {
                 medium_outside(medium, scene, hit.geom_id)
             };
@@ -421,7 +421,7 @@ fn lane_mean<const N: usize>(s: SampledSpectrum<N>, companions_alive: bool) -> f
 /// none when the path was in the shape's own medium (media do not nest), else `current`.
 #[inline]
 fn medium_outside(current: u32, scene: &crate::scene::Scene, geom: u32) -> u32 {
-    if current == scene.shape_medium[geom as usize] {
+    if current == scene.shapes[geom as usize].medium {
         NO_MEDIUM
     } else {
         current
@@ -463,7 +463,7 @@ pub(crate) fn transmittance<const N: usize>(
             return Some(tr);
         };
         let g = h.geom_id as usize;
-        if !scene.shape_interface[g] {
+        if !scene.shapes[g].interface {
             return None;
         }
         if medium != NO_MEDIUM {
@@ -472,7 +472,7 @@ pub(crate) fn transmittance<const N: usize>(
         let ray = crate::geometry::Ray::new(q.origin, q.dir, q.tnear, q.tfar);
         let (it, _) = scene.interaction(&ray, &h, ctx.offset.is_robust());
         medium = if wi.dot(it.n_outward) < 0.0 {
-            scene.shape_medium[g]
+            scene.shapes[g].medium
         } else {
             NO_MEDIUM
         };

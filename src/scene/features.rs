@@ -94,7 +94,7 @@ impl Features {
             nee: (non_specular || !scene.media.is_empty()) && scene.lights.iter().any(emits),
             specular: used().any(|m| m.flags().is_specular()),
             glossy: used().any(|m| matches!(m, Material::Glossy(_))),
-            emitters: scene.shape_light.iter().any(|&l| l != NO_LIGHT),
+            emitters: scene.shapes.iter().any(|s| s.light != NO_LIGHT),
             escape: !scene.infinite_lights.is_empty(),
             media: !scene.media.is_empty(),
         }

@@ -243,6 +243,30 @@ pub enum ShapeFile {
 /// The `type` values of [`ShapeFile`], in declaration order.
 pub const SHAPE_TYPES: &[&str] = &["sphere", "triangle", "plane", "quad", "mesh"];
 
+impl ShapeFile {
+    /// The entry's material name, emission and two-sidedness.
+    pub fn emission(&self) -> (Option<&String>, Option<&Emission>, Option<bool>) {
+        match self {
+            ShapeFile::Sphere(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Triangle(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Plane(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Quad(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Mesh(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        }
+    }
+
+    /// The entry's medium.
+    pub fn medium(&self) -> Option<&MediumFile> {
+        match self {
+            ShapeFile::Sphere(x) => x.medium.as_ref(),
+            ShapeFile::Triangle(x) => x.medium.as_ref(),
+            ShapeFile::Plane(x) => x.medium.as_ref(),
+            ShapeFile::Quad(x) => x.medium.as_ref(),
+            ShapeFile::Mesh(x) => x.medium.as_ref(),
+        }
+    }
+}
+
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SphereFile {
@@ -353,7 +377,7 @@ pub struct MeshFile {
 /// the Lorenz–Mie wavelength nodes, default 10) and `forward_cutoff` (degrees, default
 /// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
 /// `sigma_a`, `sigma_s` (per scene unit) and `g` in (−1, 1). The keys are checked
-/// against the type in `load.rs`.
+/// against the type in `load/media.rs`.
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MediumFile {
