@@ -6,8 +6,8 @@
 use crate::error::HeronError;
 use crate::scene::file::{
     show, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile,
-    MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, SphereFile, SpotLightFile,
-    SunLightFile, TriangleFile, LIGHT_TYPES, MATERIAL_TYPES, SHAPE_TYPES,
+    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, ShapeFile,
+    SphereFile, SpotLightFile, SunLightFile, TriangleFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -152,9 +152,9 @@ pub(super) fn key(base: &str, k: &str) -> String {
 /// Whether `path` is an item of a collection tagged by `type`, and the type list.
 fn tagged_item(path: &[Seg]) -> Option<&'static [&'static str]> {
     match path {
-        [Seg::Key(c), Seg::Key(_)] if c == "materials" => Some(MATERIAL_TYPES),
-        [Seg::Key(c), Seg::Index(_)] if c == "shapes" => Some(SHAPE_TYPES),
-        [Seg::Key(c), Seg::Index(_)] if c == "lights" => Some(LIGHT_TYPES),
+        [Seg::Key(c), Seg::Key(_)] if c == "materials" => Some(MaterialFile::NAMES),
+        [Seg::Key(c), Seg::Index(_)] if c == "shapes" => Some(ShapeFile::NAMES),
+        [Seg::Key(c), Seg::Index(_)] if c == "lights" => Some(LightFile::NAMES),
         _ => None,
     }
 }
@@ -391,9 +391,9 @@ mod tests {
     #[test]
     fn every_tagged_type_is_refined() {
         for (collection, item, names) in [
-            ("materials", Seg::Key("m".into()), MATERIAL_TYPES),
-            ("shapes", Seg::Index(0), SHAPE_TYPES),
-            ("lights", Seg::Index(0), LIGHT_TYPES),
+            ("materials", Seg::Key("m".into()), MaterialFile::NAMES),
+            ("shapes", Seg::Index(0), ShapeFile::NAMES),
+            ("lights", Seg::Index(0), LightFile::NAMES),
         ] {
             for name in names {
                 let mut t = toml::Table::new();

@@ -6,7 +6,7 @@ use super::SkyTables;
 use crate::bsdf::Material;
 use crate::geometry::Shape;
 use crate::medium::{HgMedium, LorenzMieMedium, Medium};
-use crate::scene::file::{MediumFile, ShapeFile, MEDIUM_TYPES};
+use crate::scene::file::{MediumFile, MediumType, ShapeFile};
 use crate::spectrum::DenseSpectrum;
 
 /// Drop-size quadrature nodes of a medium's distribution when its table gives none:
@@ -53,12 +53,13 @@ pub(super) fn plan_media(entries: &[ShapeFile]) -> Result<Vec<Option<MediumPlan>
 
 /// Checks a `medium` table against its type.
 fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
-    match m.kind.as_str() {
-        "mie" => plan_mie(at, m),
-        "henyey-greenstein" => plan_hg(at, m),
-        other => Err(format!(
-            "{at}.type: expected one of {}, got {other:?}",
-            MEDIUM_TYPES.join(", ")
+    match MediumType::from_name(&m.kind) {
+        Some(MediumType::Mie) => plan_mie(at, m),
+        Some(MediumType::HenyeyGreenstein) => plan_hg(at, m),
+        None => Err(format!(
+            "{at}.type: expected one of {}, got {:?}",
+            MediumType::NAMES.join(", "),
+            m.kind
         )),
     }
 }
@@ -254,13 +255,7 @@ pub(super) fn assign_media(
         if !shape.is_closed() {
             return Err(format!(
                 "{at}.medium: expected a closed shape (a sphere, or a mesh whose every edge is shared by two triangles) around the medium, got an open {}",
-                match entry {
-                    ShapeFile::Sphere(_) => "sphere",
-                    ShapeFile::Triangle(_) => "triangle",
-                    ShapeFile::Plane(_) => "plane",
-                    ShapeFile::Quad(_) => "quad",
-                    ShapeFile::Mesh(_) => "mesh",
-                }
+                entry.name()
             ));
         }
         match &materials.list[shape.material as usize] {

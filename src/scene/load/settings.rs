@@ -32,15 +32,8 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
         settings.offset = OffsetMode::parse(name).map_err(|e| format!("render.offset: {e}"))?;
     }
     if let Some(name) = &r.light_sampler {
-        settings.light_sampler = match name.as_str() {
-            "power" => LightSamplerKind::Power,
-            "uniform" => LightSamplerKind::Uniform,
-            other => {
-                return Err(format!(
-                    "render.light_sampler: expected power or uniform, got {other:?}"
-                ))
-            }
-        };
+        settings.light_sampler =
+            LightSamplerKind::parse(name).map_err(|e| format!("render.light_sampler: {e}"))?;
     }
     Ok(settings)
 }
