@@ -22,7 +22,7 @@
 //! (stages 1 and 2's messages, key paths, `scene_error`), `materials.rs`, `shapes.rs`
 //! (spheres, triangles, planes, quads, meshes; `obj.rs` reads OBJ text), `media.rs`,
 //! `lights.rs` (the file's lights and the area lights of emitting shapes), `sky.rs`
-//! (`[sky]`), `settings.rs` (`[render]`), `camera.rs`.
+//! (`[sky]` to a [`crate::sky::SkySpec`]), `settings.rs` (`[render]`), `camera.rs`.
 //! [`build`] runs them in the order of the errors they report.
 pub(crate) mod obj;
 
@@ -123,7 +123,7 @@ pub(crate) fn build(
     let settings = settings::render_settings(file.render.as_ref()).map_err(err)?;
     let sky = match &file.sky {
         Some(sf) => {
-            let plan = sky::plan_sky(sf, &lights, &background).map_err(err)?;
+            let plan = sky::plan_sky(sf, &file.lights, &lights, &background).map_err(err)?;
             match sky_tables {
                 SkyTables::Build => Some(std::sync::Arc::new(plan.tabulate())),
                 SkyTables::Skip => None,
