@@ -257,12 +257,16 @@ pub fn scene(data: &[u8], fixtures: &Path) -> Outcome {
         return Outcome::Skipped;
     }
     let path = fixtures.join("scene.toml");
-    match load::build(&path, file, SkyTables::Skip) {
+    match load::build(&path, file, SkyTables::Skip, String::new()) {
         Ok(scene) => {
             assert_eq!(scene.materials.len(), scene.material_names.len());
-            assert_eq!(scene.shape_light.len(), scene.shapes.len());
             for s in &scene.shapes {
                 check_shape(s, scene.materials.len());
+                assert!(
+                    s.light == crate::geometry::NO_LIGHT
+                        || matches!(scene.lights.get(s.light as usize), Some(Light::Area(_))),
+                    "a shape's light is not an area light"
+                );
             }
             scene.materials.iter().for_each(check_material);
             scene.lights.iter().for_each(check_light);

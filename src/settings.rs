@@ -109,6 +109,24 @@ pub enum LightSamplerKind {
     Uniform,
 }
 
+impl LightSamplerKind {
+    pub const NAMES: &'static [&'static str] = &["power", "uniform"];
+
+    pub fn parse(name: &str) -> Result<LightSamplerKind, String> {
+        match name {
+            "power" => Ok(LightSamplerKind::Power),
+            "uniform" => Ok(LightSamplerKind::Uniform),
+            other => {
+                let (last, rest) = Self::NAMES.split_last().unwrap();
+                Err(format!(
+                    "expected {} or {last}, got {other:?}",
+                    rest.join(", ")
+                ))
+            }
+        }
+    }
+}
+
 /// The `offset` setting: which ray offset a render uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum OffsetMode {

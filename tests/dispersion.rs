@@ -23,7 +23,9 @@ fn glass_scene(shapes: Vec<Shape>, ior: Ior) -> Scene {
         materials: vec![Material::Dielectric(Dielectric::new(ior, true))],
         material_names: vec!["glass".into()],
         lights: vec![],
-        shape_light: vec![],
+        source_sha256: String::new(),
+        inputs: vec![],
+        media: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
         settings: RenderSettings {
@@ -40,8 +42,8 @@ fn glass_scene(shapes: Vec<Shape>, ior: Ior) -> Scene {
 fn prism() -> Shape {
     let h = 3f32.sqrt() / 2.0;
     let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
-    Shape {
-        kind: ShapeKind::Mesh(Mesh {
+    Shape::new(
+        ShapeKind::Mesh(Mesh {
             positions: vec![
                 p(-0.5, 0.0, -1.0),
                 p(0.5, 0.0, -1.0),
@@ -61,18 +63,18 @@ fn prism() -> Shape {
                 [2, 3, 5],
             ],
         }),
-        material: 0,
-    }
+        0,
+    )
 }
 
 fn drop() -> Shape {
-    Shape {
-        kind: ShapeKind::Sphere {
+    Shape::new(
+        ShapeKind::Sphere {
             center: Vec3::ZERO,
             radius: 1.0,
         },
-        material: 0,
-    }
+        0,
+    )
 }
 
 fn v(a: [f32; 3]) -> Vec3 {
@@ -289,15 +291,15 @@ fn trace_cli_prints_json_and_rejects_a_bad_path() {
 fn ending_secondary_wavelengths_is_unbiased() {
     let mut s = glass_scene(
         vec![
-            Shape {
-                kind: ShapeKind::Sphere {
+            Shape::new(
+                ShapeKind::Sphere {
                     center: Vec3::new(0.0, 0.0, 0.0),
                     radius: 0.8,
                 },
-                material: 0,
-            },
-            Shape {
-                kind: ShapeKind::Mesh(Mesh {
+                0,
+            ),
+            Shape::new(
+                ShapeKind::Mesh(Mesh {
                     positions: vec![
                         Vec3::new(-5.0, -1.0, -5.0),
                         Vec3::new(5.0, -1.0, -5.0),
@@ -306,8 +308,8 @@ fn ending_secondary_wavelengths_is_unbiased() {
                     ],
                     indices: vec![[0, 2, 1], [0, 3, 2]],
                 }),
-                material: 1,
-            },
+                1,
+            ),
         ],
         ior::named("N-SF11").unwrap(),
     );

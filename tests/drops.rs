@@ -262,15 +262,15 @@ fn sky_profile_takes_a_distribution_and_debye_terms() {
         ),
         (
             "--model mie --distribution marshall-palmer --rain-rate-mm-h 5",
-            "--distribution: the mie model takes radii up to 2 mm",
+            "--distribution: the mie sky takes radii up to 2 mm",
         ),
         (
             "--model descartes --distribution lognormal --median-mm 0.5 --sigma 0.1",
-            "--distribution applies to airy and mie",
+            "--distribution: applies to airy and mie",
         ),
         (
             "--model airy --droplet-radius 0.5 --debye 2",
-            "--debye applies to mie",
+            "--debye: applies to mie",
         ),
         ("--model mie --droplet-radius 0.5 --debye 99", "--debye:"),
     ] {

@@ -35,7 +35,9 @@ fn scene(
         material_names: (0..materials.len()).map(|i| format!("m{i}")).collect(),
         materials,
         lights,
-        shape_light: vec![],
+        source_sha256: String::new(),
+        inputs: vec![],
+        media: vec![],
         background: DenseSpectrum::constant(bg),
         sky: None,
         settings: RenderSettings {
@@ -49,13 +51,13 @@ fn scene(
 }
 
 fn quad(origin: Vec3, e1: Vec3, e2: Vec3, material: u32) -> Shape {
-    Shape {
-        kind: ShapeKind::Mesh(Mesh {
+    Shape::new(
+        ShapeKind::Mesh(Mesh {
             positions: vec![origin, origin + e1, origin + e1 + e2, origin + e2],
             indices: vec![[0, 1, 2], [0, 2, 3]],
         }),
         material,
-    }
+    )
 }
 
 /// The square y = 0, |x|, |z| ≤ `half`, facing +y.
@@ -69,10 +71,7 @@ fn floor(half: f32, material: u32) -> Shape {
 }
 
 fn sphere(center: Vec3, radius: f32, material: u32) -> Shape {
-    Shape {
-        kind: ShapeKind::Sphere { center, radius },
-        material,
-    }
+    Shape::new(ShapeKind::Sphere { center, radius }, material)
 }
 
 /// A render with the scene's settings on `threads` threads.

@@ -403,23 +403,19 @@ fn sky_profile_cli_writes_csv() {
         let want = sky.profile(v[0].to_radians(), 450.0) as f64;
         assert!((v[1] - want).abs() <= 1e-6 * want.abs() + 1e-12);
     }
-    for model in ["constant", "aristotle", "airy", "mie"] {
-        let out = heron(&[
-            "sky",
-            "profile",
-            "--model",
-            model,
-            "--lambda",
-            "550",
-            "--from",
-            "41",
-            "--to",
-            "42",
-            "--step",
-            "0.25",
-            "--droplet-radius",
-            "0.05",
-        ]);
+    // A drop radius only where the model has drops (SkySpec refuses it elsewhere).
+    for (model, radius) in [
+        ("constant", &[][..]),
+        ("aristotle", &[]),
+        ("airy", &["--droplet-radius", "0.05"]),
+        ("mie", &["--droplet-radius", "0.05"]),
+    ] {
+        let mut args = vec![
+            "sky", "profile", "--model", model, "--lambda", "550", "--from", "41", "--to", "42",
+            "--step", "0.25",
+        ];
+        args.extend_from_slice(radius);
+        let out = heron(&args);
         assert!(
             out.status.success(),
             "{model}: {}",
@@ -436,7 +432,7 @@ fn sky_profile_cli_rejects_bad_values_in_one_line() {
     for (args, needle) in [
         (
             "--model nope --lambda 500 --from 0 --to 1 --step 1",
-            "unknown model",
+            "--model: expected one of constant, aristotle, descartes, airy, mie, got \"nope\"",
         ),
         (
             "--model descartes --lambda 500 --from 0 --to 1 --step -1",
@@ -486,6 +482,19 @@ fn sky_profile_cli_rejects_bad_values_in_one_line() {
             "--model descartes --lambda 500 --from 0 --to 1 --step 1 --polarisation q",
             "--polarisation",
         ),
+        // SkySpec's rules, as in scene files: options that do not apply are refused.
+        (
+            "--model descartes --lambda 500 --from 0 --to 1 --step 1 --droplet-radius 0.5",
+            "--droplet-radius: applies to airy and mie, not descartes",
+        ),
+        (
+            "--model airy --lambda 500 --from 0 --to 1 --step 1 --droplet-radius 0.5 --k 0",
+            "--k: expected a non-empty subset of [1, 2], got [0]",
+        ),
+        (
+            "--model airy --lambda 500 --from 0 --to 1 --step 1 --droplet-radius 10.5",
+            "--droplet-radius: expected at most 10 mm, got 10.5",
+        ),
         (
             "--model descartes --lambda 500 --from 0 --to 200 --step 1",
             "0–180",
@@ -516,20 +525,22 @@ fn water_drop_scene() -> Scene {
     Scene::from_parts(SceneParts {
         source: "test".into(),
         camera: Camera::new(Vec3::new(0.0, 0.0, -5.0), Vec3::ZERO, Vec3::Y, 1.0, 8, 8).unwrap(),
-        shapes: vec![Shape {
-            kind: ShapeKind::Sphere {
+        shapes: vec![Shape::new(
+            ShapeKind::Sphere {
                 center: Vec3::ZERO,
                 radius: 1.0,
             },
-            material: 0,
-        }],
+            0,
+        )],
         materials: vec![Material::Dielectric(Dielectric::new(
             ior::named("water").unwrap(),
             true,
         ))],
         material_names: vec!["water".into()],
         lights: vec![],
-        shape_light: vec![],
+        source_sha256: String::new(),
+        inputs: vec![],
+        media: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
         settings: RenderSettings {

@@ -101,6 +101,39 @@ fn sky_section_errors_name_the_key() {
     assert!(e.contains("sun"), "{e}");
 }
 
+/// A scene's `[sky]` follows the limits of `heron sky profile` (one `SkySpec`): Airy
+/// drops up to 10 mm, Mie drops up to 2 mm, a sun of at most 5°, descartes order 0.
+#[test]
+fn sky_limits_are_the_clis() {
+    let e = load_err("[sky]\nmodel = \"airy\"\ndroplet_radius = 10.5");
+    assert!(
+        e.ends_with("sky.droplet_radius: expected at most 10 mm, got 10.5"),
+        "{e}"
+    );
+    let e = load_err("[sky]\nmodel = \"mie\"\ndroplet_radius = 2.5");
+    assert!(
+        e.ends_with("sky.droplet_radius: expected at most 2 mm, got 2.5"),
+        "{e}"
+    );
+    let e = load_err("angular_radius = 6\n[sky]\nmodel = \"descartes\"");
+    assert!(
+        e.ends_with("lights[0].angular_radius: expected an angle in (0°, 5°], got 6°"),
+        "{e}"
+    );
+    let e = load_err("[sky]\nmodel = \"airy\"\ndroplet_radius = 0.5\norders = [0, 1]");
+    assert!(
+        e.ends_with("sky.orders: expected a non-empty subset of [1, 2], got [0, 1]"),
+        "{e}"
+    );
+    // The fuzzing harness builds the sky's model without tabulating it.
+    let text = format!("{BASE}\n[sky]\nmodel = \"descartes\"\norders = [0, 1]\n");
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/fixtures");
+    assert_eq!(
+        heron::fuzzing::scene(text.as_bytes(), &fixtures),
+        heron::fuzzing::Outcome::Accepted
+    );
+}
+
 #[test]
 fn rendered_descartes_sky_has_its_bows_and_dark_band_where_optics_puts_them() {
     let mut s = load_scene(&scenes().join("rainbow-descartes.toml")).unwrap();

@@ -366,8 +366,9 @@ impl DropsFile {
             "marshall-palmer" | "marshall_palmer" => &["rain_rate_mm_h"],
             other => {
                 return Err(format!(
-                    "{}: expected one of monodisperse, lognormal, gamma, marshall-palmer, got {other:?}",
-                    name("distribution")
+                    "{}: expected one of {}, got {other:?}",
+                    name("distribution"),
+                    DISTRIBUTION_NAMES.join(", ")
                 ))
             }
         };

@@ -38,15 +38,40 @@ pub enum ShapeKind {
     Mesh(Mesh),
 }
 
-/// One shape of the scene; its index in `Scene::shapes` is its Embree geomID.
+/// [`Shape::light`] of a shape that does not emit.
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// [`Shape::medium`] of a shape that encloses no medium.
+pub const NO_MEDIUM: u32 = u32::MAX;
+
+/// One shape of the scene; its index in `Scene::shapes` is its Embree geomID. It carries
+/// what the transport asks of it at a hit: its material, its light and its medium.
 #[derive(Clone, Debug)]
 pub struct Shape {
     pub kind: ShapeKind,
     /// Index into `Scene::materials`.
     pub material: u32,
+    /// Its area light in `Scene::lights`, or [`NO_LIGHT`].
+    pub light: u32,
+    /// The medium it encloses in `Scene::media`, or [`NO_MEDIUM`].
+    pub medium: u32,
+    /// Whether it is only a medium's boundary (a medium and no material): index-matched,
+    /// rays pass it without refraction or reflection.
+    pub interface: bool,
 }
 
 impl Shape {
+    /// A shape of `material` that neither emits nor encloses a medium.
+    pub fn new(kind: ShapeKind, material: u32) -> Shape {
+        Shape {
+            kind,
+            material,
+            light: NO_LIGHT,
+            medium: NO_MEDIUM,
+            interface: false,
+        }
+    }
+
     /// Whether the shape encloses a volume: a sphere, or a mesh whose every edge is
     /// shared by exactly two triangles. A medium needs one around it, and `heron stress`
     /// counts a ray that escapes after leaving into one as a leak.

@@ -341,7 +341,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             v.wo = -ray.dir;
             v.frame = it.frame();
             v.material = it.material;
-            v.light = scene.shape_light[hit.geom_id as usize];
+            v.light = scene.shapes[hit.geom_id as usize].light;
             v.ended = ended;
             v.pdf_fwd = convert_density(pdf_fwd, &path[bounces], &v);
             path[bounces + 1] = v;

@@ -86,11 +86,11 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         }
         if on(K, MEDIA) {
             if let Some(h) = &hit {
-                if scene.shape_interface[h.geom_id as usize] {
+                if scene.shapes[h.geom_id as usize].interface {
                     // An index-matched boundary: cross it, switching media, no bounce.
                     let (it, _) = scene.interaction(&ray, h, ctx.offset.is_robust());
                     s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
-                        scene.shape_medium[h.geom_id as usize]
+                        scene.shapes[h.geom_id as usize].medium
                     } else {
                         NO_MEDIUM
                     };
@@ -357,7 +357,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags>(
 
     // Emission of an area light the path has reached.
     let emitter = if on(K, EMITTERS) {
-        scene.shape_light[hit.geom_id as usize]
+        scene.shapes[hit.geom_id as usize].light
     } else {
         NO_LIGHT
     };
@@ -421,7 +421,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags>(
     if on(K, MEDIA) && bs.is_transmission() {
         // Through a dielectric around a medium (a glass of milk) into or out of it.
         s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
-            scene.shape_medium[hit.geom_id as usize]
+            scene.shapes[hit.geom_id as usize].medium
         } else {
             medium_outside(s.medium, scene, hit.geom_id)
         };
@@ -471,7 +471,7 @@ fn surface_direct_light<const N: usize, const K: KernelFlags>(
     // Through media: the transmittance of the shadow ray (None: blocked).
     let tr_l = if on(K, MEDIA) {
         let from = if ls.wi.dot(it.n_outward) < 0.0 {
-            ctx.scene.shape_medium[v.geom as usize]
+            ctx.scene.shapes[v.geom as usize].medium
         } else {
             medium_outside(s.medium, ctx.scene, v.geom)
         };
@@ -530,7 +530,7 @@ fn lane_mean<const N: usize>(s: SampledSpectrum<N>, companions_alive: bool) -> f
 /// none when the path was in the shape's own medium (media do not nest), else `current`.
 #[inline]
 fn medium_outside(current: u32, scene: &Scene, geom: u32) -> u32 {
-    if current == scene.shape_medium[geom as usize] {
+    if current == scene.shapes[geom as usize].medium {
         NO_MEDIUM
     } else {
         current

@@ -212,7 +212,7 @@ pub(crate) fn transmittance<const N: usize>(
             return Some(tr);
         };
         let g = h.geom_id as usize;
-        if !scene.shape_interface[g] {
+        if !scene.shapes[g].interface {
             return None;
         }
         if medium != NO_MEDIUM {
@@ -221,7 +221,7 @@ pub(crate) fn transmittance<const N: usize>(
         let ray = Ray::new(q.origin, q.dir, q.tnear, q.tfar);
         let (it, _) = scene.interaction(&ray, &h, ctx.offset.is_robust());
         medium = if wi.dot(it.n_outward) < 0.0 {
-            scene.shape_medium[g]
+            scene.shapes[g].medium
         } else {
             NO_MEDIUM
         };

@@ -64,7 +64,7 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
         let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
         let wo = -ray.dir;
         if on(K, EMITTERS) {
-            let emitter = scene.shape_light[hit.geom_id as usize];
+            let emitter = scene.shapes[hit.geom_id as usize].light;
             if emitter != NO_LIGHT {
                 l += beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
             }

@@ -37,8 +37,8 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use phase_table::{direction_at, v_between};
 
-/// `Scene::shape_medium` for a shape without a medium.
-pub const NO_MEDIUM: u32 = u32::MAX;
+/// `Shape::medium` of a shape without a medium (defined with the shape).
+pub use crate::geometry::NO_MEDIUM;
 
 /// A participating medium.
 #[derive(Debug)]

@@ -45,10 +45,8 @@ pub fn spectra_json(scene: &Scene) -> Value {
     let shapes: Vec<Value> = scene
         .shapes
         .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let light = scene.shape_light[i];
-            let (emission, two_sided) = match scene.lights.get(light as usize) {
+        .map(|s| {
+            let (emission, two_sided) = match scene.lights.get(s.light as usize) {
                 Some(Light::Area(a)) => (values(&a.emission), a.two_sided),
                 _ => (Value::Null, false),
             };

@@ -98,7 +98,7 @@ impl Features {
             // Media scatter light from the lights too.
             nee: (non_specular || !scene.media.is_empty()) && scene.lights.iter().any(emits),
             specular: used().any(|m| m.flags().is_specular()),
-            emitters: scene.shape_light.iter().any(|&l| l != NO_LIGHT),
+            emitters: scene.shapes.iter().any(|s| s.light != NO_LIGHT),
             escape: !scene.infinite_lights.is_empty(),
             media: !scene.media.is_empty(),
         }

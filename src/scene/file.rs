@@ -163,8 +163,12 @@ pub enum MaterialFile {
     Conductor(ConductorFile),
 }
 
-/// The `type` values of [`MaterialFile`], in declaration order.
-pub const MATERIAL_TYPES: &[&str] = &["lambertian", "mirror", "dielectric", "glossy", "conductor"];
+impl MaterialFile {
+    /// The `type` values, in declaration order (serde's `rename_all = "lowercase"` of the
+    /// variants; `tests::names_are_the_serde_tags` holds them to it).
+    pub const NAMES: &'static [&'static str] =
+        &["lambertian", "mirror", "dielectric", "glossy", "conductor"];
+}
 
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -240,8 +244,45 @@ pub enum ShapeFile {
     Mesh(MeshFile),
 }
 
-/// The `type` values of [`ShapeFile`], in declaration order.
-pub const SHAPE_TYPES: &[&str] = &["sphere", "triangle", "plane", "quad", "mesh"];
+impl ShapeFile {
+    /// The `type` values, in declaration order (serde's `rename_all = "lowercase"` of the
+    /// variants; `tests::names_are_the_serde_tags` holds them to it).
+    pub const NAMES: &'static [&'static str] = &["sphere", "triangle", "plane", "quad", "mesh"];
+
+    /// The entry's material name, emission and two-sidedness.
+    pub fn emission(&self) -> (Option<&String>, Option<&Emission>, Option<bool>) {
+        match self {
+            ShapeFile::Sphere(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Triangle(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Plane(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Quad(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Mesh(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        }
+    }
+
+    /// The entry's medium.
+    pub fn medium(&self) -> Option<&MediumFile> {
+        match self {
+            ShapeFile::Sphere(x) => x.medium.as_ref(),
+            ShapeFile::Triangle(x) => x.medium.as_ref(),
+            ShapeFile::Plane(x) => x.medium.as_ref(),
+            ShapeFile::Quad(x) => x.medium.as_ref(),
+            ShapeFile::Mesh(x) => x.medium.as_ref(),
+        }
+    }
+
+    /// The entry's `type` value.
+    pub fn name(&self) -> &'static str {
+        let i = match self {
+            ShapeFile::Sphere(_) => 0,
+            ShapeFile::Triangle(_) => 1,
+            ShapeFile::Plane(_) => 2,
+            ShapeFile::Quad(_) => 3,
+            ShapeFile::Mesh(_) => 4,
+        };
+        Self::NAMES[i]
+    }
+}
 
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -353,7 +394,7 @@ pub struct MeshFile {
 /// the Lorenz–Mie wavelength nodes, default 10) and `forward_cutoff` (degrees, default
 /// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
 /// `sigma_a`, `sigma_s` (per scene unit) and `g` in (−1, 1). The keys are checked
-/// against the type in `load.rs`.
+/// against the type in `load/media.rs`.
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MediumFile {
@@ -382,8 +423,29 @@ pub struct MediumFile {
     pub g: Option<f32>,
 }
 
-/// The `type` values of [`MediumFile`].
-pub const MEDIUM_TYPES: &[&str] = &["mie", "henyey-greenstein"];
+/// The `type` of a [`MediumFile`] (read as a string and matched in the loader's media
+/// room, whose messages name the keys that do not apply to the type).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MediumType {
+    /// Water drops, coefficients from Lorenz–Mie theory.
+    Mie,
+    /// Given σ_a, σ_s and the Henyey–Greenstein g.
+    HenyeyGreenstein,
+}
+
+impl MediumType {
+    /// The `type` values, in declaration order.
+    pub const NAMES: &'static [&'static str] = &["mie", "henyey-greenstein"];
+    const ALL: [MediumType; 2] = [MediumType::Mie, MediumType::HenyeyGreenstein];
+
+    /// The type named `name`, if any.
+    pub fn from_name(name: &str) -> Option<MediumType> {
+        Self::NAMES
+            .iter()
+            .position(|n| *n == name)
+            .map(|i| Self::ALL[i])
+    }
+}
 
 /// `[[lights]]`, tagged by `type`.
 #[derive(Debug, serde::Deserialize)]
@@ -395,8 +457,11 @@ pub enum LightFile {
     Spot(SpotLightFile),
 }
 
-/// The `type` values of [`LightFile`], in declaration order.
-pub const LIGHT_TYPES: &[&str] = &["point", "directional", "sun", "spot"];
+impl LightFile {
+    /// The `type` values, in declaration order (serde's `rename_all = "lowercase"` of the
+    /// variants; `tests::names_are_the_serde_tags` holds them to it).
+    pub const NAMES: &'static [&'static str] = &["point", "directional", "sun", "spot"];
+}
 
 /// A spot light (pbrt-v4's falloff): full intensity within cone_angle − cone_delta of
 /// its axis, smoothly down to 0 at cone_angle.
@@ -1052,5 +1117,57 @@ impl<'de> Deserialize<'de> for Emission {
             )));
         }
         Ok(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The names serde's derived deserializer lists for an unknown `type` of the tagged
+    /// enum `T` (its error reads "unknown variant `x`, expected one of `a`, `b`, …").
+    fn serde_tags<T: serde::de::DeserializeOwned + std::fmt::Debug>() -> Vec<String> {
+        let v: toml::Value = toml::from_str("type = \"\"").unwrap();
+        let e = T::deserialize(v).unwrap_err().to_string();
+        let list = e
+            .split("expected one of ")
+            .nth(1)
+            .unwrap_or_else(|| panic!("{e}"));
+        list.lines()
+            .next()
+            .unwrap()
+            .split(", ")
+            .map(|n| n.trim().trim_matches('`').to_string())
+            .collect()
+    }
+
+    #[test]
+    fn names_are_the_serde_tags() {
+        assert_eq!(serde_tags::<MaterialFile>(), MaterialFile::NAMES);
+        assert_eq!(serde_tags::<ShapeFile>(), ShapeFile::NAMES);
+        assert_eq!(serde_tags::<LightFile>(), LightFile::NAMES);
+        // Each shape type's entry reports its own name.
+        for (name, keys) in [
+            ("sphere", "center = [0, 0, 0]\nradius = 1"),
+            ("triangle", "vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]"),
+            ("plane", "point = [0, 0, 0]\nnormal = [0, 1, 0]"),
+            (
+                "quad",
+                "origin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 1, 0]",
+            ),
+            ("mesh", "file = \"m.obj\""),
+        ] {
+            let v: toml::Value = toml::from_str(&format!("type = \"{name}\"\n{keys}")).unwrap();
+            assert_eq!(ShapeFile::deserialize(v).unwrap().name(), name);
+        }
+        assert_eq!(
+            ShapeFile::NAMES.len(),
+            5,
+            "a new shape type needs a line above"
+        );
+        for (i, n) in MediumType::NAMES.iter().enumerate() {
+            assert_eq!(MediumType::from_name(n), Some(MediumType::ALL[i]));
+        }
+        assert_eq!(MediumType::from_name("fog"), None);
     }
 }

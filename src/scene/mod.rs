@@ -18,8 +18,8 @@ use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 use std::path::PathBuf;
 
-/// `Scene::shape_light` for a shape that does not emit.
-pub const NO_LIGHT: u32 = u32::MAX;
+/// `Shape::light` of a shape that does not emit (defined with the shape).
+pub use crate::geometry::NO_LIGHT;
 
 /// A validated scene. `shapes[i]` is Embree geometry i.
 #[derive(Clone, Debug)]
@@ -31,14 +31,13 @@ pub struct Scene {
     /// scene names it and the SHA-256 of its bytes, sorted by path.
     pub inputs: Vec<(String, String)>,
     pub camera: Camera,
+    /// Each with its material, area light and medium.
     pub shapes: Vec<Shape>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     /// The file's lights in file order, then one area light per emitting shape, then
     /// the environment (background and sky), when it emits.
     pub lights: Vec<Light>,
-    /// For each shape, the index of its area light in `lights`, or [`NO_LIGHT`].
-    pub shape_light: Vec<u32>,
     /// The index of the environment light, if the background or sky emits.
     pub environment: Option<u32>,
     /// Lights a ray that leaves the scene can see (the environment first, then suns).
@@ -52,30 +51,31 @@ pub struct Scene {
     pub bounds: SceneBounds,
     /// Picks one light per shading point for the path integrator.
     pub light_sampler: LightSampler,
-    /// Participating media (`medium` on shapes); empty for most scenes.
+    /// Participating media (`Shape::medium` indexes them); empty for most scenes.
     pub media: std::sync::Arc<Vec<crate::medium::Medium>>,
-    /// For each shape, the medium it encloses, or [`crate::medium::NO_MEDIUM`].
-    pub shape_medium: Vec<u32>,
-    /// For each shape, whether it is only a medium's boundary (a medium and no
-    /// material): index-matched, rays pass it without refraction or reflection.
-    pub shape_interface: Vec<bool>,
 }
 
 /// What a scene is made of before its derived parts (the environment light, the list of
-/// lights at infinity, the bounding sphere, the light sampler) are computed.
+/// lights at infinity, the bounding sphere, the light sampler) are computed: everything
+/// [`Scene::from_parts`] needs, so nothing is patched into the scene afterwards.
 pub struct SceneParts {
     pub source: PathBuf,
+    /// SHA-256 of the scene file's text (hex; empty for scenes built in code).
+    pub source_sha256: String,
+    /// The other files the scene read, with the SHA-256 of each (see [`Scene::inputs`]).
+    pub inputs: Vec<(String, String)>,
     pub camera: Camera,
+    /// Each with its material, its area light in `lights` and its medium in `media`.
     pub shapes: Vec<Shape>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     /// Every light but the environment (area lights included).
     pub lights: Vec<Light>,
-    /// For each shape, its area light in `lights` or [`NO_LIGHT`]; empty: none emits.
-    pub shape_light: Vec<u32>,
     pub background: DenseSpectrum,
     pub sky: Option<std::sync::Arc<crate::sky::SceneSky>>,
     pub settings: RenderSettings,
+    /// The media the shapes enclose.
+    pub media: Vec<crate::medium::Medium>,
 }
 
 impl Scene {
@@ -103,22 +103,15 @@ impl Scene {
         );
         let bounds = load::scene_bounds(&p.shapes);
         let light_sampler = LightSampler::new(p.settings.light_sampler, &lights, &bounds);
-        let n_shapes = p.shapes.len();
-        let shape_light = if p.shape_light.is_empty() {
-            vec![NO_LIGHT; p.shapes.len()]
-        } else {
-            p.shape_light
-        };
         Scene {
             source: p.source,
-            source_sha256: String::new(),
-            inputs: Vec::new(),
+            source_sha256: p.source_sha256,
+            inputs: p.inputs,
             camera: p.camera,
             shapes: p.shapes,
             materials: p.materials,
             material_names: p.material_names,
             lights,
-            shape_light,
             environment,
             infinite_lights,
             background: p.background,
@@ -126,9 +119,7 @@ impl Scene {
             settings: p.settings,
             bounds,
             light_sampler,
-            media: Default::default(),
-            shape_medium: vec![crate::medium::NO_MEDIUM; n_shapes],
-            shape_interface: vec![false; n_shapes],
+            media: std::sync::Arc::new(p.media),
         }
     }
 

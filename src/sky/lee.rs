@@ -47,7 +47,7 @@ fn bad(msg: String) -> HeronError {
 
 impl LeeRequest {
     fn validate(&self) -> Result<()> {
-        let max = super::profile::MIE_MAX_RADIUS_MM;
+        let max = super::spec::MIE_MAX_RADIUS_MM;
         for (flag, v) in [
             ("--radius-from", self.radius_from_mm),
             ("--radius-to", self.radius_to_mm),
@@ -84,7 +84,7 @@ impl LeeRequest {
                 self.lambda_step_nm
             )));
         }
-        super::check_sun_radius(self.sun_radius_deg.to_radians())
+        super::spec::check_sun_radius(self.sun_radius_deg, "--sun-radius").map_err(bad)
     }
 
     /// The radii (mm): log-spaced from `radius_from_mm` to `radius_to_mm`.

@@ -34,7 +34,9 @@
 //! diagrams.
 //!
 //! The single-particle physics (Lorenz–Mie, Debye) is [`crate::optics`]; this module holds
-//! what makes it a sky (profiles, disk averages, tables).
+//! what makes it a sky (profiles, disk averages, tables). [`SkySpec`] (`spec.rs`) is the
+//! one description of a sky that scene files, `heron sky profile` and the Python module
+//! fill, with its rules and limits.
 //!
 //! Polarisation: `S` means incident light polarised perpendicular to the scattering plane
 //! (Fresnel's s, Mie's S₁), `P` parallel to it (Fresnel's p, Mie's S₂); unpolarised light is
@@ -46,6 +48,7 @@ pub mod descartes;
 pub mod lee;
 pub mod mie;
 pub mod profile;
+pub mod spec;
 pub mod table;
 
 pub use airy::AirySky;
@@ -53,6 +56,7 @@ pub use aristotle::AristotleSky;
 pub use constant::ConstantSky;
 pub use descartes::DescartesSky;
 pub use mie::MieSky;
+pub use spec::{SkyKey, SkyModel, SkySpec};
 pub use table::SceneSky;
 
 use glam::Vec3;
@@ -69,6 +73,21 @@ pub enum Polarisation {
 }
 
 impl Polarisation {
+    /// The names scene files, the CLI and Python give, in the order of the variants
+    /// ("unpolarized" is read as "unpolarised" too).
+    pub const NAMES: [&'static str; 3] = ["unpolarised", "s", "p"];
+
+    /// The polarisation named `name`, if any.
+    pub fn from_name(name: &str) -> Option<Polarisation> {
+        match name {
+            "unpolarized" => Some(Polarisation::Unpolarised),
+            _ => [Polarisation::Unpolarised, Polarisation::S, Polarisation::P]
+                .into_iter()
+                .zip(Self::NAMES)
+                .find_map(|(p, n)| (n == name).then_some(p)),
+        }
+    }
+
     /// Combines a quantity computed for s and for p light.
     #[inline]
     pub fn mix(self, s: f64, p: f64) -> f64 {
@@ -148,17 +167,6 @@ pub fn disk_quadrature(n: usize) -> Vec<(f64, f64)> {
             (a.cos(), 2.0 * a.sin().powi(2) / (n as f64 + 1.0))
         })
         .collect()
-}
-
-/// Validates a sun angular radius in radians: finite, > 0 and ≤ 5°.
-pub(crate) fn check_sun_radius(alpha: f64) -> crate::Result<()> {
-    if !(alpha.is_finite() && alpha > 0.0 && alpha <= 5f64.to_radians()) {
-        return Err(crate::HeronError::Invalid(format!(
-            "--sun-radius: expected an angle in (0°, 5°], got {}°",
-            alpha.to_degrees()
-        )));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -1,7 +1,9 @@
 //! `heron sky profile`: radiance against the angle from the antisolar point as CSV, one
-//! column per wavelength; and `heron sky mie-phase` (hidden), the raw Mie amplitudes for
-//! the miepython comparison in tests/python/test_mie.py.
-use super::{AirySky, AristotleSky, ConstantSky, DescartesSky, MieSky, Polarisation, Sky};
+//! column per wavelength; its flags (the Python module's `heron.sky_profile` passes its
+//! keyword arguments as the same flags) mapped to a [`SkySpec`], which holds the rules and
+//! the limits. And `heron sky mie-phase` (hidden), the raw Mie amplitudes for the
+//! miepython comparison in tests/python/test_mie.py.
+use super::{Sky, SkyKey, SkySpec};
 use crate::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
 use crate::{HeronError, Result};
 use std::fmt::Write;
@@ -59,171 +61,69 @@ pub fn parse_lambdas(s: &str) -> Result<Vec<f32>> {
     Ok(v)
 }
 
-/// `--k`: 1, 2 or both; descartes also takes 0 (external reflection) and all (0, 1, 2).
-fn parse_orders(k: Option<&str>, model: &str) -> Result<Vec<u32>> {
-    match (k.unwrap_or("both"), model) {
-        ("1", _) => Ok(vec![1]),
-        ("2", _) => Ok(vec![2]),
-        ("both", _) => Ok(vec![1, 2]),
-        ("0", "descartes") => Ok(vec![0]),
-        ("all", "descartes") => Ok(vec![0, 1, 2]),
-        (other, _) => Err(bad(format!(
+/// The flag that names `key` of a [`SkySpec`] on the command line (the Python module
+/// renames the flags to its arguments).
+pub fn flag(key: SkyKey) -> String {
+    match key {
+        SkyKey::Model => "--model".into(),
+        SkyKey::SunRadius => "--sun-radius".into(),
+        // A monodisperse distribution takes its radius from --droplet-radius.
+        SkyKey::DropletRadius | SkyKey::Drop("radius_mm") => "--droplet-radius".into(),
+        SkyKey::Orders => "--k".into(),
+        SkyKey::Polarisation => "--polarisation".into(),
+        SkyKey::Drops => "--distribution".into(),
+        SkyKey::Drop(k) => drops_flag(k),
+        SkyKey::MonodisperseDrops => "--distribution monodisperse --droplet-radius …".into(),
+        SkyKey::Debye => "--debye".into(),
+        SkyKey::Background => "--background".into(),
+    }
+}
+
+/// `--k`: 1, 2, both, 0 (the external reflection) or all (0, 1 and 2) as a list of
+/// orders; which orders a model takes is [`SkySpec`]'s rule.
+fn parse_orders(k: &str) -> Result<Vec<u32>> {
+    match k {
+        "1" => Ok(vec![1]),
+        "2" => Ok(vec![2]),
+        "both" => Ok(vec![1, 2]),
+        "0" => Ok(vec![0]),
+        "all" => Ok(vec![0, 1, 2]),
+        other => Err(bad(format!(
             "--k: expected 1, 2 or both (descartes also 0 or all), got {other:?}"
         ))),
     }
 }
 
-fn parse_polarisation(p: Option<&str>) -> Result<Polarisation> {
-    match p.unwrap_or("unpolarised") {
-        "unpolarised" | "unpolarized" => Ok(Polarisation::Unpolarised),
-        "s" => Ok(Polarisation::S),
-        "p" => Ok(Polarisation::P),
-        other => Err(bad(format!(
-            "--polarisation: expected unpolarised, s or p, got {other:?}"
-        ))),
-    }
-}
-
-/// Largest drop radius accepted for `mie` (x ≈ 35 000 at 360 nm: seconds per wavelength).
-pub const MIE_MAX_RADIUS_MM: f64 = 2.0;
 /// Largest number of rows.
 pub const MAX_ROWS: usize = 2_000_000;
 
-/// Builds the model of a request (validating every value).
-pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
-    let alpha = req.sun_radius_deg.to_radians();
-    super::check_sun_radius(alpha)?;
-    let model = req.model.as_str();
-    let uses_orders = matches!(model, "descartes" | "airy");
-    let uses_pol = matches!(model, "descartes" | "airy" | "mie");
-    if req.k.is_some() && !uses_orders && is_model(model) {
-        return Err(bad(format!(
-            "--k applies to descartes and airy, not {model}"
-        )));
-    }
-    if req.polarisation.is_some() && !uses_pol && is_model(model) {
-        return Err(bad(format!(
-            "--polarisation applies to descartes, airy and mie, not {model}"
-        )));
-    }
-    if (req.drops.is_some() || req.debye.is_some())
-        && is_model(model)
-        && !matches!(model, "airy" | "mie")
-    {
-        let flag = if req.drops.is_some() {
-            "--distribution"
-        } else {
-            "--debye"
-        };
-        return Err(bad(format!("{flag} applies to airy and mie, not {model}")));
-    }
-    if req.debye.is_some() && model == "airy" {
-        return Err(bad("--debye applies to mie, not airy".into()));
-    }
-    if let Some(p) = req.debye {
-        if p > super::mie::MAX_DEBYE_TERM {
-            return Err(bad(format!(
-                "--debye: expected a term p in 0..={}, got {p}",
-                super::mie::MAX_DEBYE_TERM
-            )));
-        }
-    }
-    let orders = parse_orders(req.k.as_deref(), model)?;
-    let pol = parse_polarisation(req.polarisation.as_deref())?;
-    // A distribution other than monodisperse replaces --droplet-radius.
-    let dsd = |max_mm: f64| -> Result<Option<(crate::drops::DropSizeDistribution, usize)>> {
-        let Some(f) = &req.drops else { return Ok(None) };
-        let mut f = f.clone();
+/// The sky of a request as a [`SkySpec`]: each flag to its key, a monodisperse
+/// `--distribution` with the radius of `--droplet-radius`.
+pub fn sky_spec(req: &ProfileRequest) -> Result<SkySpec> {
+    let mut droplet_radius_mm = req.droplet_radius_mm;
+    let mut drops = req.drops.clone();
+    if let Some(f) = &mut drops {
         if f.distribution == "monodisperse" {
-            f.radius_mm = req.droplet_radius_mm;
-        } else if req.droplet_radius_mm.is_some() {
-            return Err(bad(format!(
-                "--droplet-radius: gives one radius; the {} distribution takes its own flags",
-                f.distribution
-            )));
+            f.radius_mm = droplet_radius_mm.take();
         }
-        let (d, n) = f
-            .parse_named(&|k| {
-                if k == "radius_mm" {
-                    "--droplet-radius".into()
-                } else {
-                    drops_flag(k)
-                }
-            })
-            .map_err(bad)?;
-        let n = if model == "mie" && f.nodes.is_none() {
-            crate::drops::MIE_DEFAULT_NODES
-        } else {
-            n
-        };
-        let largest = d.max_radius_mm();
-        if largest > max_mm {
-            return Err(bad(format!(
-                "--distribution: the {model} model takes radii up to {max_mm} mm; this distribution reaches {largest:.3} mm"
-            )));
-        }
-        Ok(Some((d, n)))
-    };
-    let radius = |max_mm: f64| -> Result<f64> {
-        let r = req.droplet_radius_mm.ok_or_else(|| {
-            bad(format!(
-                "--droplet-radius: the {model} model needs a drop radius in mm"
-            ))
-        })?;
-        if !(r.is_finite() && r > 0.0 && r <= max_mm) {
-            return Err(bad(format!(
-                "--droplet-radius: expected a radius in (0, {max_mm}] mm for {model}, got {r}"
-            )));
-        }
-        // Airy and Mie need x = 2πa/λ well above 1 for the bows to exist at all.
-        Ok(r)
-    };
-    let background = |default: f64| -> Result<DenseSpectrum> {
-        let b = req.background.unwrap_or(default);
-        if !(b.is_finite() && b >= 0.0) {
-            return Err(bad(format!(
-                "--background: expected a radiance ≥ 0, got {b}"
-            )));
-        }
-        Ok(DenseSpectrum::constant(b as f32))
-    };
-    Ok(match model {
-        "constant" => Sky::Constant(ConstantSky::new(background(1.0)?)),
-        "aristotle" => Sky::Aristotle(AristotleSky::new(alpha, background(0.0)?)),
-        "descartes" => {
-            let mut s = DescartesSky::water(alpha);
-            s.orders = orders;
-            s.polarisation = pol;
-            Sky::Descartes(s)
-        }
-        "airy" => {
-            let mut s = match dsd(10.0)? {
-                Some((d, n)) => AirySky::water(1.0, alpha).with_distribution(&d, n),
-                None => AirySky::water(radius(10.0)?, alpha),
-            };
-            s.orders = orders;
-            s.polarisation = pol;
-            Sky::Airy(s)
-        }
-        "mie" => {
-            let mut s = match dsd(MIE_MAX_RADIUS_MM)? {
-                Some((d, n)) => MieSky::water(1.0, alpha).with_distribution(&d, n),
-                None => MieSky::water(radius(MIE_MAX_RADIUS_MM)?, alpha),
-            };
-            s.polarisation = pol;
-            s.debye = req.debye;
-            Sky::Mie(s)
-        }
-        other => {
-            return Err(bad(format!(
-                "--model: unknown model {other:?}; expected constant, aristotle, descartes, airy or mie"
-            )))
-        }
+    }
+    Ok(SkySpec {
+        model: req.model.clone(),
+        sun_radius_deg: req.sun_radius_deg,
+        sun_radius_rad: req.sun_radius_deg.to_radians(),
+        droplet_radius_mm,
+        drops,
+        orders: req.k.as_deref().map(parse_orders).transpose()?,
+        polarisation: req.polarisation.clone(),
+        debye: req.debye,
+        background: req.background.map(|b| DenseSpectrum::constant(b as f32)),
     })
 }
 
-fn is_model(m: &str) -> bool {
-    matches!(m, "constant" | "aristotle" | "descartes" | "airy" | "mie")
+/// Builds the model of a request (validating every value by [`SkySpec::build`], errors
+/// named by flag).
+pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
+    sky_spec(req)?.build(&flag).map_err(bad)
 }
 
 /// The θ values (degrees) of a request.

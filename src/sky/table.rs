@@ -119,6 +119,35 @@ pub struct SceneSky {
     pub replaces_background: bool,
 }
 
+impl SceneSky {
+    /// Tabulates `sky` for rendering (seconds for the physical models) and ties it to the
+    /// scene's sun: `model` names it, `sun_dir` points toward the sun, `factor` and
+    /// `replaces_background` as the fields say.
+    pub fn new(
+        model: String,
+        mut sky: Sky,
+        sun_dir: Vec3,
+        factor: DenseSpectrum,
+        replaces_background: bool,
+    ) -> SceneSky {
+        if let Sky::Mie(m) = &mut sky {
+            if m.drops.len() > 1 {
+                // One Mie series per node and wavelength: a table every 10 nm, interpolated
+                // (the bows move by ≤ 0.06° over 10 nm, well inside the 0.53° disk), halves
+                // the scene's 95 wavelengths of the sky table.
+                m.lambda_step_nm = 10.0;
+            }
+        }
+        SceneSky {
+            table: SkyTable::build(&sky),
+            model,
+            sun_dir,
+            factor,
+            replaces_background,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,136 @@
+//! Lights: each `[[lights]]` entry to its [`Light`] (point, directional, sun with an
+//! optional portal, spot), and one area light per emitting shape after them.
+use super::errors::fmt_points;
+use super::shapes::{cross_overflows, is_degenerate};
+use crate::geometry::{Shape, ShapeKind};
+use crate::light::{
+    AreaLight, AreaShape, DirectionalLight, Light, PointLight, Portal, SpotLight, SunLight,
+};
+use crate::scene::file::{fmt_f32, LightFile, ShapeFile, SpotLightFile, SunLightFile};
+
+/// The file's lights, in file order.
+pub(super) fn build_lights(entries: &[LightFile]) -> Result<Vec<Light>, String> {
+    entries
+        .iter()
+        .enumerate()
+        .map(|(i, l)| match l {
+            LightFile::Point(p) => Ok(Light::Point(PointLight {
+                position: p.position.0,
+                intensity: p.intensity.spectrum(),
+            })),
+            LightFile::Directional(d) => Ok(Light::Directional(DirectionalLight {
+                direction: d.direction.unit(),
+                radiance: d.radiance.spectrum(),
+            })),
+            LightFile::Sun(s) => sun(&format!("lights[{i}]"), s).map(Light::Sun),
+            LightFile::Spot(s) => spot(&format!("lights[{i}]"), s).map(Light::Spot),
+        })
+        .collect()
+}
+
+/// A sun entry at key path `at`.
+fn sun(at: &str, s: &SunLightFile) -> Result<SunLight, String> {
+    let deg = s
+        .angular_radius
+        .map_or(crate::light::sun::SUN_ANGULAR_RADIUS_DEG, |a| a.0);
+    if deg >= 90.0 {
+        return Err(format!(
+            "{at}.angular_radius: expected degrees in (0, 90), got {deg}"
+        ));
+    }
+    let mut sun = SunLight::new(
+        s.direction.unit(),
+        s.irradiance.spectrum(),
+        deg.to_radians(),
+    );
+    if !sun.radiance.values().iter().all(|v| v.is_finite()) {
+        return Err(format!(
+            "{at}: the sun's radiance (irradiance / solid angle of the disk) overflows f32 with angular_radius = {} degrees and irradiance up to {}; expected a larger angular_radius or a smaller irradiance",
+            fmt_f32(deg),
+            fmt_f32(sun.irradiance.max_value())
+        ));
+    }
+    if let Some(p) = &s.portal {
+        let (o, e1, e2) = (p.origin.0, p.edge1.0, p.edge2.0);
+        if cross_overflows(o, o + e1, o + e2) || !(o + e1 + e2).is_finite() {
+            return Err(format!(
+                "{at}.portal: expected a portal whose corners and edges' cross product are finite in f32 (coordinates within about ±1e19), got origin {} and edges {} and {}",
+                fmt_points(&[o]),
+                fmt_points(&[e1]),
+                fmt_points(&[e2])
+            ));
+        }
+        if is_degenerate(o, o + e1, o + e2) {
+            return Err(format!(
+                "{at}.portal: expected edge1 and edge2 spanning a non-zero area, got {} and {}",
+                fmt_points(&[e1]),
+                fmt_points(&[e2])
+            ));
+        }
+        sun.portal = Some(Portal::new(o, e1, e2));
+    }
+    Ok(sun)
+}
+
+/// A spot entry at key path `at`.
+fn spot(at: &str, s: &SpotLightFile) -> Result<SpotLight, String> {
+    let angle = s.cone_angle.map_or(30.0, |a| a.0);
+    let delta = s.cone_delta.map_or(5.0, |a| a.0);
+    if angle > 90.0 {
+        return Err(format!(
+            "{at}.cone_angle: expected degrees in (0, 90], got {angle}"
+        ));
+    }
+    if delta > angle {
+        return Err(format!(
+            "{at}.cone_delta: expected degrees in [0, cone_angle = {angle}], got {delta}"
+        ));
+    }
+    Ok(SpotLight {
+        position: s.position.0,
+        direction: s.direction.unit(),
+        intensity: s.intensity.spectrum(),
+        cos_falloff_start: (angle - delta).to_radians().cos(),
+        cos_falloff_end: angle.to_radians().cos(),
+    })
+}
+
+/// Appends one area light per emitting shape (emission above zero somewhere) to `lights`
+/// and gives the shape its index. `shape_entry` is each shape's entry in `entries`.
+pub(super) fn add_area_lights(
+    entries: &[ShapeFile],
+    shape_entry: &[usize],
+    shapes: &mut [Shape],
+    lights: &mut Vec<Light>,
+) {
+    for (k, shape) in shapes.iter_mut().enumerate() {
+        let (_, emission, two_sided) = entries[shape_entry[k]].emission();
+        let Some(e) = emission else { continue };
+        if e.0.max_value() <= 0.0 {
+            continue;
+        }
+        let two_sided = two_sided.unwrap_or(false);
+        let area = match &shape.kind {
+            ShapeKind::Sphere { center, radius } => AreaLight::new(
+                k as u32,
+                e.spectrum(),
+                two_sided,
+                AreaShape::Sphere {
+                    center: *center,
+                    radius: *radius,
+                },
+            ),
+            ShapeKind::Mesh(m) => AreaLight::triangles(
+                k as u32,
+                e.spectrum(),
+                two_sided,
+                m.indices
+                    .iter()
+                    .map(|t| t.map(|v| m.positions[v as usize]))
+                    .collect(),
+            ),
+        };
+        shape.light = lights.len() as u32;
+        lights.push(Light::Area(area));
+    }
+}

@@ -1,0 +1,288 @@
+//! Materials: each `[materials.NAME]` table to its [`Material`] (refractive indices and
+//! metals' complex indices read from the catalogue, formulas or tables), the two materials
+//! the loader adds for shapes that name none, and the lookup of a material by name.
+use super::errors::key;
+use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
+use crate::bsdf::{
+    Conductor, Dielectric, Glossy, Lambertian, Material, Mirror, RoughConductor, RoughDielectric,
+};
+use crate::scene::file::{Colour, IorSpec, MaterialFile, MetalSpec, SceneFile};
+use crate::spectrum::ior::Ior;
+use crate::spectrum::metals::ComplexIor;
+use crate::spectrum::DenseSpectrum;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The scene's materials: the file's, sorted by name (a TOML table keeps no order), then
+/// the ones the loader adds.
+pub(super) struct Materials {
+    pub list: Vec<Material>,
+    pub names: Vec<String>,
+    /// The black Lambertian of a shape that emits and names no material (a pure
+    /// emitter); its index even when no shape needs it.
+    pub black: u32,
+    /// The index-matched boundary of a shape with a medium and no material: a dielectric
+    /// of index 1 (Fresnel 0, straight through), so every integrator and `heron stress`
+    /// see a valid material, and the path tracer passes it without a bounce.
+    pub boundary: u32,
+    index: HashMap<String, u32>,
+}
+
+impl Materials {
+    /// Builds the file's materials (tables read relative to `base_dir`, recorded in
+    /// `inputs`), and adds the black emitter and the medium boundary after them, when a
+    /// shape needs one, so the named materials' indices do not move.
+    pub fn build(
+        file: &SceneFile,
+        base_dir: &Path,
+        inputs: &mut Vec<String>,
+    ) -> Result<Materials, String> {
+        let mut list = Vec::with_capacity(file.materials.len());
+        let mut names = Vec::with_capacity(file.materials.len());
+        for (name, m) in &file.materials {
+            list.push(build_material(
+                &key("materials", name),
+                m,
+                base_dir,
+                inputs,
+            )?);
+            names.push(name.clone());
+        }
+        let black = list.len() as u32;
+        if file.shapes.iter().any(|s| {
+            let (m, e, _) = s.emission();
+            m.is_none() && e.is_some()
+        }) {
+            list.push(Material::Lambertian(Lambertian {
+                rho_d: DenseSpectrum::constant(0.0),
+            }));
+            names.push("(black emitter)".into());
+        }
+        let boundary = list.len() as u32;
+        if file.shapes.iter().any(|s| {
+            let (m, e, _) = s.emission();
+            m.is_none() && e.is_none() && s.medium().is_some()
+        }) {
+            list.push(Material::Dielectric(Dielectric::new(
+                Ior::Constant(1.0),
+                true,
+            )));
+            names.push("(medium boundary)".into());
+        }
+        let index = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.clone(), i as u32))
+            .collect();
+        Ok(Materials {
+            list,
+            names,
+            black,
+            boundary,
+            index,
+        })
+    }
+
+    /// The index of the material `name` that key path `at` names.
+    pub fn lookup(&self, at: &str, name: &str) -> Result<u32, String> {
+        self.index.get(name).copied().ok_or_else(|| {
+            let defined = if self.names.is_empty() {
+                "no materials are defined".to_string()
+            } else {
+                format!("defined: {}", self.names.join(", "))
+            };
+            format!("{at}: no material named {name:?} ({defined})")
+        })
+    }
+}
+
+/// The refractive-index model a scene file's `ior` value describes (a number, a catalogue
+/// name, `{ sellmeier = .. }`, `{ cauchy = .. }` or `{ table = "file.csv" }`, read
+/// relative to `base_dir`), checked as the loader checks it; the error is the loader's
+/// message after `at` (the key path it names). For the Python module's `heron.ior`.
+pub fn ior_from_value(
+    at: &str,
+    value: toml::Value,
+    base_dir: &Path,
+) -> std::result::Result<Ior, String> {
+    use serde::Deserialize as _;
+    let spec = IorSpec::deserialize(value).map_err(|e| format!("{at}: {}", e.message()))?;
+    build_ior(at, &spec, base_dir, &mut Vec::new())
+}
+
+/// The refractive-index model of `spec`; a table file is read relative to `base_dir`.
+fn build_ior(
+    at: &str,
+    spec: &IorSpec,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<Ior, String> {
+    let ior = match spec {
+        IorSpec::Constant(n) => Ior::Constant(*n),
+        IorSpec::Named(name) => crate::spectrum::ior::named(name)
+            .ok_or_else(|| format!("{at}: unknown refractive-index model {name:?}"))?,
+        IorSpec::Sellmeier { b, c } => Ior::sellmeier(b, c).map_err(|e| format!("{at}: {e}"))?,
+        IorSpec::Cauchy([a, b, c]) => Ior::Cauchy {
+            a: *a,
+            b: *b,
+            c: *c,
+        },
+        IorSpec::Table(file) => {
+            let p = base_dir.join(file);
+            let csv =
+                crate::spectrum::csv::SpectrumCsv::read(&p).map_err(|e| format!("{at}: {e}"))?;
+            inputs.push(file.clone());
+            Ior::Table(csv.to_dense())
+        }
+    };
+    ior.validate().map_err(|e| format!("{at}: {e}"))?;
+    Ok(ior)
+}
+
+/// The complex index of `spec`; a table is read relative to `base_dir`.
+fn build_metal(
+    at: &str,
+    spec: &MetalSpec,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<ComplexIor, String> {
+    let at = format!("{at}.metal");
+    match spec {
+        MetalSpec::Named(name) => crate::spectrum::metals::named(name)
+            .ok_or_else(|| format!("{at}: unknown metal {name:?}")),
+        MetalSpec::Table(file) => {
+            inputs.push(file.clone());
+            crate::spectrum::metals::read_nk(&base_dir.join(file)).map_err(|e| format!("{at}: {e}"))
+        }
+        MetalSpec::Constant { n, k } => Ok(ComplexIor {
+            n: DenseSpectrum::constant(*n),
+            k: DenseSpectrum::constant(*k),
+        }),
+    }
+}
+
+/// The material of the table `m` at key path `at` (`materials.NAME`).
+fn build_material(
+    at: &str,
+    m: &MaterialFile,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<Material, String> {
+    Ok(match m {
+        MaterialFile::Lambertian(l) => Material::Lambertian(Lambertian {
+            rho_d: l.rho_d.spectrum(),
+        }),
+        MaterialFile::Mirror(mi) => Material::Mirror(Mirror {
+            // Left out: the lecture's ideal mirror, exactly 1 at every wavelength.
+            rho_s: mi
+                .rho_s
+                .as_ref()
+                .map_or_else(|| DenseSpectrum::constant(1.0), |r| r.spectrum()),
+        }),
+        MaterialFile::Dielectric(d) => {
+            let mut interface = Dielectric::new(
+                build_ior(&format!("{at}.ior"), &d.ior, base_dir, inputs)?,
+                d.fresnel.unwrap_or(true),
+            );
+            if let Some(o) = &d.outside_ior {
+                interface.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir, inputs)?;
+            }
+            let alpha = d.roughness.map_or(0.0, |r| r.0);
+            if alpha < MIN_ALPHA {
+                Material::Dielectric(interface)
+            } else {
+                if d.fresnel == Some(false) {
+                    return Err(format!(
+                        "{at}.fresnel: false applies to the smooth interface (the lecture's pure refraction), not with roughness = {alpha}"
+                    ));
+                }
+                Material::RoughDielectric(RoughDielectric {
+                    interface,
+                    distribution: TrowbridgeReitz { alpha },
+                })
+            }
+        }
+        MaterialFile::Conductor(c) => {
+            let ior = build_metal(at, &c.metal, base_dir, inputs)?;
+            let alpha = c.roughness.map_or(0.0, |r| r.0);
+            if alpha < MIN_ALPHA {
+                Material::Conductor(Conductor { ior })
+            } else {
+                Material::RoughConductor(RoughConductor {
+                    ior,
+                    distribution: TrowbridgeReitz { alpha },
+                })
+            }
+        }
+        MaterialFile::Glossy(g) => {
+            if g.fresnel.is_some() && g.ior.is_none() {
+                return Err(format!(
+                    "{at}.fresnel: expected only together with ior (fresnel weights the refractive base), but ior is not given"
+                ));
+            }
+            // Energy conservation, seed "Glossy materials": ρd + ρs ≤ 1.
+            let rho_s = g.rho_s.0;
+            let sum_max = match g.rho_d.0.rgb() {
+                Some(rgb) => rgb.iter().fold(f32::MIN, |a, &c| a.max(c + rho_s)),
+                None => g.rho_d.0.max_value() + rho_s,
+            };
+            if sum_max > 1.0 + 1e-6 {
+                let rho_d = match &g.rho_d.0 {
+                    Colour::Grey(x) => format!("{x}"),
+                    Colour::Rgb(c) => format!("[{}, {}, {}]", c[0], c[1], c[2]),
+                    Colour::Named { spectrum, scale } => {
+                        format!("{{ spectrum = {spectrum:?}, scale = {scale} }}")
+                    }
+                };
+                return Err(format!(
+                    "{at}: expected rho_d + rho_s <= 1 in every channel (energy conservation), got rho_d = {rho_d} and rho_s = {rho_s} (sum up to {sum_max})"
+                ));
+            }
+            Material::Glossy(Glossy {
+                rho_d: g.rho_d.spectrum(),
+                rho_s,
+                shininess: g.shininess.0,
+                base: match &g.ior {
+                    Some(spec) => Some(Dielectric::new(
+                        build_ior(&format!("{at}.ior"), spec, base_dir, inputs)?,
+                        g.fresnel.unwrap_or(true),
+                    )),
+                    None => None,
+                },
+            })
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ior_from_value_reads_a_scene_files_ior() {
+        let eval = |v: toml::Value| ior_from_value("ior", v, Path::new("")).map(|i| i.eval(500.0));
+        assert_eq!(eval(toml::Value::Float(1.5)), Ok(1.5));
+        let named = crate::spectrum::ior::named("N-BK7").unwrap().eval(500.0);
+        assert_eq!(eval(toml::Value::String("N-BK7".into())), Ok(named));
+        let cauchy: toml::Value = toml::from_str::<toml::Table>("cauchy = [1.5, 0.0042]")
+            .unwrap()
+            .into();
+        let n = eval(cauchy).unwrap();
+        assert!((n - (1.5 + 0.0042 / 0.25)).abs() < 1e-6, "{n}");
+        // The loader's messages, after the key path given.
+        let e = eval(toml::Value::String("BK7".into())).unwrap_err();
+        assert!(
+            e.starts_with("ior: unknown refractive-index model \"BK7\", expected one of"),
+            "{e}"
+        );
+        let e = eval(toml::Value::Float(-1.0)).unwrap_err();
+        assert_eq!(e, "ior: expected a positive finite number, got -1");
+        // A Cauchy model below 1 in the visible is refused as in a scene.
+        let low: toml::Value = toml::from_str::<toml::Table>("cauchy = [0.5, 0.0]")
+            .unwrap()
+            .into();
+        assert!(eval(low)
+            .unwrap_err()
+            .starts_with("ior: expected a refractive index ≥ 1"));
+    }
+}

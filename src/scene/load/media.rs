@@ -1,0 +1,285 @@
+//! Media: each shape's `medium` table to a [`Medium`] (water drops by Lorenz–Mie theory,
+//! or Henyey–Greenstein), checked against its type, and given to closed shapes whose
+//! surface lets light in; each distinct medium is tabulated once.
+use super::materials::Materials;
+use super::SkyTables;
+use crate::bsdf::Material;
+use crate::geometry::Shape;
+use crate::medium::{HgMedium, LorenzMieMedium, Medium};
+use crate::scene::file::{MediumFile, MediumType, ShapeFile};
+use crate::spectrum::DenseSpectrum;
+
+/// Drop-size quadrature nodes of a medium's distribution when its table gives none:
+/// each node is one Lorenz–Mie tabulation (about 16 s for 0.5 mm drops).
+pub const MEDIUM_DEFAULT_NODES: usize = 8;
+
+/// What a `medium` table builds: the key path is `at` (`shapes[i].medium`).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum MediumPlan {
+    Mie(crate::medium::MieSpec),
+    Hg { sigma_a: f32, sigma_s: f32, g: f32 },
+}
+
+impl MediumPlan {
+    /// The medium (for Lorenz–Mie, its tabulation: seconds for rain drops).
+    fn build(&self) -> Medium {
+        match self {
+            MediumPlan::Mie(spec) => Medium::LorenzMie(LorenzMieMedium::new(spec.clone())),
+            MediumPlan::Hg {
+                sigma_a,
+                sigma_s,
+                g,
+            } => Medium::HenyeyGreenstein(HgMedium::new(
+                DenseSpectrum::constant(*sigma_a),
+                DenseSpectrum::constant(*sigma_s),
+                *g,
+            )),
+        }
+    }
+}
+
+/// The plan of each entry's `medium` table (None: the entry has none), checked.
+pub(super) fn plan_media(entries: &[ShapeFile]) -> Result<Vec<Option<MediumPlan>>, String> {
+    entries
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.medium()
+                .map(|m| plan_medium(&format!("shapes[{i}].medium"), m))
+                .transpose()
+        })
+        .collect()
+}
+
+/// Checks a `medium` table against its type.
+fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+    match MediumType::from_name(&m.kind) {
+        Some(MediumType::Mie) => plan_mie(at, m),
+        Some(MediumType::HenyeyGreenstein) => plan_hg(at, m),
+        None => Err(format!(
+            "{at}.type: expected one of {}, got {:?}",
+            MediumType::NAMES.join(", "),
+            m.kind
+        )),
+    }
+}
+
+/// `Some(name)` when the key `name` is given.
+fn given(name: &'static str, v: bool) -> Option<&'static str> {
+    if v {
+        Some(name)
+    } else {
+        None
+    }
+}
+
+/// A `type = "mie"` medium: water drops, one radius or a distribution's nodes, with a
+/// number density or a liquid water content. Radii are limited to 0.1 µm–1 mm: the
+/// Lorenz–Mie series has x + 4x^{1/3} + 2 terms per angle (x = 2πr/λ, 17 500 at 1 mm and
+/// 360 nm), so larger drops would take minutes to tabulate.
+fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+    if let Some(k) = given("sigma_a", m.sigma_a.is_some())
+        .or(given("sigma_s", m.sigma_s.is_some()))
+        .or(given("g", m.g.is_some()))
+    {
+        return Err(format!(
+            "{at}.{k}: applies to type = \"henyey-greenstein\", not to type = \"mie\" (whose coefficients come from Lorenz-Mie theory)"
+        ));
+    }
+    // The drops: one radius, or a distribution's quadrature nodes (number
+    // fractions summing to 1).
+    let (nodes, dist) = match (m.radius_mm, &m.drops) {
+        (Some(r), None) => (
+            vec![crate::drops::DropNode {
+                radius_mm: r.0 as f64,
+                weight: 1.0,
+            }],
+            None,
+        ),
+        (None, Some(d)) => {
+            let (dist, n) = d.parse(&format!("{at}.drops"))?;
+            // Each node is a Lorenz–Mie tabulation (seconds for rain drops), so
+            // media default to fewer nodes than skies.
+            let n = if d.nodes.is_none() {
+                MEDIUM_DEFAULT_NODES
+            } else {
+                n
+            };
+            (dist.nodes(n), Some(dist))
+        }
+        (Some(_), Some(_)) => {
+            return Err(format!(
+                "{at}: expected one of radius_mm (one drop radius) or drops (a distribution), got both"
+            ))
+        }
+        (None, None) => {
+            return Err(format!(
+                "{at}.radius_mm: missing required key (expected the drop radius in mm, or a drops table)"
+            ))
+        }
+    };
+    for n in &nodes {
+        if !(1e-4..=1.0).contains(&n.radius_mm) {
+            return Err(if dist.is_some() {
+                format!(
+                    "{at}.drops: expected drop radii in [0.0001, 1] mm (larger drops take minutes to tabulate), but the distribution has a quadrature node at {:.4} mm",
+                    n.radius_mm
+                )
+            } else {
+                format!(
+                    "{at}.radius_mm: expected a drop radius in [0.0001, 1] mm, got {}",
+                    n.radius_mm
+                )
+            });
+        }
+    }
+    // Σ wᵢ (4/3) π rᵢ³: the mean drop volume in m³.
+    let mean_volume: f64 = nodes
+        .iter()
+        .map(|n| n.weight * 4.0 / 3.0 * std::f64::consts::PI * (n.radius_mm * 1e-3).powi(3))
+        .sum();
+    let density = match (m.number_density, m.liquid_water_content) {
+        (Some(n), None) => n.0 as f64,
+        // N = LWC / (ρ_water ⟨V⟩), ρ_water = 10⁶ g/m³.
+        (None, Some(w)) => w.0 as f64 / (1e6 * mean_volume),
+        (Some(_), Some(_)) => {
+            return Err(format!(
+                "{at}: expected one of number_density (drops per m³) or liquid_water_content (g/m³), got both"
+            ))
+        }
+        // Marshall–Palmer defines its own number density (N0/Λ).
+        (None, None) => match dist.as_ref().and_then(|d| d.number_density()) {
+            Some(n) => n,
+            None => {
+                return Err(format!(
+                    "{at}.number_density: missing required key (expected drops per m³, or liquid_water_content in g/m³)"
+                ))
+            }
+        },
+    };
+    let step = m.lambda_step.map_or(10.0, |s| s.0);
+    if !(1.0..=50.0).contains(&step) {
+        return Err(format!(
+            "{at}.lambda_step: expected nm between wavelength nodes in [1, 50], got {step}"
+        ));
+    }
+    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.0 as f64);
+    if cutoff > 10.0 {
+        return Err(format!(
+            "{at}.forward_cutoff: expected degrees in [0, 10] (the diffraction peak counted as unscattered), got {cutoff}"
+        ));
+    }
+    Ok(MediumPlan::Mie(crate::medium::MieSpec {
+        population: nodes
+            .iter()
+            .map(|n| crate::medium::PopulationNode {
+                radius_m: n.radius_mm * 1e-3,
+                number_density: density * n.weight,
+            })
+            .collect(),
+        absorption: m.absorption.unwrap_or(true),
+        lambda_step_nm: step,
+        forward_cutoff_deg: cutoff,
+    }))
+}
+
+/// A `type = "henyey-greenstein"` medium: σ_a, σ_s and g given.
+fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+    if let Some(k) = given("radius_mm", m.radius_mm.is_some())
+        .or(given("drops", m.drops.is_some()))
+        .or(given("number_density", m.number_density.is_some()))
+        .or(given(
+            "liquid_water_content",
+            m.liquid_water_content.is_some(),
+        ))
+        .or(given("absorption", m.absorption.is_some()))
+        .or(given("lambda_step", m.lambda_step.is_some()))
+        .or(given("forward_cutoff", m.forward_cutoff.is_some()))
+    {
+        return Err(format!(
+            "{at}.{k}: applies to type = \"mie\", not to type = \"henyey-greenstein\""
+        ));
+    }
+    let g = m.g.unwrap_or(0.0);
+    if !(g.is_finite() && g.abs() < 1.0) {
+        return Err(format!(
+            "{at}.g: expected a mean cosine in (-1, 1), got {g}"
+        ));
+    }
+    let sigma_a = m.sigma_a.map_or(0.0, |x| x.0);
+    let sigma_s = m.sigma_s.map_or(0.0, |x| x.0);
+    if !(sigma_a + sigma_s).is_finite() || sigma_a + sigma_s <= 0.0 {
+        return Err(format!(
+            "{at}: expected sigma_a + sigma_s finite and > 0, got {sigma_a} + {sigma_s}"
+        ));
+    }
+    Ok(MediumPlan::Hg {
+        sigma_a,
+        sigma_s,
+        g,
+    })
+}
+
+/// Gives each shape its entry's medium (`plans`, by `shape_entry`) and returns the media.
+/// A medium sits in a closed shape whose surface lets light in: no material (an
+/// index-matched boundary, `Shape::interface`) or a smooth or rough dielectric (a glass of
+/// milk); one medium per entry, tabulated once per distinct medium. With
+/// [`SkyTables::Skip`] (the fuzzing harness, which never renders) Lorenz–Mie media are
+/// checked but not tabulated, which takes seconds: their shapes are left without one.
+pub(super) fn assign_media(
+    entries: &[ShapeFile],
+    shape_entry: &[usize],
+    plans: &[Option<MediumPlan>],
+    shapes: &mut [Shape],
+    materials: &Materials,
+    sky_tables: SkyTables,
+) -> Result<Vec<Medium>, String> {
+    let mut media: Vec<Medium> = Vec::new();
+    let mut medium_plans: Vec<&MediumPlan> = Vec::new();
+    for k in 0..shapes.len() {
+        let i = shape_entry[k];
+        let Some(plan) = &plans[i] else { continue };
+        let at = format!("shapes[{i}]");
+        let entry = &entries[i];
+        if entry.emission().1.is_some() {
+            return Err(format!(
+                "{at}.medium: a shape with a medium cannot also emit (emission is given)"
+            ));
+        }
+        if shape_entry.iter().filter(|&&e| e == i).count() > 1 {
+            return Err(format!(
+                "{at}.medium: expected a mesh of one material around the medium, got a mesh whose groups use several"
+            ));
+        }
+        let shape = &mut shapes[k];
+        if !shape.is_closed() {
+            return Err(format!(
+                "{at}.medium: expected a closed shape (a sphere, or a mesh whose every edge is shared by two triangles) around the medium, got an open {}",
+                entry.name()
+            ));
+        }
+        match &materials.list[shape.material as usize] {
+            _ if entry.emission().0.is_none() => shape.interface = true,
+            Material::Dielectric(_) | Material::RoughDielectric(_) => {}
+            _ => {
+                return Err(format!(
+                    "{at}.material: a shape with a medium needs a surface light can enter: no material (an index-matched boundary) or a dielectric, got {:?}",
+                    materials.names[shape.material as usize]
+                ))
+            }
+        }
+        if sky_tables == SkyTables::Skip && matches!(plan, MediumPlan::Mie(_)) {
+            continue;
+        }
+        let id = match medium_plans.iter().position(|p| *p == plan) {
+            Some(id) => id,
+            None => {
+                media.push(plan.build());
+                medium_plans.push(plan);
+                media.len() - 1
+            }
+        };
+        shape.medium = id as u32;
+    }
+    Ok(media)
+}

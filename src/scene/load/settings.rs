@@ -1,0 +1,39 @@
+//! The `[render]` table to [`RenderSettings`]: every key optional, defaults from
+//! `RenderSettings::default()`.
+use crate::scene::file::RenderFile;
+use crate::settings::{IntegratorKind, LightSamplerKind, OffsetMode, RenderSettings};
+
+/// The settings of the `[render]` table `r` (defaults without one).
+pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, String> {
+    let mut settings = RenderSettings::default();
+    let Some(r) = r else {
+        return Ok(settings);
+    };
+    if let Some(x) = r.spp {
+        settings.spp = x.0;
+    }
+    if let Some(x) = r.max_depth {
+        settings.max_depth = x.0;
+    }
+    if let Some(x) = r.epsilon {
+        settings.epsilon = x.0;
+    }
+    if let Some(x) = r.seed {
+        settings.seed = x;
+    }
+    if let Some(name) = &r.integrator {
+        settings.integrator =
+            IntegratorKind::parse(name).map_err(|e| format!("render.integrator: {e}"))?;
+    }
+    if let Some(x) = r.rr_depth {
+        settings.rr_depth = x;
+    }
+    if let Some(name) = &r.offset {
+        settings.offset = OffsetMode::parse(name).map_err(|e| format!("render.offset: {e}"))?;
+    }
+    if let Some(name) = &r.light_sampler {
+        settings.light_sampler =
+            LightSamplerKind::parse(name).map_err(|e| format!("render.light_sampler: {e}"))?;
+    }
+    Ok(settings)
+}

@@ -1,0 +1,440 @@
+//! Shapes: spheres, triangles, planes, quads and OBJ meshes from the `[[shapes]]`
+//! entries, each with its material (named, or one the loader adds) and no light or
+//! medium yet (`lights.rs` and `media.rs` give them theirs); the geometric checks
+//! (finite, non-degenerate, a finite bounding sphere) and the bounding sphere itself.
+use super::errors::{fmt_path, fmt_points, scene_error, Seg};
+use super::materials::Materials;
+use super::obj;
+use crate::error::Result;
+use crate::geometry::{Mesh, Shape, ShapeKind, MIN_RELATIVE_RADIUS};
+use crate::scene::file::{
+    fmt_f32, MeshFile, PlaneFile, QuadFile, ShapeFile, SphereFile, TriangleFile,
+};
+use glam::Vec3;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+/// The shapes of the `[[shapes]]` entries, in file order (a mesh entry gives one shape per
+/// material it uses), and for each shape the index of the entry it came from. Meshes are
+/// read relative to `base_dir` and recorded in `inputs`; errors name `path`, or the mesh
+/// file for problems inside it.
+pub(super) fn build_shapes(
+    path: &Path,
+    base_dir: &Path,
+    entries: &[ShapeFile],
+    materials: &Materials,
+    inputs: &mut Vec<String>,
+) -> Result<(Vec<Shape>, Vec<usize>)> {
+    let err = |m: String| scene_error(path, m);
+    // The material of a simple shape: named, or black for a pure emitter, or the
+    // boundary of a medium.
+    let resolve = |at: &str, s: &ShapeFile| -> Result<u32> {
+        let (material, emission, two_sided) = s.emission();
+        if two_sided.is_some() && emission.is_none() {
+            return Err(err(format!(
+                "{at}.two_sided: applies to emitting shapes, but emission is not given"
+            )));
+        }
+        match (material, emission) {
+            (Some(name), _) => materials.lookup(&format!("{at}.material"), name).map_err(err),
+            (None, Some(_)) => Ok(materials.black),
+            (None, None) if s.medium().is_some() => Ok(materials.boundary),
+            (None, None) => Err(err(format!(
+                "{at}.material: missing required key (expected the name of a material, or an emission)"
+            ))),
+        }
+    };
+
+    let mut shapes = Vec::with_capacity(entries.len());
+    let mut shape_entry: Vec<usize> = Vec::with_capacity(entries.len());
+    for (i, s) in entries.iter().enumerate() {
+        let at = format!("shapes[{i}]");
+        match s {
+            ShapeFile::Sphere(sp) => {
+                let kind = sphere(&at, sp).map_err(err)?;
+                shapes.push(Shape::new(kind, resolve(&at, s)?));
+            }
+            ShapeFile::Triangle(t) => {
+                let material = resolve(&at, s)?;
+                shapes.push(Shape::new(triangle(&at, t).map_err(err)?, material));
+            }
+            ShapeFile::Plane(p) => {
+                let material = resolve(&at, s)?;
+                shapes.push(Shape::new(plane(&at, p).map_err(err)?, material));
+            }
+            ShapeFile::Quad(q) => {
+                let material = resolve(&at, s)?;
+                shapes.push(Shape::new(quad(&at, q).map_err(err)?, material));
+            }
+            ShapeFile::Mesh(m) => {
+                if m.two_sided.is_some() && m.emission.is_none() {
+                    return Err(err(format!(
+                        "{at}.two_sided: applies to emitting shapes, but emission is not given"
+                    )));
+                }
+                let fallback = match (&m.emission, &m.medium) {
+                    (Some(_), _) => Some(materials.black),
+                    (None, Some(_)) => Some(materials.boundary),
+                    (None, None) => None,
+                };
+                shapes.extend(build_mesh(path, base_dir, &at, m, materials, fallback)?);
+                inputs.push(m.file.clone());
+            }
+        }
+        shape_entry.resize(shapes.len(), i);
+    }
+    Ok((shapes, shape_entry))
+}
+
+/// A sphere entry at key path `at`.
+fn sphere(at: &str, sp: &SphereFile) -> std::result::Result<ShapeKind, String> {
+    // Below this a sphere spans a handful of f32 steps at its centre, less than the
+    // error bound of its hit points (geometry::spawn): rays would pass through it (heron
+    // stress finds leaks from 2e-7 down).
+    let reach = sp.center.0.abs().max_element();
+    if sp.radius.0 < MIN_RELATIVE_RADIUS * reach {
+        return Err(format!(
+            "{at}.radius: expected at least {MIN_RELATIVE_RADIUS:e} × the centre's largest coordinate ({}), i.e. {:e}, got {}: a smaller sphere is below float precision where it is",
+            fmt_f32(reach),
+            MIN_RELATIVE_RADIUS * reach,
+            fmt_f32(sp.radius.0)
+        ));
+    }
+    Ok(ShapeKind::Sphere {
+        center: sp.center.0,
+        radius: sp.radius.0,
+    })
+}
+
+/// A triangle entry at key path `at`: a mesh of one triangle.
+fn triangle(at: &str, t: &TriangleFile) -> std::result::Result<ShapeKind, String> {
+    let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
+    if cross_overflows(v[0], v[1], v[2]) {
+        return Err(format!(
+            "{at}.vertices: expected a triangle whose edges' cross product is finite in f32 (coordinates within about ±1e19), got {}",
+            fmt_points(&v)
+        ));
+    }
+    if is_degenerate(v[0], v[1], v[2]) {
+        return Err(format!(
+            "{at}.vertices: expected a triangle with non-zero area, got collinear vertices {}",
+            fmt_points(&v)
+        ));
+    }
+    Ok(mesh(v.to_vec(), vec![[0, 1, 2]]))
+}
+
+/// A plane entry at key path `at`: a square of two triangles.
+fn plane(at: &str, p: &PlaneFile) -> std::result::Result<ShapeKind, String> {
+    let n = p.normal.unit();
+    let size = p.size.map_or(1000.0, |s| s.0);
+    // Tangents with t × b = n, so (v1 − v0) × (v2 − v0) points along n.
+    let t = n.any_orthogonal_vector().normalize();
+    let b = n.cross(t);
+    let c = p.point.0;
+    let v = vec![
+        c - size * t - size * b,
+        c + size * t - size * b,
+        c + size * t + size * b,
+        c - size * t + size * b,
+    ];
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(format!(
+            "{at}.size: expected a size whose square has finite corners, got {size}"
+        ));
+    }
+    Ok(mesh(v, vec![[0, 1, 2], [0, 2, 3]]))
+}
+
+/// A quad entry at key path `at`: a parallelogram of two triangles.
+fn quad(at: &str, q: &QuadFile) -> std::result::Result<ShapeKind, String> {
+    let (o, e1, e2) = (q.origin.0, q.edge1.0, q.edge2.0);
+    let v = vec![o, o + e1, o + e1 + e2, o + e2];
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(format!(
+            "{at}: expected a quad with finite corners, got origin + edges overflowing f32"
+        ));
+    }
+    if cross_overflows(v[0], v[1], v[3]) {
+        return Err(format!(
+            "{at}: expected edge1 and edge2 whose cross product is finite in f32 (coordinates within about ±1e19), got {} and {}",
+            fmt_points(&[e1]),
+            fmt_points(&[e2])
+        ));
+    }
+    if is_degenerate(v[0], v[1], v[3]) {
+        return Err(format!(
+            "{at}: expected edge1 and edge2 spanning a non-zero area, got parallel edges {} and {}",
+            fmt_points(&[e1]),
+            fmt_points(&[e2])
+        ));
+    }
+    Ok(mesh(v, vec![[0, 1, 2], [0, 2, 3]]))
+}
+
+/// Checks that the bounding sphere of `shapes` (the lights at infinity start their paths
+/// on it) is finite, naming the first shape that makes it overflow by its entry
+/// (`shape_entry`).
+pub(super) fn check_bounds(
+    shapes: &[Shape],
+    shape_entry: &[usize],
+) -> std::result::Result<(), String> {
+    let mut bbox = EMPTY_BOX;
+    for (k, shape) in shapes.iter().enumerate() {
+        bbox = grow_box(bbox, shape);
+        let b = box_sphere(bbox);
+        if !(b.center.is_finite() && b.radius.is_finite()) {
+            return Err(format!(
+                "shapes[{}]: expected shapes whose bounding sphere is finite in f32 (coordinates within about ±1e19), got shapes reaching from {} to {} with this one",
+                shape_entry[k],
+                fmt_points(&[bbox.0]),
+                fmt_points(&[bbox.1])
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The sphere around the shapes' bounding box (a unit sphere at the origin for a scene
+/// without shapes).
+pub fn scene_bounds(shapes: &[Shape]) -> crate::light::SceneBounds {
+    let mut b = EMPTY_BOX;
+    for s in shapes {
+        b = grow_box(b, s);
+    }
+    box_sphere(b)
+}
+
+/// A bounding box (lo, hi); lo > hi when empty.
+type Box3 = (Vec3, Vec3);
+
+const EMPTY_BOX: Box3 = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+
+/// `b` grown to hold shape `s`.
+fn grow_box((mut lo, mut hi): Box3, s: &Shape) -> Box3 {
+    match &s.kind {
+        ShapeKind::Sphere { center, radius } => {
+            lo = lo.min(*center - Vec3::splat(*radius));
+            hi = hi.max(*center + Vec3::splat(*radius));
+        }
+        ShapeKind::Mesh(m) => {
+            for p in &m.positions {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+/// The sphere around box `b` (a unit sphere at the origin for an empty box).
+fn box_sphere((lo, hi): Box3) -> crate::light::SceneBounds {
+    if !(lo.x <= hi.x) {
+        return crate::light::SceneBounds {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        };
+    }
+    // Not 0.5 (lo + hi), which overflows for a shape near ±3e38 (the same value
+    // elsewhere: halving is exact).
+    let center = 0.5 * lo + 0.5 * hi;
+    crate::light::SceneBounds {
+        center,
+        radius: (0.5 * (hi - lo).length()).max(1e-6),
+    }
+}
+
+/// A triangle mesh.
+fn mesh(positions: Vec<Vec3>, indices: Vec<[u32; 3]>) -> ShapeKind {
+    ShapeKind::Mesh(Mesh { positions, indices })
+}
+
+/// Whether the cross product of the edges b − a and c − a (twice the area, and the normal
+/// Embree and the lights compute) overflows f32: coordinates beyond about ±1e19.
+pub(super) fn cross_overflows(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    !(b - a).cross(c - a).is_finite()
+}
+
+/// Zero area up to f32 rounding: |e1 × e2| ≤ ε |e1| |e2| (the angle between the edges is
+/// below about 1e-7 rad), or a zero-length edge.
+pub(super) fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    let (e1, e2) = (b - a, c - a);
+    let cross = e1.cross(e2).length();
+    let limit = f32::EPSILON * e1.length() * e2.length();
+    // Not strictly above the limit, NaN included (overflowing edges).
+    cross.partial_cmp(&limit) != Some(std::cmp::Ordering::Greater)
+}
+
+/// A `type = "mesh"` entry: one shape per material it uses. Mesh-file problems are
+/// reported with the mesh file as `file` and the scene's key path in the message.
+fn build_mesh(
+    scene_path: &Path,
+    base_dir: &Path,
+    at: &str,
+    m: &MeshFile,
+    materials: &Materials,
+    emitter_material: Option<u32>,
+) -> Result<Vec<Shape>> {
+    let lookup = |at: String, name: &str| {
+        materials
+            .lookup(&at, name)
+            .map_err(|m| scene_error(scene_path, m))
+    };
+    // Scene-file checks first: the material names.
+    let default_material = match &m.material {
+        Some(name) => Some(lookup(format!("{at}.material"), name)?),
+        None => emitter_material,
+    };
+    let mut group_material = BTreeMap::new();
+    for (group, name) in &m.groups {
+        let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(group.clone())]);
+        group_material.insert(group.as_str(), lookup(format!("{at}.{gk}"), name)?);
+    }
+    if m.file.trim().is_empty() {
+        return Err(scene_error(
+            scene_path,
+            format!("{at}.file: expected the path of an OBJ file, got an empty string"),
+        ));
+    }
+
+    let mesh_path: PathBuf = base_dir.join(&m.file);
+    let text = std::fs::read_to_string(&mesh_path).map_err(|e| {
+        scene_error(
+            &mesh_path,
+            format!("{at}.file: cannot read the mesh file: {e}"),
+        )
+    })?;
+    mesh_shapes(
+        &text,
+        scene_path,
+        &mesh_path,
+        at,
+        m,
+        &group_material,
+        default_material,
+    )
+}
+
+/// The shapes of mesh entry `m` (at key path `at`) from the text of its OBJ file
+/// `mesh_path`, with the materials of its groups already looked up.
+pub(crate) fn mesh_shapes(
+    text: &str,
+    scene_path: &Path,
+    mesh_path: &Path,
+    at: &str,
+    m: &MeshFile,
+    group_material: &BTreeMap<&str, u32>,
+    default_material: Option<u32>,
+) -> Result<Vec<Shape>> {
+    let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
+    let groups = obj::parse_obj(text).map_err(merr)?;
+
+    for g in m.groups.keys() {
+        if !groups.iter().any(|x| &x.name == g) {
+            let mut names: Vec<&str> = groups
+                .iter()
+                .filter(|x| !x.indices.is_empty())
+                .map(|x| x.name.as_str())
+                .collect();
+            names.dedup();
+            let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(g.clone())]);
+            return Err(scene_error(
+                mesh_path,
+                format!(
+                    "{at}.{gk}: no object or group named {g:?} in the mesh (it has: {})",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+
+    let scale = m.scale.map_or(1.0, |s| s.0);
+    let translate = m.translate.map_or(Vec3::ZERO, |t| t.0);
+
+    // Gather the triangles per material, in the order the materials first appear.
+    struct Part {
+        material: u32,
+        positions: Vec<Vec3>,
+        indices: Vec<[u32; 3]>,
+        /// Vertex index by position: OBJ groups come with their own vertex arrays, so
+        /// vertices are shared within a shape by their (exact) coordinates.
+        remap: HashMap<[u32; 3], u32>,
+    }
+    let mut parts: Vec<Part> = Vec::new();
+    let mut any_triangle = false;
+    for g in &groups {
+        if g.indices.is_empty() {
+            continue;
+        }
+        let material = match group_material.get(g.name.as_str()).copied().or(default_material) {
+            Some(mat) => mat,
+            None => {
+                return Err(scene_error(
+                    scene_path,
+                    format!(
+                        "{at}.material: missing required key (expected the name of a material for the mesh's object {:?}, which groups does not list)",
+                        g.name
+                    ),
+                ))
+            }
+        };
+        let part = match parts.iter().position(|p| p.material == material) {
+            Some(k) => &mut parts[k],
+            None => {
+                parts.push(Part {
+                    material,
+                    positions: Vec::new(),
+                    indices: Vec::new(),
+                    remap: HashMap::new(),
+                });
+                parts.last_mut().expect("just pushed")
+            }
+        };
+        for tri in &g.indices {
+            let p = tri.map(|i| g.positions[i as usize] * scale + translate);
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(merr(format!(
+                    "a vertex of object {:?} is not finite after scale {} and translate {}",
+                    g.name,
+                    fmt_f32(scale),
+                    fmt_points(&[translate])
+                )));
+            }
+            if cross_overflows(p[0], p[1], p[2]) {
+                return Err(merr(format!(
+                    "a triangle of object {:?} is too large for f32 after scale {} and translate {}: expected its edges' cross product to be finite (coordinates within about ±1e19), got {}",
+                    g.name,
+                    fmt_f32(scale),
+                    fmt_points(&[translate]),
+                    fmt_points(&p)
+                )));
+            }
+            // Zero-area triangles are never hit; they are dropped.
+            if is_degenerate(p[0], p[1], p[2]) {
+                continue;
+            }
+            any_triangle = true;
+            let mut out = [0u32; 3];
+            for (o, v) in out.iter_mut().zip(p) {
+                let next = part.positions.len() as u32;
+                // + 0.0 turns −0 into +0, so the two zeros share a vertex.
+                let bits = (v + Vec3::ZERO).to_array().map(f32::to_bits);
+                *o = *part.remap.entry(bits).or_insert_with(|| {
+                    part.positions.push(v);
+                    next
+                });
+            }
+            part.indices.push(out);
+        }
+    }
+    if !any_triangle {
+        return Err(merr(
+            "expected a mesh with at least one triangle of non-zero area, got none".into(),
+        ));
+    }
+    Ok(parts
+        .into_iter()
+        .filter(|p| !p.indices.is_empty())
+        .map(|p| Shape::new(mesh(p.positions, p.indices), p.material))
+        .collect())
+}
