@@ -399,3 +399,67 @@ impl RenderSettings {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flags_apply_in_one_place_and_a_bad_one_changes_nothing() {
+        let mut s = RenderSettings::default();
+        s.apply(&SettingsArgs {
+            spp: Some(3),
+            lanes: Some(4),
+            integrator: Some("bdpt"),
+            wavelengths: Some("uniform"),
+            max_depth: Some(2),
+            offset: Some("robust"),
+            no_packets: true,
+            ..SettingsArgs::default()
+        })
+        .unwrap();
+        assert_eq!(
+            (s.spp, s.lanes, s.integrator, s.max_depth, s.packets),
+            (3, 4, IntegratorKind::Bdpt, 2, false)
+        );
+        assert_eq!(s.wavelengths, WavelengthSampler::Uniform);
+        assert!(!s.offset.is_epsilon(s.integrator));
+        let before = s.clone();
+        for (args, message) in [
+            (
+                SettingsArgs {
+                    spp: Some(0),
+                    ..SettingsArgs::default()
+                },
+                "--spp: expected at least 1",
+            ),
+            (
+                SettingsArgs {
+                    seed: Some(9),
+                    lanes: Some(3),
+                    ..SettingsArgs::default()
+                },
+                "--lanes: expected 1, 4 or 8, got 3",
+            ),
+            (
+                SettingsArgs {
+                    spectral_bins: Some(471),
+                    ..SettingsArgs::default()
+                },
+                "--spectral-bins: expected 0 (none) or 1 to 470 bins, got 471",
+            ),
+            (
+                SettingsArgs {
+                    integrator: Some("nope"),
+                    ..SettingsArgs::default()
+                },
+                "--integrator: expected one of whitted, path, lighttrace, bdpt, got \"nope\"",
+            ),
+        ] {
+            assert_eq!(s.apply(&args), Err(message.to_string()));
+            assert_eq!(args.check(), Err(message.to_string()));
+            // The seed of the second case was valid, but the call failed as a whole.
+            assert_eq!(s, before);
+        }
+    }
+}
