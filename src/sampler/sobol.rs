@@ -154,15 +154,22 @@ const PERMUTATIONS: [[u8; 4]; 24] = [
 /// above it and of the decision (pbrt-v4 `ZSobolSampler::GetSampleIndex`).
 #[inline]
 fn permuted_digits(morton: u64, dim: u64, odd: bool, lo: u32, hi: u32) -> u64 {
-    let salt = 0x5555_5555u64.wrapping_mul(dim);
     let mut index = 0u64;
     for i in lo..hi {
         let shift = 2 * i - odd as u32;
         let digit = (morton >> shift) & 3;
-        let p = (mix_bits((morton >> (shift + 2)) ^ salt) >> 24) % 24;
+        let p = digit_permutation(morton, shift, dim);
         index |= (PERMUTATIONS[p as usize][digit as usize] as u64) << shift;
     }
     index
+}
+
+/// Which of the 24 permutations the digit at bit `shift` takes: a hash of the digits
+/// above it and of the decision.
+#[inline]
+fn digit_permutation(morton: u64, shift: u32, dim: u64) -> u8 {
+    let salt = 0x5555_5555u64.wrapping_mul(dim);
+    ((mix_bits((morton >> (shift + 2)) ^ salt) >> 24) % 24) as u8
 }
 
 /// The lowest bit of the index when log₂ spp is odd, flipped by a hash of the bits above.
@@ -195,6 +202,16 @@ pub struct SobolSampler {
     /// pixel's.
     high: [u64; CACHED],
     cached: u64,
+    /// Per decision, the digits below `split` except the lowest, permuted, and the lowest
+    /// digit's permutation (its flip when log₂ spp is odd), for the samples whose index
+    /// agrees above the lowest digit (`low_key`): consecutive samples of a pixel share
+    /// them in runs of 4 (2 when log₂ spp is odd), so the hashes run once per run.
+    low_key: [u64; CACHED],
+    low_upper: [u64; CACHED],
+    low_perm: [u8; CACHED],
+    /// Per decision, the scrambles' hash ([`Self::hash`]), which depends only on the seed
+    /// and the decision.
+    scramble: [u64; CACHED],
 }
 
 impl SobolSampler {
@@ -205,8 +222,9 @@ impl SobolSampler {
         let log2_spp = spp.max(1).next_power_of_two().trailing_zeros();
         let res = width.max(height).max(1).next_power_of_two();
         let log4_res = res.trailing_zeros();
+        let seed_hash = mix_bits(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
         SobolSampler {
-            seed_hash: mix_bits(seed.wrapping_add(0x9e37_79b9_7f4a_7c15)),
+            seed_hash,
             log2_spp,
             base4_digits: log4_res + log2_spp.div_ceil(2),
             pixel: u64::MAX,
@@ -214,6 +232,10 @@ impl SobolSampler {
             dimension: 0,
             high: [0; CACHED],
             cached: 0,
+            low_key: [u64::MAX; CACHED],
+            low_upper: [0; CACHED],
+            low_perm: [0; CACHED],
+            scramble: std::array::from_fn(|d| mix_bits(d as u64 ^ seed_hash)),
         }
     }
 
@@ -236,29 +258,49 @@ impl SobolSampler {
         // Digits from `split` up hold pixel bits only.
         let split = self.log2_spp.div_ceil(2);
         let dim = self.dimension as u64;
-        let first = odd as u32;
-        let mut low = permuted_digits(self.morton_index, dim, odd, first, split);
-        if odd {
-            low |= permuted_last_bit(self.morton_index, dim);
-        }
+        let m = self.morton_index;
         let d = self.dimension as usize;
-        let high = if d < CACHED {
-            if self.cached & (1 << d) == 0 {
-                self.high[d] =
-                    permuted_digits(self.morton_index, dim, odd, split, self.base4_digits);
-                self.cached |= 1 << d;
+        if d >= CACHED {
+            let mut index = permuted_digits(m, dim, odd, odd as u32, self.base4_digits);
+            if odd {
+                index |= permuted_last_bit(m, dim);
             }
-            self.high[d]
+            return index;
+        }
+        if self.cached & (1 << d) == 0 {
+            self.high[d] = permuted_digits(m, dim, odd, split, self.base4_digits);
+            self.cached |= 1 << d;
+        }
+        if self.log2_spp == 0 {
+            return self.high[d];
+        }
+        // The lowest digit's permutation and every digit above it depend only on the
+        // index without that digit (`permuted_digits`).
+        let key = if odd { m >> 1 } else { m >> 2 };
+        if self.low_key[d] != key {
+            self.low_key[d] = key;
+            self.low_upper[d] = permuted_digits(m, dim, odd, 1, split);
+            self.low_perm[d] = if odd {
+                permuted_last_bit(m, dim) as u8 ^ (m & 1) as u8
+            } else {
+                digit_permutation(m, 0, dim)
+            };
+        }
+        let lowest = if odd {
+            (m & 1) ^ self.low_perm[d] as u64
         } else {
-            permuted_digits(self.morton_index, dim, odd, split, self.base4_digits)
+            PERMUTATIONS[self.low_perm[d] as usize][(m & 3) as usize] as u64
         };
-        high | low
+        self.high[d] | self.low_upper[d] | lowest
     }
 
     /// Hash of (decision, seed) for the scrambles.
     #[inline]
     fn hash(&self) -> u64 {
-        mix_bits((self.dimension as u64) ^ self.seed_hash)
+        match self.scramble.get(self.dimension as usize) {
+            Some(&h) => h,
+            None => mix_bits((self.dimension as u64) ^ self.seed_hash),
+        }
     }
 
     /// (index in the sequence, scramble hash) for the current decision.
@@ -395,12 +437,21 @@ mod tests {
     }
 
     #[test]
-    fn cached_pixel_digits_give_the_full_index() {
+    fn cached_digits_give_the_full_index() {
         for spp in [1u32, 2, 8, 32, 64] {
             let mut s = SobolSampler::new(9, 300, 200, spp);
             // Revisit pixels in an order that invalidates the cache, and run past it.
-            for &(x, y) in &[(0u32, 0u32), (299, 199), (0, 0), (17, 4), (17, 4), (5, 150)] {
-                for i in 0..spp {
+            // Samples in a row (as the render loop asks for them), backwards, and
+            // jumping by an odd stride, so that runs sharing the low digits' cache are
+            // cut at every place.
+            let orders: [Vec<u32>; 3] = [
+                (0..spp).collect(),
+                (0..spp).rev().collect(),
+                (0..spp).map(|i| (i * 7 + 3) % spp).collect(),
+            ];
+            let pixels = [(0u32, 0u32), (299, 199), (0, 0), (17, 4), (17, 4), (5, 150)];
+            for (&(x, y), order) in pixels.iter().zip(orders.iter().cycle()) {
+                for &i in order {
                     s.start_pixel_sample(x, y, i);
                     for _ in 0..CACHED + 5 {
                         let want = full_index(&s);
