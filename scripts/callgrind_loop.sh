@@ -1,25 +1,45 @@
 #!/usr/bin/env bash
 # Instruction counts of the render loop (callgrind, collecting inside render_passes only),
 # which do not drift with the machine's load: the default scene under whitted and the
-# Cornell box under path, 4 spp on one thread. For refactors of the hot path: compare a
+# Cornell box under path, on one thread. For refactors of the hot path: compare a
 # binary before and after.
 #
 #   scripts/callgrind_loop.sh [HERON_BINARY...]     (default: target/release/heron)
+#   SPP=64 SIZE=128 scripts/callgrind_loop.sh ...   (per-sample cost at a real sample count)
 #
-# Prints one line per (binary, scene): the instruction count ("Ir").
+# SPP (default 4) is the samples per pixel; SIZE, if set, renders a SIZE×SIZE copy of each
+# scene (the Sobol' sampler's per-pixel work is shared by a pixel's samples, so 4 spp
+# overstates it; 64 spp at 128² costs the same instructions as 4 spp at 512²).
+# Prints one line per (binary, scene): the instruction count ("Ir"), the instructions per
+# sample and the sha256 of the EXR (equal bytes for an optimisation that keeps the image).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bins=("$@")
 [ ${#bins[@]} -gt 0 ] || bins=(target/release/heron)
+spp=${SPP:-4}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+for scene in default cornell-box; do
+  if [ -n "${SIZE:-}" ]; then
+    sed -E "s/^resolution = \[[0-9]+, *[0-9]+\]/resolution = [$SIZE, $SIZE]/" \
+      "scenes/$scene.toml" >"$tmp/$scene.toml"
+  else
+    cp "scenes/$scene.toml" "$tmp/$scene.toml"
+  fi
+done
 for bin in "${bins[@]}"; do
   for scene in default cornell-box; do
     valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --collect-atstart=no \
       --toggle-collect='*render_passes*' \
-      "$bin" render "scenes/$scene.toml" -o "$tmp/cg.exr" --spp 4 --threads 1 --quiet --no-png \
-      >/dev/null 2>"$tmp/log"
+      "$bin" render "$tmp/$scene.toml" -o "$tmp/cg.exr" --spp "$spp" --threads 1 --quiet \
+      --no-png >"$tmp/out" 2>"$tmp/log"
     ir=$(grep -E '^(summary|totals):' "$tmp/cg.out" | head -n 1 | awk '{print $2}')
-    printf '%s\t%s\t%s\n' "$bin" "$scene" "$ir"
+    px=$(cat "$tmp/out" "$tmp/log" | grep -oE ': [0-9]+x[0-9]+ at' | head -n 1 | grep -oE '[0-9]+x[0-9]+' || true)
+    per=""
+    if [ -n "$px" ]; then
+      per=$(( ir / (${px%x*} * ${px#*x} * spp) ))
+    fi
+    sha=$(sha256sum "$tmp/cg.exr" | cut -c1-16)
+    printf '%s\t%s\t%s\t%s\t%s\n' "$bin" "$scene" "$ir" "$per" "$sha"
   done
 done
