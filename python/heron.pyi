@@ -171,12 +171,14 @@ class Color(TypedDict):
     linear_srgb: list[float]
     observer: str
     illuminant: str
+    interpolation: str
 
 def color(
     wavelengths: _Numbers,
     values: _Numbers,
-    illuminant: Literal["D65", "A", "E", "none"] = "D65",
+    illuminant: Literal["D65", "D50", "A", "E", "none"] = "D65",
     observer: Union[Literal["1931", "1964"], int] = "1931",
+    interpolation: Literal["cie167", "linear"] = "cie167",
 ) -> Color:
     """XYZ, xy and linear sRGB of a spectral distribution, as ``heron color``."""
 

@@ -74,6 +74,12 @@ def main():
     write(out, "cie_d65.csv", ["wavelength_nm", "value"],
           np.column_stack([d65.wavelengths, d65.values]))
 
+    # CIE D50 (`heron color --illuminant D50`, the reference white of print and of ICC
+    # profiles): 5 nm over 300-780 nm in colour-science, aligned exactly like D65.
+    d50 = colour.SDS_ILLUMINANTS["D50"].copy().align(SHAPE)
+    write(out, "cie_d50.csv", ["wavelength_nm", "value"],
+          np.column_stack([d50.wavelengths, d50.values]))
+
     # CIE standard illuminant A relative spectral power: 5 nm over 300-780 nm in
     # colour-science (the CIE 15:2004 table), aligned exactly like D65: linear
     # interpolation (the distribution's own interpolator) and constant extrapolation

@@ -3,14 +3,21 @@
 //! [`DenseSpectrum`], [`crate::spectrum::color`]) so that anyone can hold heron's
 //! colorimetry against colour-science (tests/python/test_color_cmd.py does).
 //!
-//! The file is read by [`SpectrumCsv`] (its format is documented there).
+//! The file is read by [`SpectrumCsv`] (its format is documented there) and put on the
+//! 1 nm grid by CIE 167:2005's rules as colour-science applies them (Sprague for uniform
+//! rows, a cubic spline otherwise), or with `--interpolation linear` by straight lines
+//! between the rows, which is how colour-science interpolates every illuminant of its
+//! `SDS_ILLUMINANTS` ([`Interpolation`]; `crate::spectrum::interp` says why this, and
+//! nothing else, made `heron color` differ from `colour.sd_to_XYZ` by up to 1.2e-3 for
+//! the CIE illuminants' own data). The built-in illuminants (D65, D50, A) are
+//! colour-science's tables aligned that way, linearly.
 //!
 //! # Colorimetry
 //!
 //! All sums run over the 471 rows λ = 360, 361, …, 830 nm (Δλ = 1 nm cancels), with the
 //! chosen observer's x̄, ȳ, z̄ (CIE 1931 2° or CIE 1964 10°):
 //!
-//! - with an illuminant I (D65, A or E), the distribution is a reflectance (or
+//! - with an illuminant I (D65, D50, A or E), the distribution is a reflectance (or
 //!   transmittance) R and XYZ = Σ R·I·x̄ / Σ I·ȳ, so the perfect reflector R = 1 has
 //!   Y = 1 and the XYZ of the illuminant's white point (CIE 15 with k = 1/Σ I·ȳ);
 //! - with `none`, the distribution is an emitted spectrum (radiance) S and
@@ -25,6 +32,7 @@
 use crate::spectrum::cie::{self, Observer};
 use crate::spectrum::color::xyz_to_linear_srgb;
 use crate::spectrum::csv::SpectrumCsv;
+use crate::spectrum::interp::Interpolation;
 use crate::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
 use crate::Result;
 use serde::Serialize;
@@ -84,6 +92,8 @@ impl fmt::Display for StandardObserver {
 pub enum Illuminant {
     /// CIE standard illuminant D65 ([`cie::d65_relative`]).
     D65,
+    /// CIE illuminant D50 ([`cie::d50_relative`]).
+    D50,
     /// CIE standard illuminant A ([`cie::illuminant_a_relative`]).
     A,
     /// CIE illuminant E, equal energy ([`cie::illuminant_e`]).
@@ -93,10 +103,11 @@ pub enum Illuminant {
 }
 
 impl Illuminant {
-    /// "D65", "A", "E" or "none", as in the JSON.
+    /// "D65", "D50", "A", "E" or "none", as in the JSON.
     pub fn name(self) -> &'static str {
         match self {
             Illuminant::D65 => "D65",
+            Illuminant::D50 => "D50",
             Illuminant::A => "A",
             Illuminant::E => "E",
             Illuminant::None => "none",
@@ -107,6 +118,7 @@ impl Illuminant {
     pub fn spectrum(self) -> Option<DenseSpectrum> {
         match self {
             Illuminant::D65 => Some(cie::d65_relative().clone()),
+            Illuminant::D50 => Some(cie::d50_relative().clone()),
             Illuminant::A => Some(cie::illuminant_a_relative().clone()),
             Illuminant::E => Some(cie::illuminant_e()),
             Illuminant::None => None,
@@ -116,14 +128,15 @@ impl Illuminant {
 
 impl FromStr for Illuminant {
     type Err = String;
-    /// Case-insensitive: `D65`, `A`, `E` or `none`.
+    /// Case-insensitive: `D65`, `D50`, `A`, `E` or `none`.
     fn from_str(s: &str) -> std::result::Result<Self, String> {
         match s.trim().to_ascii_lowercase().as_str() {
             "d65" => Ok(Illuminant::D65),
+            "d50" => Ok(Illuminant::D50),
             "a" => Ok(Illuminant::A),
             "e" => Ok(Illuminant::E),
             "none" => Ok(Illuminant::None),
-            _ => Err(format!("expected D65, A, E or none, got {s:?}")),
+            _ => Err(format!("expected D65, D50, A, E or none, got {s:?}")),
         }
     }
 }
@@ -175,8 +188,10 @@ pub struct ColorReport {
     pub file: String,
     /// "1931" or "1964".
     pub observer: &'static str,
-    /// "D65", "A", "E" or "none".
+    /// "D65", "D50", "A", "E" or "none".
     pub illuminant: &'static str,
+    /// "cie167" or "linear": how the rows were put on the 1 nm grid.
+    pub interpolation: &'static str,
     #[serde(rename = "XYZ")]
     pub xyz: [f32; 3],
     /// `null` when X + Y + Z = 0.
@@ -188,14 +203,16 @@ pub struct ColorReport {
     pub notes: Vec<String>,
 }
 
-/// `heron color FILE`: reads the CSV, builds the 1 nm table and computes its colour.
+/// `heron color FILE`: reads the CSV, builds the 1 nm table (interpolated as
+/// `interpolation` says) and computes its colour.
 pub fn color_file(
     path: &Path,
     observer: StandardObserver,
     illuminant: Illuminant,
+    interpolation: Interpolation,
 ) -> Result<ColorReport> {
     let csv = SpectrumCsv::read(path)?;
-    let c = colour_of(&csv.to_dense(), observer, illuminant);
+    let c = colour_of(&csv.to_dense_with(interpolation), observer, illuminant);
     let (lo, hi) = csv.range();
     let mut notes = Vec::new();
     if lo > LAMBDA_MIN || hi < LAMBDA_MAX {
@@ -208,6 +225,7 @@ pub fn color_file(
         file: path.display().to_string(),
         observer: observer.name(),
         illuminant: illuminant.name(),
+        interpolation: interpolation.name(),
         xyz: c.xyz,
         xy: c.xy,
         linear_srgb: c.linear_srgb,
@@ -278,6 +296,7 @@ mod tests {
     fn names_parse_back() {
         for i in [
             Illuminant::D65,
+            Illuminant::D50,
             Illuminant::A,
             Illuminant::E,
             Illuminant::None,

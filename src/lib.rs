@@ -24,6 +24,7 @@ pub mod light;
 pub mod math;
 pub mod medium;
 pub mod optics;
+pub mod plot;
 pub mod provenance;
 pub mod render;
 pub mod sampler;

@@ -90,7 +90,7 @@ enum SkyCommand {
     /// CSV of radiance against the angle from the antisolar point (degrees), one column
     /// per wavelength. Units: dσ/dΩ/(πa²) per sr for descartes, airy and mie (see
     /// heron::sky); the texture's radiance for aristotle.
-    Profile(SkyProfileArgs),
+    Profile(Box<SkyProfileArgs>),
     /// Lee diagram: the bow's colour against drop radius (log-spaced) and angle from the
     /// antisolar point, from Lorenz–Mie theory under a D65 sun averaged over its disk, as
     /// CSV radius_mm,theta_deg,X,Y,Z,R,G,B (see heron::sky::lee).
@@ -205,6 +205,10 @@ struct SkyProfileArgs {
     /// direct transmission, 2 the primary bow, 3 the secondary, …
     #[arg(long)]
     debye: Option<u32>,
+    /// Also draw the profile as a PNG chart (960×600, one line per wavelength), written
+    /// atomically; the CSV still goes to standard output.
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// The distribution flags as the scene table they mirror; a parameter without
@@ -246,7 +250,20 @@ fn drops_from_flags(
 fn cmd_sky(c: SkyCommand) -> Result<()> {
     let csv = match c {
         SkyCommand::Profile(a) => {
-            heron::sky::profile::profile_csv(&heron::sky::profile::ProfileRequest {
+            let a = *a;
+            if let Some(p) = &a.plot {
+                heron::plot::check_path(p, "--plot")?;
+            }
+            let mut title = format!("heron sky profile: {}", a.model);
+            if let Some(r) = a.droplet_radius {
+                title += &format!(", drop radius {r} mm");
+            }
+            if let Some(d) = &a.distribution {
+                title += &format!(", {d} drops");
+            }
+            title += &format!(", sun radius {}°", a.sun_radius);
+            let model = a.model.clone();
+            let profile = heron::sky::profile::profile(&heron::sky::profile::ProfileRequest {
                 model: a.model,
                 sun_radius_deg: a.sun_radius,
                 droplet_radius_mm: a.droplet_radius,
@@ -263,7 +280,12 @@ fn cmd_sky(c: SkyCommand) -> Result<()> {
                     a.nodes,
                 )?,
                 debye: a.debye,
-            })?
+            })?;
+            if let Some(p) = &a.plot {
+                let chart = heron::plot::sky::chart(&title, &model, &profile);
+                heron::plot::write_png(p, &chart, "--plot")?;
+            }
+            profile.csv()
         }
         SkyCommand::Lee(a) => {
             let csv = heron::sky::lee::lee_csv(&heron::sky::lee::LeeRequest {
@@ -365,6 +387,10 @@ struct ConvergeArgs {
     /// Override the scene's resolution, W,H (smaller is faster to converge).
     #[arg(long, value_parser = parse_size)]
     size: Option<(u32, u32)>,
+    /// Also draw error against time as a PNG chart (960×600, log–log, one line per lane
+    /// count, the 1/√t slope), written atomically; the CSV still goes to standard output.
+    #[arg(long)]
+    plot: Option<PathBuf>,
     /// Worker threads (default: one per core).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
     threads: Option<u16>,
@@ -551,17 +577,23 @@ fn parse_lanes(s: &str) -> std::result::Result<usize, String> {
 struct ColorArgs {
     /// CSV of rows `wavelength_nm,value` (optional header line, # comments).
     file: PathBuf,
-    /// D65, A or E: the file is a reflectance, XYZ = Σ R·I·x̄ / Σ I·ȳ (white has Y = 1);
-    /// none: the file is emitted, XYZ = Σ S·x̄ / Σ ȳ (the constant 1 has Y = 1).
+    /// D65, D50, A or E: the file is a reflectance, XYZ = Σ R·I·x̄ / Σ I·ȳ (white has
+    /// Y = 1); none: the file is emitted, XYZ = Σ S·x̄ / Σ ȳ (the constant 1 has Y = 1).
     #[arg(long, default_value = "D65")]
     illuminant: heron::colorimetry::Illuminant,
     /// CIE standard observer: 1931 (2°) or 1964 (10°).
     #[arg(long, default_value = "1931")]
     observer: heron::colorimetry::StandardObserver,
+    /// How the rows go onto the 1 nm grid: cie167 (Sprague for uniform rows, a cubic
+    /// spline otherwise, as colour-science by default) or linear (straight lines, as
+    /// colour-science interpolates the illuminants of its SDS_ILLUMINANTS).
+    #[arg(long, default_value = "cie167")]
+    interpolation: heron::spectrum::interp::Interpolation,
 }
 
 fn cmd_color(a: ColorArgs) -> Result<()> {
-    let report = heron::colorimetry::color_file(&a.file, a.observer, a.illuminant)?;
+    let report =
+        heron::colorimetry::color_file(&a.file, a.observer, a.illuminant, a.interpolation)?;
     println!("{}", serde_json::to_string_pretty(&report)?);
     for note in &report.notes {
         eprintln!("note: {note}");
@@ -863,6 +895,10 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
 }
 
 fn cmd_converge(a: ConvergeArgs) -> Result<()> {
+    // A bad --plot path fails before the renders, not after.
+    if let Some(p) = &a.plot {
+        heron::plot::check_path(p, "--plot")?;
+    }
     let mut scene = load_scene(&a.scene)?;
     if let Some((w, h)) = a.size {
         let c = &scene.camera;
@@ -893,11 +929,22 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
         ref_wall
     );
     println!("lanes,spp,wall_s,ns_per_sample,rel_rmse,rmse_sqrt_time");
-    for r in rows {
+    for r in &rows {
         println!(
             "{},{},{:.4},{:.1},{:.5},{:.5}",
             r.lanes, r.spp, r.wall_s, r.ns_per_sample, r.rel_rmse, r.rmse_sqrt_time
         );
+    }
+    if let Some(p) = &a.plot {
+        let title = format!(
+            "{}: {}×{}, {}, reference {} spp",
+            a.scene.display(),
+            scene.camera.width,
+            scene.camera.height,
+            base.settings.integrator.name(),
+            a.reference_spp
+        );
+        heron::plot::write_png(p, &heron::plot::converge::chart(&title, &rows), "--plot")?;
     }
     Ok(())
 }

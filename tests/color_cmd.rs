@@ -1,4 +1,5 @@
-//! `heron color FILE.csv [--illuminant D65|A|E|none] [--observer 1931|1964]`: bad input
+//! `heron color FILE.csv [--illuminant D65|D50|A|E|none] [--observer 1931|1964]
+//! [--interpolation cie167|linear]`: bad input
 //! gets a one-line error naming the file (and line) and what was expected, exit status 1
 //! (2 for a bad command-line value, clap's usage error) and no panic; good input prints
 //! the JSON whose numbers follow from heron's tables (spectra/README.md).
@@ -141,7 +142,12 @@ fn bad_command_line_values_are_usage_errors() {
     assert_fails(
         &["color", &ok, "--illuminant", "F2"],
         1,
-        &["--illuminant", "expected D65, A, E or none", "F2"],
+        &["--illuminant", "expected D65, D50, A, E or none", "F2"],
+    );
+    assert_fails(
+        &["color", &ok, "--interpolation", "sprague"],
+        1,
+        &["--interpolation", "expected cie167", "linear", "sprague"],
     );
     assert_fails(
         &["color", &ok, "--observer", "2015"],
@@ -230,6 +236,54 @@ fn perfect_reflector_gives_the_illuminant_white() {
     let xy = v["xy"].as_array().unwrap();
     assert!((xy[0].as_f64().unwrap() - 0.447561).abs() < 2e-6, "{v}");
     assert!((xy[1].as_f64().unwrap() - 0.407431).abs() < 2e-6, "{v}");
+    // D50: x = 0.345684, y = 0.358504 (the 5 nm table linearly interpolated; CIE 15
+    // quotes 0.34567, 0.35850).
+    let v = color(&[&white, "--illuminant", "D50"]);
+    assert_eq!(v["illuminant"], "D50");
+    assert!((vec3(&v, "XYZ")[1] - 1.0).abs() < 1e-6, "{v}");
+    let xy = v["xy"].as_array().unwrap();
+    assert!((xy[0].as_f64().unwrap() - 0.345684).abs() < 2e-6, "{v}");
+    assert!((xy[1].as_f64().unwrap() - 0.358504).abs() < 2e-6, "{v}");
+}
+
+#[test]
+fn linear_interpolation_joins_the_rows_with_straight_lines() {
+    // A triangle on 5 nm rows (uniform, so Sprague by default): linear interpolation
+    // gives the triangle, whose emitted Y is Σ ȳ(λ)·tri(λ) / Σ ȳ; Sprague rings beside
+    // the peak and gives another Y. The JSON names the interpolation.
+    let d = tempfile::tempdir().unwrap();
+    let mut text = String::from("wavelength_nm,value\n");
+    for i in 0..=20 {
+        let l = 500 + 5 * i;
+        text += &format!("{l},{}\n", if l == 550 { 1.0 } else { 0.0 });
+    }
+    let tri = write(d.path(), "tri.csv", &text);
+    let lin = color(&[&tri, "--illuminant", "none", "--interpolation", "linear"]);
+    let cie = color(&[&tri, "--illuminant", "none"]);
+    assert_eq!(lin["interpolation"], "linear");
+    assert_eq!(cie["interpolation"], "cie167");
+    let rows: Vec<(f64, f64)> = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("spectra/cie1931_2deg.csv"),
+    )
+    .unwrap()
+    .lines()
+    .skip(1)
+    .map(|l| {
+        let f: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        (f[0], f[2])
+    })
+    .collect();
+    let sum_y: f64 = rows.iter().map(|r| r.1).sum();
+    let want: f64 = rows
+        .iter()
+        .map(|&(l, y)| y * (1.0 - (l - 550.0).abs() / 5.0).max(0.0))
+        .sum::<f64>()
+        / sum_y;
+    let got = vec3(&lin, "XYZ")[1];
+    assert!((got - want).abs() < 1e-6 * want, "{got} vs {want}");
+    let sprague = vec3(&cie, "XYZ")[1];
+    // (7.8e-4 relative here.)
+    assert!((sprague - want).abs() > 3e-4 * want, "{sprague} vs {want}");
 }
 
 #[test]

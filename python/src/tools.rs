@@ -3,6 +3,7 @@
 use crate::convert::{json_to_py, numbers, to_toml, vec3};
 use crate::{err, guard, lib_err};
 use heron_core::colorimetry::{colour_of, Illuminant, StandardObserver};
+use heron_core::spectrum::interp::Interpolation;
 use heron_core::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
@@ -182,13 +183,14 @@ pub fn sky_profile<'py>(
 ///
 /// wavelengths (nm, strictly increasing) and values: at least two samples, interpolated
 /// onto heron's 1 nm grid over 360–830 nm as colour-science does (held constant beyond
-/// the ends). illuminant: "D65", "A" or "E" (values are a reflectance, white has Y = 1)
-/// or "none" (values are emitted, the constant 1 has Y = 1). observer: "1931" (2°) or
-/// "1964" (10°).
+/// the ends): interpolation "cie167" (Sprague or cubic spline) or "linear" (as
+/// colour-science interpolates its SDS_ILLUMINANTS). illuminant: "D65", "D50", "A" or
+/// "E" (values are a reflectance, white has Y = 1) or "none" (values are emitted, the
+/// constant 1 has Y = 1). observer: "1931" (2°) or "1964" (10°).
 #[pyfunction]
 #[pyo3(
-    signature = (wavelengths, values, illuminant="D65", observer=None),
-    text_signature = "(wavelengths, values, illuminant='D65', observer='1931')"
+    signature = (wavelengths, values, illuminant="D65", observer=None, interpolation="cie167"),
+    text_signature = "(wavelengths, values, illuminant='D65', observer='1931', interpolation='cie167')"
 )]
 pub fn color<'py>(
     py: Python<'py>,
@@ -196,11 +198,15 @@ pub fn color<'py>(
     values: &Bound<'py, PyAny>,
     illuminant: &str,
     observer: Option<&Bound<'py, PyAny>>,
+    interpolation: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let illuminant: Illuminant = illuminant
             .parse()
             .map_err(|e| err(format!("illuminant: {e}")))?;
+        let interpolation: Interpolation = interpolation
+            .parse()
+            .map_err(|e| err(format!("interpolation: {e}")))?;
         // 1931 and "1931" alike.
         let observer_text = match observer {
             None => "1931".to_string(),
@@ -219,13 +225,15 @@ pub fn color<'py>(
         // The same interpolation and check as a CSV file's (SpectrumCsv::parse).
         heron_core::spectrum::csv::interpolate_column(Path::new("values"), "value", &samples)
             .map_err(|e| lib_err(e, &[]))?;
-        let c = colour_of(&DenseSpectrum::from_table(&samples), observer, illuminant);
+        let dense = DenseSpectrum::from_table_with(&samples, interpolation);
+        let c = colour_of(&dense, observer, illuminant);
         let d = PyDict::new(py);
         d.set_item("XYZ", c.xyz.to_vec())?;
         d.set_item("xy", c.xy.map(|v| v.to_vec()))?;
         d.set_item("linear_srgb", c.linear_srgb.to_vec())?;
         d.set_item("observer", observer.name())?;
         d.set_item("illuminant", illuminant.name())?;
+        d.set_item("interpolation", interpolation.name())?;
         Ok(d)
     })
 }

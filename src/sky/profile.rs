@@ -158,25 +158,54 @@ pub fn angles(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
         .collect())
 }
 
-/// The CSV text of a request: `theta_deg,<λ1>nm,…`, one row per angle.
-pub fn profile_csv(req: &ProfileRequest) -> Result<String> {
-    let lambdas = parse_lambdas(&req.lambdas)?;
-    let thetas = angles(req.from_deg, req.to_deg, req.step_deg)?;
-    let sky = build_sky(req)?;
-    let table = profile_table(&sky, &lambdas, &thetas);
-    let mut out = String::from("theta_deg");
-    for l in &lambdas {
-        write!(out, ",{l}nm").unwrap();
-    }
-    out.push('\n');
-    for (&t, row) in thetas.iter().zip(table.chunks(lambdas.len().max(1))) {
-        write!(out, "{t}").unwrap();
-        for v in row {
-            write!(out, ",{v:.6e}").unwrap();
+/// The numbers of a request: radiance at each angle and wavelength.
+#[derive(Clone, Debug)]
+pub struct Profile {
+    pub lambdas: Vec<f32>,
+    pub thetas_deg: Vec<f64>,
+    /// Row-major: one row of `lambdas.len()` values per angle ([`profile_table`]).
+    pub table: Vec<f32>,
+}
+
+impl Profile {
+    /// The CSV text: `theta_deg,<λ1>nm,…`, one row per angle.
+    pub fn csv(&self) -> String {
+        let mut out = String::from("theta_deg");
+        for l in &self.lambdas {
+            write!(out, ",{l}nm").unwrap();
         }
         out.push('\n');
+        for (&t, row) in self
+            .thetas_deg
+            .iter()
+            .zip(self.table.chunks(self.lambdas.len().max(1)))
+        {
+            write!(out, "{t}").unwrap();
+            for v in row {
+                write!(out, ",{v:.6e}").unwrap();
+            }
+            out.push('\n');
+        }
+        out
     }
-    Ok(out)
+}
+
+/// Evaluates a request (every flag checked first).
+pub fn profile(req: &ProfileRequest) -> Result<Profile> {
+    let lambdas = parse_lambdas(&req.lambdas)?;
+    let thetas_deg = angles(req.from_deg, req.to_deg, req.step_deg)?;
+    let sky = build_sky(req)?;
+    let table = profile_table(&sky, &lambdas, &thetas_deg);
+    Ok(Profile {
+        lambdas,
+        thetas_deg,
+        table,
+    })
+}
+
+/// The CSV text of a request: `theta_deg,<λ1>nm,…`, one row per angle.
+pub fn profile_csv(req: &ProfileRequest) -> Result<String> {
+    Ok(profile(req)?.csv())
 }
 
 /// The radiance of `sky` at each angle of `thetas_deg` (degrees from the antisolar

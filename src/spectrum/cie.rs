@@ -6,6 +6,7 @@
 //!   the renderer's film uses;
 //! - the CIE 1964 10° standard observer ([`cie1964`], spectra/cie1964_10deg.csv);
 //! - CIE standard illuminant D65 ([`d65_relative`], [`d65_unit`], spectra/cie_d65.csv);
+//! - CIE illuminant D50 ([`d50_relative`], spectra/cie_d50.csv; `heron color` only);
 //! - CIE standard illuminant A ([`illuminant_a_relative`], [`illuminant_a_unit`],
 //!   spectra/cie_a.csv);
 //! - CIE illuminant E, the constant 1 ([`illuminant_e`]; no table).
@@ -18,6 +19,7 @@ use std::sync::OnceLock;
 const CIE1931_CSV: &str = include_str!("../../spectra/cie1931_2deg.csv");
 const CIE1964_CSV: &str = include_str!("../../spectra/cie1964_10deg.csv");
 const D65_CSV: &str = include_str!("../../spectra/cie_d65.csv");
+const D50_CSV: &str = include_str!("../../spectra/cie_d50.csv");
 const A_CSV: &str = include_str!("../../spectra/cie_a.csv");
 
 /// The observer's three matching functions as dense tables, and Σ ȳ Δλ.
@@ -100,6 +102,14 @@ pub fn cie1964() -> &'static Observer {
 pub fn d65_relative() -> &'static DenseSpectrum {
     static D65: OnceLock<DenseSpectrum> = OnceLock::new();
     D65.get_or_init(|| dense_column(&parse_table(D65_CSV, 1), 0))
+}
+
+/// CIE illuminant D50 as tabulated at 5 nm (relative power, 100 at 560 nm), linearly
+/// interpolated to 1 nm and held at its 780 nm value (78.274) over 781–830 nm:
+/// colour-science's `SDS_ILLUMINANTS["D50"]` aligned to 360–830 nm, as D65 is.
+pub fn d50_relative() -> &'static DenseSpectrum {
+    static D50: OnceLock<DenseSpectrum> = OnceLock::new();
+    D50.get_or_init(|| dense_column(&parse_table(D50_CSV, 1), 0))
 }
 
 /// CIE standard illuminant A as tabulated by CIE 15:2004 at 5 nm (relative power, 100 at
@@ -212,6 +222,24 @@ mod tests {
         }
         let y = spectrum_to_xyz(illuminant_a_unit())[1];
         assert!((y - 1.0).abs() < 1e-6, "{y}");
+    }
+
+    #[test]
+    fn d50_chromaticity_is_cie_s() {
+        // CIE 15:2004 Table T.3: D50 is (0.34567, 0.35850) for 2° and (0.34773, 0.35952)
+        // for 10°; the 5 nm table linearly interpolated to 1 nm gives (0.345684,
+        // 0.358504) and (0.347748, 0.359536), as colour-science's sd_to_XYZ does.
+        let d = d50_relative();
+        assert_eq!(d.eval(560.0), 100.0);
+        assert_eq!(d.eval(830.0), 78.274);
+        let c2 = xy(spectrum_to_xyz(d));
+        let c10 = xy(spectrum_to_xyz_with(cie1964(), d));
+        for (got, want) in [(c2, [0.34567, 0.35850]), (c10, [0.34773, 0.35952])] {
+            assert!(
+                (got[0] - want[0]).abs() < 3e-5 && (got[1] - want[1]).abs() < 3e-5,
+                "{got:?} vs {want:?}"
+            );
+        }
     }
 
     #[test]

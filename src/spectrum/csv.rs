@@ -18,7 +18,10 @@
 //! polynomial for uniformly spaced rows (at least six), a not-a-knot cubic spline for
 //! irregular ones (at least four), linear for two or three rows, evaluated at each whole
 //! nanometre, the end values held constant beyond the first and last row. (Data finer
-//! than 1 nm is therefore point-sampled at whole nanometres, not averaged.)
+//! than 1 nm is therefore point-sampled at whole nanometres, not averaged.) `heron color`
+//! can interpolate linearly instead ([`SpectrumCsv::to_dense_with`],
+//! [`Interpolation::Linear`]), as colour-science does for its illuminants.
+use super::interp::Interpolation;
 use super::{DenseSpectrum, LAMBDA_MIN};
 use crate::{HeronError, Result};
 use std::path::Path;
@@ -53,6 +56,12 @@ impl SpectrumCsv {
     /// beyond the ends).
     pub fn to_dense(&self) -> DenseSpectrum {
         DenseSpectrum::from_table(&self.samples)
+    }
+
+    /// The distribution on heron's 1 nm grid, interpolated as `how` says
+    /// ([`DenseSpectrum::from_table_with`]), held constant beyond the ends.
+    pub fn to_dense_with(&self, how: Interpolation) -> DenseSpectrum {
+        DenseSpectrum::from_table_with(&self.samples, how)
     }
 
     /// First and last wavelength, nm.

@@ -29,7 +29,19 @@ impl DenseSpectrum {
     /// cubic spline otherwise, held constant beyond the ends ([`super::interp`]). Every
     /// spectral CSV heron reads goes through this.
     pub fn from_table(samples: &[(f32, f32)]) -> Self {
-        let v = super::interp::interpolate(samples, (0..DENSE_LEN).map(|i| LAMBDA_MIN + i as f32));
+        Self::from_table_with(samples, super::interp::Interpolation::Cie167)
+    }
+
+    /// A spectral table on the 1 nm grid interpolated as `how` says
+    /// ([`super::interp::Interpolation`]: the CIE 167 rules of [`Self::from_table`], or
+    /// straight lines as colour-science interpolates its illuminants), held constant
+    /// beyond the ends.
+    pub fn from_table_with(samples: &[(f32, f32)], how: super::interp::Interpolation) -> Self {
+        let v = super::interp::interpolate_with(
+            samples,
+            (0..DENSE_LEN).map(|i| LAMBDA_MIN + i as f32),
+            how,
+        );
         let mut values = Box::new([0.0f32; DENSE_LEN]);
         values.copy_from_slice(&v);
         DenseSpectrum { values }

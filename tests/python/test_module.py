@@ -408,15 +408,24 @@ def test_sky_profile_errors():
 # --------------------------------------------------------------------------- colour
 
 
-@pytest.mark.parametrize("illuminant,observer", [("D65", "1931"), ("A", 1964), ("none", "1931")])
-def test_color_equals_cli(tmp_path, illuminant, observer):
+@pytest.mark.parametrize("illuminant,observer,interpolation", [
+    ("D65", "1931", "cie167"), ("A", 1964, "cie167"), ("none", "1931", "cie167"),
+    ("D50", "1931", "linear"), ("none", 1964, "linear")])
+def test_color_equals_cli(tmp_path, illuminant, observer, interpolation):
     lam = np.arange(380.0, 781.0, 5.0)
     values = 0.2 + 0.7 / (1 + np.exp(-(lam - 560.0) / 15.0))  # an orange-ish reflectance
+    values[40] += 0.5  # a spike at 580 nm, where the two interpolations differ
     csv = tmp_path / "s.csv"
     csv.write_text("wavelength_nm,value\n" + "".join(f"{l:g},{np.float32(v)!r}\n" for l, v in zip(lam, values)))
-    want = json.loads(run_cli("color", csv, "--illuminant", illuminant, "--observer", observer).stdout)
-    got = heron.color(lam, values.astype(np.float32), illuminant=illuminant, observer=observer)
+    want = json.loads(run_cli("color", csv, "--illuminant", illuminant, "--observer", observer,
+                              "--interpolation", interpolation).stdout)
+    got = heron.color(lam, values.astype(np.float32), illuminant=illuminant, observer=observer,
+                      interpolation=interpolation)
     assert got["illuminant"] == want["illuminant"] and got["observer"] == want["observer"]
+    assert got["interpolation"] == want["interpolation"] == interpolation
+    other = "linear" if interpolation == "cie167" else "cie167"
+    assert heron.color(lam, values.astype(np.float32), illuminant=illuminant, observer=observer,
+                       interpolation=other)["XYZ"] != got["XYZ"]
     for k in ["XYZ", "xy", "linear_srgb"]:
         np.testing.assert_array_equal(np.float32(got[k]), np.float32(want[k]), err_msg=k)
 
@@ -428,6 +437,9 @@ def test_color_errors(tmp_path):
     assert py_error(heron.color, [400, 500], [1, 1], illuminant="F2") == "illuminant: " + clap_reason(want)
     want = cli_error("color", csv, "--observer", "1976")
     assert py_error(heron.color, [400, 500], [1, 1], observer="1976") == "observer: " + clap_reason(want)
+    want = cli_error("color", csv, "--interpolation", "sprague")
+    assert py_error(heron.color, [400, 500], [1, 1], interpolation="sprague") == (
+        "interpolation: " + clap_reason(want))
     assert py_error(heron.color, [400, 400], [1, 1]) == (
         "wavelengths[1]: expected wavelengths in strictly increasing order, got 400 nm after 400 nm")
     assert py_error(heron.color, [400], [1]) == "wavelengths, values: expected at least 2 samples, found 1"

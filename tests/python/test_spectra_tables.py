@@ -1,6 +1,6 @@
 """The committed tables in spectra/ are colour-science's data, exactly.
 
-Tables: CIE 1931 2° and CIE 1964 10° observers, illuminants D65 and A, Smits (1999).
+Tables: CIE 1931 2° and CIE 1964 10° observers, illuminants D65, D50 and A, Smits (1999).
 
 Three layers: (1) every number equals colour-science 0.4.7's value (the CSVs are written
 with repr(float), so parsing them gives the float64 back; compared at 1e-12 relative);
@@ -106,6 +106,22 @@ def test_d65_alignment_is_linear_inside_and_constant_beyond_780nm():
     # 781-830 nm hold the 780 nm value.
     assert native_at[780.0] == 63.3828
     np.testing.assert_array_equal(data[~inside, 1], np.full((~inside).sum(), 63.3828))
+    assert data[data[:, 0] == 560, 1] == [100.0]
+
+
+def test_d50_values_are_colour_science_d50_aligned():
+    header, data = read_csv("cie_d50.csv")
+    assert header == ["wavelength_nm", "value"]
+    d50 = colour.SDS_ILLUMINANTS["D50"].copy().align(heronref.SHAPE)
+    np.testing.assert_array_equal(d50.wavelengths, WL_1NM)
+    np.testing.assert_array_equal(data[:, 0], WL_1NM)
+    assert_same(data[:, 1], d50.values, "D50 vs colour-science D50 aligned to 1 nm 360-830")
+    # Linear between the 5 nm rows, the 780 nm value held beyond (spectra/README.md).
+    native = colour.SDS_ILLUMINANTS["D50"]
+    inside = data[:, 0] <= 780
+    np.testing.assert_allclose(data[inside, 1], np.interp(data[inside, 0], native.wavelengths,
+                                                          native.values), rtol=1e-12)
+    np.testing.assert_array_equal(data[~inside, 1], np.full((~inside).sum(), 78.274))
     assert data[data[:, 0] == 560, 1] == [100.0]
 
 
@@ -250,7 +266,7 @@ def test_generator_reproduces_committed_tables(tmp_path):
     proc = subprocess.run([sys.executable, str(script), "--out", str(tmp_path)],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
-    for name in ("cie1931_2deg.csv", "cie1964_10deg.csv", "cie_d65.csv", "cie_a.csv",
+    for name in ("cie1931_2deg.csv", "cie1964_10deg.csv", "cie_d65.csv", "cie_d50.csv", "cie_a.csv",
                  "smits1999.csv"):
         assert filecmp.cmp(tmp_path / name, SPECTRA / name, shallow=False), (
             f"spectra/{name} differs from what scripts/gen_spectra.py writes now; "
