@@ -383,6 +383,22 @@ impl Comparison {
         f
     }
 
+    /// The region z-scores as a grid: (rows, columns, values row-major with the three
+    /// channels innermost), NaN where a region and channel was not tested.
+    pub fn z_grid(&self) -> (usize, usize, Vec<f64>) {
+        let (cols, rows) = (
+            tiles(self.width, self.region),
+            tiles(self.height, self.region),
+        );
+        let mut z = vec![f64::NAN; rows.len() * cols.len() * 3];
+        for t in &self.regions {
+            let r = rows.iter().position(|&(y, _)| y == t.y).unwrap_or(0);
+            let c = cols.iter().position(|&(x, _)| x == t.x).unwrap_or(0);
+            z[(r * cols.len() + c) * 3 + t.channel] = t.z;
+        }
+        (rows.len(), cols.len(), z)
+    }
+
     /// The largest |z| over the region tests (0 without any).
     pub fn max_abs_z(&self) -> f64 {
         self.regions.iter().map(|t| t.z.abs()).fold(0.0, f64::max)
