@@ -232,6 +232,7 @@ class Comparison(TypedDict):
     variance_from: Literal["channels", "spread"]
     per_test_alpha: float
     critical_z: float
+    critical_t: Optional[float]
     rel_rmse: float
     rel_mse: float
     mean_difference: list[float]

@@ -347,6 +347,9 @@ pub struct Comparison {
     /// |z| beyond which a normal test fails at the per-test level (a t test needs a
     /// little more, depending on its degrees of freedom).
     pub critical_z: f64,
+    /// With the spread estimator, |t| beyond which a full region's test (region² − 1
+    /// degrees of freedom) fails.
+    pub critical_t: Option<f64>,
     /// Every region test, in row-major region order, channel by channel.
     pub regions: Vec<RegionTest>,
     /// The whole image's test per channel: its mean difference and standard error.
@@ -431,16 +434,22 @@ impl Comparison {
                 self.identical
             );
         }
+        let cut = match self.critical_t {
+            Some(t) => format!(
+                "|t| > {t:.2} for a region's {} degrees of freedom",
+                self.region as u64 * self.region as u64 - 1
+            ),
+            None => format!("|z| > {:.2}", self.critical_z),
+        };
         let _ = writeln!(
             s,
-            "significance {} for the family, {}: each test at {:.3e} (|z| > {:.2})",
+            "significance {} for the family, {}: each test at {:.3e} ({cut})",
             self.alpha,
             match self.correction {
                 Correction::Sidak => "Šidák",
                 Correction::Bonferroni => "Bonferroni",
             },
             self.per_test_alpha,
-            self.critical_z
         );
         let _ = write!(s, "mean difference A − B:");
         for t in &self.whole {
@@ -668,6 +677,8 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
         variance_from: source,
         per_test_alpha: per_test,
         critical_z: normal_critical(per_test),
+        critical_t: (source == VarianceSource::Spread && o.region > 1)
+            .then(|| student_critical(per_test, (o.region as f64).powi(2) - 1.0)),
         regions,
         whole,
         identical,
@@ -782,6 +793,21 @@ pub fn normal_critical(p: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// The |t| at which a two-sided Student t test with ν degrees of freedom has p-value
+/// `p`, by bisection on [`student_two_sided`].
+pub fn student_critical(p: f64, nu: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 1e6f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if student_two_sided(mid, nu) > p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// The regularised incomplete beta function I_x(a, b), from its continued fraction
 /// (Abramowitz & Stegun 26.5.8) evaluated by the modified Lentz method (Lentz 1976,
 /// Applied Optics 15(3); Thompson & Barnett 1986, J. Comput. Phys. 64), on the side of
@@ -857,6 +883,7 @@ mod tests {
         ] {
             let got = student_two_sided(t, nu);
             assert!((got / p - 1.0).abs() < 1e-7, "t {t}, ν {nu}: {got}");
+            assert!((student_critical(p, nu) / t - 1.0).abs() < 1e-7, "ν {nu}");
         }
         // Large ν: the normal's tail.
         let (z, nu) = (4.5, 1e6);
