@@ -4,7 +4,8 @@ Scenes are heron's TOML scene files (``load_scene``) or the same schema as a dic
 (``Scene.from_dict``); ``Scene.render`` returns numpy arrays (linear sRGB, CIE XYZ,
 spectral bins) equal bit for bit to the EXR ``heron render`` writes for the same
 settings. ``trace``, ``sky_profile``, ``color`` and ``ior`` are the CLI's ``heron trace``,
-``heron sky profile``, ``heron color`` and the scene files' refractive indices.
+``heron sky profile``, ``heron color`` and the scene files' refractive indices;
+``compare`` is ``heron compare``.
 
 Bad input raises ``HeronError`` (a ``ValueError``) with the CLI's one-line message; where
 the CLI names a flag (``--lanes``) the message names the argument (``lanes``).
@@ -65,13 +66,16 @@ class Scene:
         sampler: Optional[Literal["sobol", "independent"]] = None,
         max_depth: Optional[int] = None,
         offset: Optional[Literal["auto", "epsilon", "robust"]] = None,
+        variance: bool = False,
     ) -> "RenderResult":
         """Renders the scene with ``heron render``'s options and defaults.
 
         spp and seed default to the scene's ``[render]`` values; threads 0 is one per
         core (the image does not depend on it); spectral_bins 0 is none, else 1-470
-        equal bins over 360-830 nm. The GIL is released while rendering; Ctrl-C stops
-        the render within a row of a tile and raises KeyboardInterrupt.
+        equal bins over 360-830 nm; variance=True also estimates each pixel's variance
+        (``heron render --variance``, at least 2 spp). The GIL is released while
+        rendering; Ctrl-C stops the render within a row of a tile and raises
+        KeyboardInterrupt.
         """
 
 class RenderResult:
@@ -89,6 +93,10 @@ class RenderResult:
     @property
     def wavelengths(self) -> Optional[npt.NDArray[np.float32]]:
         """The spectral bins' centres in nm, or None."""
+    @property
+    def variance(self) -> Optional[npt.NDArray[np.float32]]:
+        """The variance of each pixel's R, G, B (of its mean), H x W x 3 (the EXR's
+        variance.R, .G, .B), or None without variance=True."""
     spp: int
     """Samples per pixel in the image."""
     rays: int
@@ -187,3 +195,71 @@ def ior(
     wavelengths: _Numbers,
 ) -> npt.NDArray[np.float32]:
     """n(lambda) of a refractive-index model given as a scene file's ``ior`` value."""
+
+_Image = Union[
+    _Path,
+    RenderResult,
+    npt.ArrayLike,
+    tuple[npt.ArrayLike, npt.ArrayLike],
+]
+
+class RegionTest(TypedDict):
+    x: int
+    y: int
+    width: int
+    height: int
+    channel: int
+    pixels: int
+    mean_a: float
+    mean_b: float
+    difference: float
+    standard_error: float
+    z: float
+    p: float
+    degrees_of_freedom: Optional[float]
+    fails: bool
+    whole_image: bool
+
+class Comparison(TypedDict):
+    same: bool
+    status: Literal[0, 1]
+    report: str
+    tests: int
+    width: int
+    height: int
+    channels: list[str]
+    region: int
+    alpha: float
+    correction: Literal["sidak", "bonferroni"]
+    variance_from: Literal["channels", "spread"]
+    per_test_alpha: float
+    critical_z: float
+    critical_t: Optional[float]
+    rel_rmse: float
+    rel_mse: float
+    mean_difference: list[float]
+    standard_error: list[float]
+    failing: list[RegionTest]
+    regions: list[RegionTest]
+    whole: list[RegionTest]
+    identical: int
+    z: npt.NDArray[np.float64]
+
+def compare(
+    a: _Image,
+    b: _Image,
+    *,
+    region: int = 16,
+    alpha: float = 0.01,
+    correction: Literal["sidak", "bonferroni"] = "sidak",
+    mask: Optional[npt.ArrayLike] = None,
+    heatmap: Optional[_Path] = None,
+) -> Comparison:
+    """Are two renders the same image up to noise? ``heron compare``'s region z-test.
+
+    a, b: an EXR path, a RenderResult, an H x W x 3 array, or (array, variance array);
+    b is the reference of the relative errors. Standard errors come from both images'
+    variance, else from the spread within each region (Student t). "same" is the
+    verdict and "status" the CLI's exit status (0 same, 1 different); errors raise
+    HeronError (the CLI's status 2).
+    """

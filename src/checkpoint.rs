@@ -12,13 +12,31 @@
 //! one render with all the samples.
 //!
 //! File layout: the line `heron-film 1`; a line of JSON with `settings` (the settings
-//! key), `shard` ([K, N] or null), `width`, `height`, `anySplat` and `xyzChannels`;
+//! key), `shard` ([K, N] or null), `width`, `height`, `anySplat` and `xyzChannels`, and
+//! `variance: true` when the film keeps squares (`--variance`; absent otherwise, so
+//! films without it keep their bytes);
 //! then little-endian binary: passes done, samples per pixel done (u32 each), camera and
 //! shadow rays and non-finite samples (u64 each), the four array lengths (u64), then
 //! XYZ sums (i128, 3 per pixel), splatted XYZ (i128, 3 per pixel), spectral bin sums
-//! (i128), splatted bins (i128) and finite-sample counts (u32 per pixel).
-use crate::film::fixed::to_f64;
-use crate::film::{Film, SpectralBins};
+//! (i128), splatted bins (i128) and finite-sample counts (u32 per pixel); with
+//! `variance`, then the two lengths (u64) of the arrays of squares and the arrays:
+//! the sums of squares of the samples' linear sRGB (3 × 24 bytes per pixel, 192-bit
+//! integers, `film::fixed::SquareSum`) and of the splats' (the same per pixel for a
+//! splatting integrator, else empty).
+//!
+//! Variance (`Checkpoint::film`): a pixel's value is the mean of its n finite samples,
+//! so its variance is estimated from their sums S₁ = Σ c and S₂ = Σ c² as
+//! (S₂ − S₁²/n) / (n (n − 1)), the unbiased sample variance divided by n. Splats add the
+//! image's splatted part, (1/spp) Σⱼ sⱼ over all N = pixels × spp samples of the image,
+//! sⱼ the sum of sample j's splats into the pixel; the samples are independent and
+//! identically distributed (a light path does not depend on the pixel that started
+//! it), so its variance is estimated as (T₂ − T₁²/N) N / ((N − 1) spp²) from T₁ = Σ sⱼ
+//! and T₂ = Σ sⱼ². Left out: the covariance of a sample's own value with its splats into
+//! its own pixel (BDPT), of the order of 1/pixels of the terms kept. The sums are exact
+//! integers, so the variance, like the image, does not depend on threads, passes,
+//! checkpoints or shards.
+use crate::film::fixed::{to_f64, SquareSum};
+use crate::film::{linear_srgb_f64, Film, SpectralBins};
 use crate::{HeronError, Result};
 use std::path::Path;
 
@@ -85,6 +103,14 @@ pub struct Checkpoint {
     pub good: Vec<u32>,
     pub splat: Vec<[i128; 3]>,
     pub splat_bins: Vec<i128>,
+    /// Whether the film keeps the sums of squares below (`--variance`).
+    pub variance: bool,
+    /// Per pixel, Σ c² of the finite samples' linear sRGB components (empty without
+    /// `variance`).
+    pub sum_sq: Vec<[SquareSum; 3]>,
+    /// Per pixel, Σ sⱼ² of the samples' splats into it (empty without `variance` or
+    /// when the integrator does not splat).
+    pub splat_sq: Vec<[SquareSum; 3]>,
 }
 
 fn err(path: &Path, message: impl Into<String>) -> HeronError {
@@ -99,7 +125,7 @@ impl Checkpoint {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut b = Vec::new();
         b.extend_from_slice(MAGIC.as_bytes());
-        let header = serde_json::json!({
+        let mut header = serde_json::json!({
             "settings": serde_json::Value::Object(self.key.clone()),
             "shard": self.shard.map(|s| [s.index, s.count]),
             "width": self.width,
@@ -107,6 +133,9 @@ impl Checkpoint {
             "anySplat": self.any_splat,
             "xyzChannels": self.xyz_channels,
         });
+        if self.variance {
+            header["variance"] = true.into();
+        }
         b.extend_from_slice(header.to_string().as_bytes());
         b.push(b'\n');
         for v in [self.passes_done, self.spp_done] {
@@ -131,6 +160,14 @@ impl Checkpoint {
         }
         for g in &self.good {
             b.extend_from_slice(&g.to_le_bytes());
+        }
+        if self.variance {
+            for len in [self.sum_sq.len(), self.splat_sq.len()] {
+                b.extend_from_slice(&(len as u64).to_le_bytes());
+            }
+            for q in self.sum_sq.iter().chain(&self.splat_sq).flatten() {
+                b.extend_from_slice(&q.to_le_bytes());
+            }
         }
         b
     }
@@ -196,6 +233,10 @@ impl Checkpoint {
         };
         let (width, height) = (u32_of("width")?, u32_of("height")?);
         let (any_splat, xyz_channels) = (bool_of("anySplat")?, bool_of("xyzChannels")?);
+        let variance = match header.get("variance") {
+            None => false,
+            Some(v) => v.as_bool().ok_or_else(|| bad("variance"))?,
+        };
         let mut r = Reader { b: &rest[nl + 1..] };
         let passes_done = r.u32()?;
         let spp_done = r.u32()?;
@@ -220,6 +261,22 @@ impl Checkpoint {
         let good = (0..n_xyz)
             .map(|_| r.u32())
             .collect::<std::result::Result<_, _>>()?;
+        let (mut sum_sq, mut splat_sq) = (Vec::new(), Vec::new());
+        if variance {
+            let (n_sq, n_splat_sq) = (r.len()?, r.len()?);
+            if n_sq != n_xyz || (n_splat_sq != 0 && n_splat_sq != n_xyz) {
+                return Err(format!(
+                    "its arrays of squares do not fit its {width}x{height} image"
+                ));
+            }
+            let mut squares = |n: usize| -> std::result::Result<Vec<[SquareSum; 3]>, String> {
+                (0..n)
+                    .map(|_| Ok([r.square()?, r.square()?, r.square()?]))
+                    .collect()
+            };
+            sum_sq = squares(n_sq)?;
+            splat_sq = squares(n_splat_sq)?;
+        }
         if !r.b.is_empty() {
             return Err(format!("{} bytes after the data", r.b.len()));
         }
@@ -240,6 +297,9 @@ impl Checkpoint {
             good,
             splat,
             splat_bins,
+            variance,
+            sum_sq,
+            splat_sq,
         })
     }
 
@@ -335,7 +395,38 @@ impl Checkpoint {
             height: self.height,
             xyz,
             spectral,
+            variance: self.variance.then(|| self.variance_image()),
         }
+    }
+
+    /// The variance of each pixel's linear sRGB value, from the sums of squares (see the
+    /// module's documentation); infinite where a pixel has fewer than two samples.
+    fn variance_image(&self) -> Vec<[f32; 3]> {
+        let npix = self.sum_xyz.len();
+        let spp = self.spp_done as f64;
+        let n_all = npix as f64 * spp;
+        let rgb = |s: &[i128; 3]| linear_srgb_f64(s.map(to_f64));
+        (0..npix)
+            .map(|i| {
+                let n = self.good[i] as f64;
+                if self.good[i] < 2 {
+                    return [f32::INFINITY; 3];
+                }
+                let s1 = rgb(&self.sum_xyz[i]);
+                let splat = self.any_splat && !self.splat_sq.is_empty() && n_all > 1.0;
+                let t1 = rgb(&self.splat[i]);
+                std::array::from_fn(|c| {
+                    let s2 = self.sum_sq[i][c].to_f64();
+                    let mut v = (s2 - s1[c] * s1[c] / n).max(0.0) / (n * (n - 1.0));
+                    if splat {
+                        let t2 = self.splat_sq[i][c].to_f64();
+                        v += (t2 - t1[c] * t1[c] / n_all).max(0.0) * n_all
+                            / ((n_all - 1.0) * spp * spp);
+                    }
+                    v as f32
+                })
+            })
+            .collect()
     }
 
     /// Adds another part's sums and counts to this one's. Integer sums, so the result
@@ -360,6 +451,16 @@ impl Checkpoint {
         }
         for (a, b) in self.good.iter_mut().zip(&o.good) {
             *a += b;
+        }
+        for (a, b) in self
+            .sum_sq
+            .iter_mut()
+            .zip(&o.sum_sq)
+            .chain(self.splat_sq.iter_mut().zip(&o.splat_sq))
+        {
+            for (x, y) in a.iter_mut().zip(b) {
+                x.add(*y);
+            }
         }
         self.any_splat |= o.any_splat;
         self.passes_done += o.passes_done;
@@ -402,6 +503,18 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
                 ),
             ));
         }
+        if c.variance != first.variance {
+            let with = |v: bool| if v { "with" } else { "without" };
+            return Err(err(
+                p,
+                format!(
+                    "was rendered {} --variance, {} {} it: render every shard with the same flags",
+                    with(c.variance),
+                    first_path.display(),
+                    with(first.variance)
+                ),
+            ));
+        }
         if let Some(m) = c.differs(&first.key, "here", &format!("in {}", first_path.display())) {
             return Err(err(p, format!("is from another render ({m})")));
         }
@@ -412,6 +525,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
                 first.sum_bins.len(),
                 first.splat_bins.len(),
             )
+            || (c.sum_sq.len(), c.splat_sq.len()) != (first.sum_sq.len(), first.splat_sq.len())
             || c.xyz_channels != first.xyz_channels
         {
             return Err(err(
@@ -464,6 +578,8 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
         sum_bins: vec![0; first.sum_bins.len()],
         splat_bins: vec![0; first.splat_bins.len()],
         good: vec![0; first.good.len()],
+        sum_sq: vec![Default::default(); first.sum_sq.len()],
+        splat_sq: vec![Default::default(); first.splat_sq.len()],
         ..first.clone()
     };
     for (_, c) in parts {
@@ -493,6 +609,9 @@ impl Reader<'_> {
     }
     fn i128(&mut self) -> std::result::Result<i128, String> {
         Ok(i128::from_le_bytes(self.take()?))
+    }
+    fn square(&mut self) -> std::result::Result<SquareSum, String> {
+        Ok(SquareSum::from_le_bytes(self.take()?))
     }
     /// An array length, bounded by what is left of the file (so a corrupt length cannot
     /// ask for an absurd allocation).
@@ -530,6 +649,9 @@ mod tests {
             good: vec![12, 11],
             splat: vec![[-9; 3]; 2],
             splat_bins: vec![],
+            variance: false,
+            sum_sq: vec![],
+            splat_sq: vec![],
         };
         let b = c.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&b).unwrap(), c);

@@ -11,6 +11,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod checkpoint;
 pub mod colorimetry;
+pub mod compare;
 pub mod converge;
 pub mod drops;
 pub mod error;

@@ -40,6 +40,11 @@ enum Command {
     Bench(BenchCommand),
     /// Print the CIE XYZ, xy and linear sRGB of a spectral distribution CSV as JSON.
     Color(ColorArgs),
+    /// Are two renders the same image up to noise? A z-test of the mean difference per
+    /// region and channel (R, G, B), with standard errors from the EXRs' variance
+    /// channels (heron render --variance) or from the spread within each region. Exits 0
+    /// (same), 1 (different) or 2 (cannot compare).
+    Compare(CompareArgs),
     /// Print the provenance heron wrote into an EXR: version, scene and input hashes,
     /// integrator, sampler, spp, seed, lanes, wavelengths (one `key: value` per line).
     Info {
@@ -548,6 +553,37 @@ struct RenderArgs {
     /// Do not draw the progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Also estimate each pixel's variance (of its mean, from the sums of its samples'
+    /// squares) and write it as the EXR channels variance.R, variance.G, variance.B, for
+    /// heron compare. Needs at least 2 spp.
+    #[arg(long)]
+    variance: bool,
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The first image (OpenEXR with R, G, B).
+    a: PathBuf,
+    /// The second image, the reference of the relative errors.
+    b: PathBuf,
+    /// Region edge in pixels (the last region of a row or column takes the remainder).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
+    region: u32,
+    /// Family-wise significance level: the chance that two renders of one image are
+    /// called different.
+    #[arg(long, default_value_t = 0.01)]
+    alpha: f64,
+    /// How alpha is split among the tests: sidak (1 − (1 − alpha)^(1/m)) or bonferroni
+    /// (alpha/m).
+    #[arg(long, default_value = "sidak", value_parser = clap::builder::PossibleValuesParser::new(heron::compare::Correction::NAMES))]
+    correction: String,
+    /// Write a PNG heat map of the regions' z-scores (red: A brighter, blue: B brighter;
+    /// failing regions outlined).
+    #[arg(long, value_name = "PNG")]
+    heatmap: Option<PathBuf>,
+    /// List at most this many failing tests.
+    #[arg(long, default_value_t = 20)]
+    max_listed: usize,
 }
 
 #[derive(clap::Args)]
@@ -601,9 +637,41 @@ fn cmd_color(a: ColorArgs) -> Result<()> {
     Ok(())
 }
 
+/// `heron compare`: prints the report; status 0 (same), 1 (different), and errors
+/// (status 2) through `main`.
+fn cmd_compare(a: CompareArgs) -> Result<()> {
+    use heron::compare::{compare, Correction, Image, Options};
+    let opts = Options {
+        region: a.region,
+        alpha: a.alpha,
+        correction: Correction::parse(&a.correction).map_err(anyhow::Error::msg)?,
+        mask: None,
+    };
+    opts.check().map_err(anyhow::Error::msg)?;
+    if let Some(h) = &a.heatmap {
+        check_output(h, &["png"]).map_err(|e| {
+            anyhow::anyhow!("{}", e.to_string().replacen("--output", "--heatmap", 1))
+        })?;
+    }
+    let (ia, ib) = (Image::read_exr(&a.a)?, Image::read_exr(&a.b)?);
+    let c = compare(&ia, &ib, &opts)
+        .map_err(|e| anyhow::anyhow!("{} and {}: {e}", display(&a.a), display(&a.b)))?;
+    print!("{}", c.report(&display(&a.a), &display(&a.b), a.max_listed));
+    if let Some(h) = &a.heatmap {
+        c.write_heat_map(h, None)?;
+    }
+    if !c.same() {
+        std::process::exit(1);
+    }
+    Ok(())
+}
+
 fn main() {
-    // Usage errors get one line and status 1 like every other error; --help and
+    // Usage errors get one line and status 1 like every other error (status 2 for
+    // heron compare, whose 1 means "different", as diff and cmp do); --help and
     // --version print as usual.
+    let compare = std::env::args().nth(1).as_deref() == Some("compare");
+    let fail = if compare { 2 } else { 1 };
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) if !e.use_stderr() => e.exit(),
@@ -611,7 +679,7 @@ fn main() {
             let text = e.to_string();
             let first = text.lines().next().unwrap_or("invalid arguments");
             eprintln!("{}", first.trim_end());
-            std::process::exit(1);
+            std::process::exit(fail);
         }
     };
     let result = match cli.command {
@@ -624,6 +692,7 @@ fn main() {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
         }
         Command::Color(args) => cmd_color(args),
+        Command::Compare(args) => cmd_compare(args),
         Command::Info { exr } => cmd_info(&exr),
         Command::Stress(args) => cmd_stress(args),
         Command::Sky(c) => cmd_sky(c),
@@ -633,7 +702,7 @@ fn main() {
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
-        std::process::exit(1);
+        std::process::exit(fail);
     }
 }
 
@@ -696,6 +765,13 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         .apply(&settings_args)
         .map_err(anyhow::Error::msg)?;
     opts.threads = args.threads.unwrap_or(0);
+    if args.variance && opts.settings.spp < 2 {
+        bail!(
+            "--variance: needs at least 2 samples per pixel to estimate a variance, got {}",
+            opts.settings.spp
+        );
+    }
+    opts.variance = args.variance;
     let seconds = |flag: &str, v: f64| -> Result<std::time::Duration> {
         if v.is_finite() && v >= 0.0 {
             Ok(std::time::Duration::from_secs_f64(v))

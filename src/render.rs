@@ -10,8 +10,10 @@
 //! tile order, pass by pass. So the image is bit-identical whatever the thread count.
 use crate::accel::embree::{self, RayQuery};
 use crate::checkpoint::{Checkpoint, Shard};
-use crate::film::fixed::{to_fixed, to_fixed3};
-use crate::film::{add_to_bins, xyz_of_sample, Film, SpectralBins, Splats};
+use crate::film::fixed::{to_fixed, to_fixed3, SquareSum};
+use crate::film::{
+    add_splat_squares, add_to_bins, rgb_squares, xyz_of_sample, Film, SpectralBins, Splats,
+};
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{self, Context, TraceCounters};
 use crate::sampler::Sampler;
@@ -49,6 +51,9 @@ pub struct RenderOptions {
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Called after each finished tile with (tiles done, tiles in all).
     pub progress: Option<std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>>,
+    /// Also sum the squares of each pixel's contributions, for the variance of each
+    /// pixel's value (`heron render --variance`); off, the render does no extra work.
+    pub variance: bool,
 }
 
 impl RenderOptions {
@@ -64,6 +69,7 @@ impl RenderOptions {
             stop: None,
             cancel: None,
             progress: None,
+            variance: false,
         }
     }
 }
@@ -269,6 +275,10 @@ fn settings_key(
     m.insert("width".into(), scene.camera.width.into());
     m.insert("height".into(), scene.camera.height.into());
     m.insert("passSpp".into(), pass_spp.into());
+    // Only when asked, so that the films of renders without it keep their bytes.
+    if opts.variance {
+        m.insert("variance".into(), true.into());
+    }
     m
 }
 
@@ -344,6 +354,14 @@ pub(crate) fn render_passes(
     let key = settings_key(ctx.scene, opts, pass_spp);
     let mut state = match &opts.resume {
         Some(c) => {
+            if c.variance != opts.variance {
+                let with = |v: bool| if v { "with" } else { "without" };
+                return Err(HeronError::Invalid(format!(
+                    "--resume: the checkpoint was made {} --variance, this render is {} it",
+                    with(c.variance),
+                    with(opts.variance)
+                )));
+            }
             if let Some(m) = c.mismatch(&key) {
                 return Err(HeronError::Invalid(format!(
                     "--resume: the checkpoint was made with other settings ({m})"
@@ -358,9 +376,12 @@ pub(crate) fn render_passes(
                 )));
             }
             let splat_len = if kind_splats(opts) { npix * nb } else { 0 };
+            let (sq_len, splat_sq_len) = variance_lens(opts, npix);
             if (c.width, c.height) != (cam.width, cam.height)
                 || c.sum_bins.len() != npix * nb
                 || c.splat_bins.len() != splat_len
+                || c.sum_sq.len() != sq_len
+                || c.splat_sq.len() != splat_sq_len
                 || c.passes_done as usize > passes.len()
             {
                 return Err(HeronError::Invalid(
@@ -382,6 +403,9 @@ pub(crate) fn render_passes(
             good: vec![0u32; npix],
             splat: vec![[0; 3]; npix],
             splat_bins: vec![0; if kind_splats(opts) { npix * nb } else { 0 }],
+            variance: opts.variance,
+            sum_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).0],
+            splat_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).1],
             ..Default::default()
         },
     };
@@ -402,10 +426,27 @@ pub(crate) fn render_passes(
             tiles
                 .par_iter()
                 .map(|&(x0, y0)| {
-                    let r = match &sample {
-                        SampleFn::One(f) => render_tile::<1>(ctx, opts, x0, y0, s0..s1, f),
-                        SampleFn::Four(f) => render_tile::<4>(ctx, opts, x0, y0, s0..s1, f),
-                        SampleFn::Eight(f) => render_tile::<8>(ctx, opts, x0, y0, s0..s1, f),
+                    // Two instances of the tile loop, so that a render without the
+                    // variance runs the loop it ran before the variance existed.
+                    let r = match (&sample, opts.variance) {
+                        (SampleFn::One(f), false) => {
+                            render_tile::<1, false>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::Four(f), false) => {
+                            render_tile::<4, false>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::Eight(f), false) => {
+                            render_tile::<8, false>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::One(f), true) => {
+                            render_tile::<1, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::Four(f), true) => {
+                            render_tile::<4, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::Eight(f), true) => {
+                            render_tile::<8, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
                     };
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     if let Some(p) = &opts.progress {
@@ -433,6 +474,11 @@ pub(crate) fn render_passes(
                         state.sum_xyz[dst][j] = state.sum_xyz[dst][j].wrapping_add(t.xyz[src][j]);
                     }
                     state.good[dst] += t.good[src];
+                    if let Some(sq) = t.sq.get(src) {
+                        for (a, b) in state.sum_sq[dst].iter_mut().zip(sq) {
+                            a.add(*b);
+                        }
+                    }
                     for (a, b) in state.sum_bins[dst * nb..(dst + 1) * nb]
                         .iter_mut()
                         .zip(&t.spectral[src * nb..(src + 1) * nb])
@@ -450,6 +496,15 @@ pub(crate) fn render_passes(
                         }
                     }
                     None => state.nonfinite += 1,
+                }
+            }
+            if state.splat_sq.is_empty() && !t.splat_sq.is_empty() {
+                // Splats from an integrator not known to splat (as `any_splat`).
+                state.splat_sq = vec![[SquareSum::default(); 3]; npix];
+            }
+            for (p, sq) in &t.splat_sq {
+                for (a, b) in state.splat_sq[*p as usize].iter_mut().zip(sq) {
+                    a.add(*b);
                 }
             }
             for &(p, k, v) in &t.splats.spectral {
@@ -493,6 +548,16 @@ pub(crate) fn render_passes(
     Ok((state, stats))
 }
 
+/// The lengths of the film's arrays of squares: (per pixel, per pixel for splats), zero
+/// without `--variance`.
+fn variance_lens(opts: &RenderOptions, npix: usize) -> (usize, usize) {
+    match (opts.variance, kind_splats(opts)) {
+        (false, _) => (0, 0),
+        (true, false) => (npix, 0),
+        (true, true) => (npix, npix),
+    }
+}
+
 struct TileResult {
     x0: u32,
     y0: u32,
@@ -503,13 +568,19 @@ struct TileResult {
     xyz: Vec<[i128; 3]>,
     spectral: Vec<i128>,
     good: Vec<u32>,
+    /// With `--variance`: per pixel, the sums of the squares of the samples' linear sRGB
+    /// (empty otherwise); and per sample that splatted, the squares of its splats summed
+    /// per pixel.
+    sq: Vec<[SquareSum; 3]>,
+    splat_sq: Vec<(u32, [SquareSum; 3])>,
     splats: Splats,
     counters: TraceCounters,
     nonfinite: u64,
     first_nonfinite: Option<(u32, u32, u32)>,
 }
 
-fn render_tile<const N: usize>(
+/// One tile's samples of one pass; `VARIANCE` also sums the squares (`--variance`).
+fn render_tile<const N: usize, const VARIANCE: bool>(
     ctx: &Context,
     opts: &RenderOptions,
     x0: u32,
@@ -527,6 +598,13 @@ fn render_tile<const N: usize>(
     let mut xyz = vec![[0i128; 3]; (w * h) as usize];
     let mut spectral = vec![0i128; (w * h) as usize * nb];
     let mut good = vec![0u32; (w * h) as usize];
+    let mut sq = if VARIANCE {
+        vec![[SquareSum::default(); 3]; (w * h) as usize]
+    } else {
+        Vec::new()
+    };
+    let mut splat_sq = Vec::new();
+    let mut scratch = Vec::new();
     let mut counters = TraceCounters::default();
     let mut nonfinite = 0u64;
     let mut first_nonfinite = None;
@@ -585,6 +663,7 @@ fn render_tile<const N: usize>(
                 };
                 for k in 0..lanes {
                     let ray = Ray::new(cam.eye, rays[k].dir, 0.0, f32::INFINITY);
+                    let splats_before = if VARIANCE { splats.list.len() } else { 0 };
                     let l = sample_fn(
                         ctx,
                         ray,
@@ -594,14 +673,22 @@ fn render_tile<const N: usize>(
                         &mut counters,
                         &mut splats,
                     );
+                    if VARIANCE && splats.list.len() > splats_before {
+                        add_splat_squares(
+                            &splats.list[splats_before..],
+                            &mut scratch,
+                            &mut splat_sq,
+                        );
+                    }
                     let i = (y * w + xs + k as u32) as usize;
                     // A sample whose radiance is not finite, or too large for the film's
                     // fixed-point sums (film/fixed.rs), is left out and counted.
-                    let c = if l.is_finite() {
-                        to_fixed3(xyz_of_sample(&l, &wls[k]))
+                    let v = if l.is_finite() {
+                        Some(xyz_of_sample(&l, &wls[k]))
                     } else {
                         None
                     };
+                    let c = v.and_then(to_fixed3);
                     // The bins are added only when the XYZ is in range, and the XYZ
                     // only when the bins were.
                     let ok = c.is_some()
@@ -621,6 +708,14 @@ fn render_tile<const N: usize>(
                         xyz[i][j] = xyz[i][j].wrapping_add(c[j]);
                     }
                     good[i] += 1;
+                    if VARIANCE {
+                        // In range: v passed to_fixed3.
+                        if let Some(q) = v.and_then(rgb_squares) {
+                            for (a, b) in sq[i].iter_mut().zip(q) {
+                                a.add(b);
+                            }
+                        }
+                    }
                 }
             }
         }
@@ -633,6 +728,8 @@ fn render_tile<const N: usize>(
         xyz,
         spectral,
         good,
+        sq,
+        splat_sq,
         splats,
         counters,
         nonfinite,
@@ -706,5 +803,84 @@ mod tests {
         assert!((mean - 1.0).abs() < 0.02, "mean splatted Y {mean}");
         // Passes only regroup the same splats, and the sums are exact: the same bytes.
         assert!(a == run(2, 64), "splats depend on the pass size");
+    }
+
+    /// The variance estimate (`--variance`) against the spread it estimates. Two fake
+    /// integrators whose every pixel is an independent estimate of the same value, so
+    /// the variance of the pixel values across the image is what each pixel's estimate
+    /// should be on average: one returns radiance 2u for a uniform u (the pixel's own
+    /// samples: sums S₁, S₂), one splats radiance 1 into a uniformly chosen pixel (the
+    /// splats' sums T₁, T₂; each pixel's count of splats is binomial). 1 200 pixels: the
+    /// spread's own relative standard error is about √(2/1199) ≈ 4%, so 15% is more
+    /// than 3 of them; the estimate's mean over the pixels is far steadier.
+    #[test]
+    fn the_variance_estimate_matches_the_spread_of_independent_pixels() {
+        let scene = load_scene_from_str(
+            "[camera]\neye = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nresolution = [40, 30]\n",
+            Path::new("variance.toml"),
+        )
+        .unwrap();
+        let device = embree::Device::new("").unwrap();
+        let accel = build_accel(&scene, &device).unwrap();
+        let ctx = Context {
+            scene: &scene,
+            accel: &accel,
+            settings: &scene.settings,
+            offset: scene.settings.ray_offset(IntegratorKind::Whitted),
+        };
+        fn own(
+            _: &Context,
+            _: Ray,
+            _: Option<Option<crate::accel::embree::Hit>>,
+            _: &SampledWavelengths<4>,
+            s: &mut Sampler,
+            _: &mut TraceCounters,
+            _: &mut Splats,
+        ) -> crate::spectrum::SampledSpectrum<4> {
+            crate::spectrum::SampledSpectrum::splat(2.0 * s.get_1d())
+        }
+        fn splat(
+            _: &Context,
+            _: Ray,
+            _: Option<Option<crate::accel::embree::Hit>>,
+            wl: &SampledWavelengths<4>,
+            s: &mut Sampler,
+            _: &mut TraceCounters,
+            splats: &mut Splats,
+        ) -> crate::spectrum::SampledSpectrum<4> {
+            let p = (s.get_1d() * (40 * 30) as f32) as u32;
+            splats.add(p, &crate::spectrum::SampledSpectrum::splat(1.0), wl);
+            crate::spectrum::SampledSpectrum::zero()
+        }
+        let pool = embree::worker_pool(2).unwrap();
+        for (name, f) in [("own", own as SampleFnN<4>), ("splat", splat)] {
+            let integrate = move |_: Lanes| SampleFn::Four(f);
+            let mut o = RenderOptions::from_scene(&scene);
+            o.settings.spp = 64;
+            o.settings.lanes = 4;
+            o.settings.sampler = crate::settings::SamplerKind::Independent;
+            o.variance = true;
+            let film = render_passes(&ctx, &pool, &o, 16, &integrate)
+                .unwrap()
+                .0
+                .film();
+            let rgb = film.linear_srgb();
+            let var = film.variance.as_ref().unwrap();
+            let n = rgb.len() as f64;
+            for c in 0..3 {
+                let mean = rgb.iter().map(|v| v[c] as f64).sum::<f64>() / n;
+                let spread = rgb
+                    .iter()
+                    .map(|v| (v[c] as f64 - mean).powi(2))
+                    .sum::<f64>()
+                    / (n - 1.0);
+                let estimate = var.iter().map(|v| v[c] as f64).sum::<f64>() / n;
+                eprintln!("{name} channel {c}: estimate {estimate:.5e}, spread {spread:.5e}");
+                assert!(
+                    (estimate / spread - 1.0).abs() < 0.15,
+                    "{name} channel {c}: estimated variance {estimate:.4e}, spread {spread:.4e}"
+                );
+            }
+        }
     }
 }

@@ -4,7 +4,7 @@
 mod common;
 
 use common::chi2::{Chi2, Spherical};
-use common::render::{mean_se, render_with, run_lanes};
+use common::render::{compare_xyz, mean_se, render_with, run_lanes};
 use glam::Vec3;
 use heron::film::Film;
 use heron::render::{render, RenderOptions, Renderer};
@@ -24,42 +24,6 @@ fn load_file(name: &str) -> Scene {
 fn resize(scene: &mut Scene, w: u32, h: u32) {
     let c = &scene.camera;
     scene.camera = heron::camera::Camera::new(c.eye, c.look_at, c.up, c.d, w, h).unwrap();
-}
-
-/// The largest |z| over block×block regions and the three channels of the per-pixel
-/// difference a − b (pixels where `mask` is false are left out), and the number of
-/// regions. Both images estimate the same pixel integrals, so the difference has
-/// expectation zero in every pixel.
-fn worst_region_z(a: &Film, b: &Film, mask: Option<&[bool]>, block: usize) -> (f64, usize) {
-    let (w, h) = (a.width as usize, a.height as usize);
-    let mut worst = 0.0f64;
-    let mut n = 0;
-    for ch in 0..3 {
-        for by in (0..h).step_by(block) {
-            for bx in (0..w).step_by(block) {
-                let mut d = Vec::new();
-                for y in by..(by + block).min(h) {
-                    for x in bx..(bx + block).min(w) {
-                        let i = y * w + x;
-                        if mask.map_or(true, |m| m[i]) {
-                            d.push(a.xyz[i][ch] as f64 - b.xyz[i][ch] as f64);
-                        }
-                    }
-                }
-                if d.len() < block * block / 2 {
-                    continue;
-                }
-                let (m, se) = mean_se(&d);
-                if se == 0.0 {
-                    assert_eq!(m, 0.0);
-                    continue;
-                }
-                n += 1;
-                worst = worst.max((m / se).abs());
-            }
-        }
-    }
-    (worst, n)
 }
 
 /// Film points chosen uniformly (what the renderer does for camera rays) give
@@ -154,12 +118,14 @@ fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_the_cornell_box() {
     let p = run_lanes(&scene, IntegratorKind::Path, 512, 1, 4);
     for (kind, seed) in [(IntegratorKind::LightTrace, 2), (IntegratorKind::Bdpt, 3)] {
         let f = run_lanes(&scene, kind, 512, seed, 4);
-        let (z, n) = worst_region_z(&f, &p, None, 8);
-        // 192 regions and channels: |z| < 4.2 holds for all of them with probability
-        // ≈ 0.995 (normal approximation).
+        // heron compare's test: 192 regions and channels of 64 pixels and the whole
+        // image, at α = 0.02 (Šidák), which fails a region beyond |t| ≈ 4.14 (63 degrees
+        // of freedom): no looser than the |z| < 4.2 this test held before.
+        let c = compare_xyz(&f, &p, 8, 0.02, None);
         assert!(
-            n > 150 && z < 4.2,
-            "{kind:?}: worst |z| {z} over {n} regions"
+            c.regions.len() > 150 && c.same(),
+            "{kind:?} against path:\n{}",
+            c.report(&format!("{kind:?}"), "path", 10)
         );
     }
 }
@@ -173,8 +139,14 @@ fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_caustic_glass() {
     resize(&mut scene, 64, 48);
     let p = run_lanes(&scene, IntegratorKind::Path, 1024, 1, 4);
     let b = run_lanes(&scene, IntegratorKind::Bdpt, 256, 2, 4);
-    let (z, n) = worst_region_z(&b, &p, None, 8);
-    assert!(n > 100 && z < 4.2, "bdpt: worst |z| {z} over {n} regions");
+    // 144 regions and channels and the whole image at α = 0.02: |t| ≈ 4.06 fails, no
+    // looser than the |z| < 4.2 held before heron compare.
+    let c = compare_xyz(&b, &p, 8, 0.02, None);
+    assert!(
+        c.regions.len() > 100 && c.same(),
+        "bdpt against path:\n{}",
+        c.report("bdpt", "path", 10)
+    );
     let r = Renderer::new(&scene).unwrap();
     let cam = &scene.camera;
     let mut mask = Vec::new();
@@ -200,16 +172,21 @@ fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_caustic_glass() {
         }
     }
     let l = run_lanes(&scene, IntegratorKind::LightTrace, 1024, 3, 4);
-    let (z, n) = worst_region_z(&l, &p, Some(&mask), 8);
+    // Regions with at least half their pixels on the diffuse surfaces.
+    let c = compare_xyz(&l, &p, 8, 0.02, Some(mask));
     assert!(
-        n > 60 && z < 4.2,
-        "lighttrace: worst |z| {z} over {n} regions"
+        c.regions.len() > 60 && c.same(),
+        "lighttrace against path:\n{}",
+        c.report("lighttrace", "path", 10)
     );
 }
 
 /// 4 lanes against 1 on the dispersive caustic: the companions end at the flint ball's
 /// refractions, on the light subpath, the camera subpath, or both. Both estimate the
-/// same image.
+/// same image: heron compare's test in regions of 8 pixels and over the whole image, at
+/// α = 0.02 (72 region tests and 3 of the image: the image's mean difference fails
+/// beyond 3.65 standard errors, where this test allowed 4 before it also tested
+/// regions).
 #[test]
 fn bidirectional_dispersion_is_unbiased() {
     let mut scene = load_file("caustic-dispersion.toml");
@@ -217,16 +194,12 @@ fn bidirectional_dispersion_is_unbiased() {
     for kind in [IntegratorKind::Bdpt, IntegratorKind::LightTrace] {
         let a = run_lanes(&scene, kind, 512, 11, 4);
         let b = run_lanes(&scene, kind, 512, 12, 1);
-        for ch in 0..3 {
-            let d: Vec<f64> = a
-                .xyz
-                .iter()
-                .zip(&b.xyz)
-                .map(|(x, y)| x[ch] as f64 - y[ch] as f64)
-                .collect();
-            let (m, se) = mean_se(&d);
-            assert!(m.abs() < 4.0 * se, "{kind:?} channel {ch}: {m} ± {se}");
-        }
+        let c = compare_xyz(&a, &b, 8, 0.02, None);
+        assert!(
+            c.same(),
+            "{kind:?}, 4 lanes against 1:\n{}",
+            c.report("4 lanes", "1 lane", 10)
+        );
     }
 }
 
@@ -312,8 +285,16 @@ angular_radius = 1.0
     let b = load_scene_from_str(base, Path::new("portal.toml")).unwrap();
     let fa = run_lanes(&a, IntegratorKind::LightTrace, 256, 1, 4);
     let fb = run_lanes(&b, IntegratorKind::LightTrace, 4096, 2, 4);
-    let (z, n) = worst_region_z(&fa, &fb, None, 4);
-    assert!(n > 15 && z < 4.0, "worst |z| {z} over {n} regions");
+    // Regions of 4×4: up to 144 region tests and 3 of the image at α = 0.16 (Šidák),
+    // whose per-test level puts the critical |t| at 3.99 for 15 degrees of freedom: the
+    // |z| < 4 this test held before heron compare (Student's t has a heavy tail at 15
+    // degrees of freedom, so that cut is a family-wise level of 0.16).
+    let c = compare_xyz(&fa, &fb, 4, 0.16, None);
+    assert!(
+        c.regions.len() > 15 && c.same(),
+        "portal against none:\n{}",
+        c.report("portal", "no portal", 10)
+    );
     let (ma, mb) = (
         fa.xyz.iter().map(|c| c[1] as f64).sum::<f64>(),
         fb.xyz.iter().map(|c| c[1] as f64).sum::<f64>(),

@@ -118,11 +118,12 @@ fn a_killed_whitted_render_resumes_to_the_same_bytes() {
 
 #[test]
 fn a_killed_splatting_render_resumes_to_the_same_bytes() {
-    // Light tracing splats into other pixels; 256² pixels: passes of 16 spp.
+    // Light tracing splats into other pixels; 256² pixels: passes of 16 spp. With the
+    // variance estimate, whose sums of squares the checkpoint keeps too.
     killed_and_resumed_equals_uninterrupted(
         "cornell-box.toml",
         "64",
-        &["--integrator", "lighttrace", "--lanes", "4"],
+        &["--integrator", "lighttrace", "--lanes", "4", "--variance"],
     );
 }
 
@@ -211,6 +212,19 @@ fn bad_checkpoints_and_numbers_are_one_line_errors() {
     assert_eq!(o.status.code(), Some(1));
     assert!(
         err.contains("spp: \"32\" in the checkpoint, \"48\" in this render"),
+        "{err}"
+    );
+    // Nor can a checkpoint without the variance's squares continue a render with it.
+    let o = run(&render_args(
+        &sc,
+        out.to_str().unwrap(),
+        "32",
+        &["--resume", ck.to_str().unwrap(), "--variance"],
+    ));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the checkpoint was made without --variance, this render is with it"),
         "{err}"
     );
     // Truncated and foreign files name the file.

@@ -21,7 +21,7 @@
 mod common;
 
 use common::chi2::{assert_all, Chi2, Outcome, Spherical};
-use common::render::{mean_se, mean_se_y, y_of};
+use common::render::{compare_xyz, mean_se_y};
 use glam::{Vec2, Vec3};
 use heron::film::Film;
 use heron::medium::{HgMedium, LorenzMieMedium, Medium, MieSpec, PopulationNode};
@@ -422,12 +422,13 @@ irradiance = 1.0
             a_m * 1e3
         ),
     );
-    let ys = y_of(&run(&slab, 4096));
-    let yk = y_of(&run(&sky, 1024));
-    // Pixel by pixel, so that the profile's change across the image is not noise.
-    let diff: Vec<f64> = ys.iter().zip(&yk).map(|(a, b)| a - b).collect();
-    let (md, sed) = mean_se(&diff);
-    let mk = yk.iter().sum::<f64>() / yk.len() as f64;
+    // heron compare's mean difference of Y over the image, pixel by pixel (so that the
+    // profile's change across the image is not noise), with its standard error from the
+    // spread of the differences.
+    let c = compare_xyz(&run(&slab, 4096), &run(&sky, 1024), 8, 0.01, None);
+    let y = &c.whole[1];
+    assert_eq!(y.channel, 1);
+    let (md, sed, mk) = (y.difference, y.standard_error, y.mean_b);
     println!(
         "slab − sky = {md:.3e} ± {sed:.3e}, sky {mk:.5e}, ratio {}",
         1.0 + md / mk

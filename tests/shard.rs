@@ -2,8 +2,10 @@
 //! part.heronfilm` for every K and `heron merge` give the EXR and PNG of one `heron
 //! render` with all the samples, byte for byte, for any N, any order of the parts, any
 //! thread count per part, and every integrator (the splatting ones too); with the XYZ
-//! and spectral channels. Merging refuses a missing, repeated, foreign, incomplete or
-//! differently split part with a one-line message naming it.
+//! and spectral channels, and the variance channels (`--variance`: sums of squares, as
+//! exact as the sums). Merging refuses a missing, repeated, foreign, incomplete or
+//! differently split part, or parts with and without `--variance`, with a one-line
+//! message naming it.
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -86,16 +88,25 @@ fn whitted_shards_merge_to_the_bytes_of_one_render() {
     merged_equals_whole(d.path(), &sc, &set, 4, &[2, 0, 3, 1]);
     // More shards than samples: two of the eight hold none.
     merged_equals_whole(d.path(), &sc, &set, 8, &[7, 6, 5, 4, 3, 2, 1, 0]);
+    let var = ["--spp", "6", "--xyz", "--variance"];
+    merged_equals_whole(d.path(), &sc, &var, 3, &[1, 2, 0]);
 }
 
 /// Path tracing, light tracing and BDPT on the Cornell box (light tracing and BDPT
-/// splat into other pixels, which the shards sum separately).
+/// splat into other pixels, which the shards sum separately), without and with the
+/// variance estimate (whose splats' squares the shards also sum separately).
 #[test]
 fn physically_based_shards_merge_to_the_bytes_of_one_render() {
     let d = tempfile::tempdir().unwrap();
     let sc = scene("cornell-box.toml");
-    for integrator in ["path", "lighttrace", "bdpt"] {
-        let set = [
+    for (integrator, variance) in [
+        ("path", false),
+        ("lighttrace", false),
+        ("bdpt", false),
+        ("path", true),
+        ("bdpt", true),
+    ] {
+        let mut set = vec![
             "--spp",
             "5",
             "--integrator",
@@ -105,6 +116,9 @@ fn physically_based_shards_merge_to_the_bytes_of_one_render() {
             "--lanes",
             "4",
         ];
+        if variance {
+            set.push("--variance");
+        }
         merged_equals_whole(d.path(), &sc, &set, 3, &[2, 0, 1]);
     }
 }
@@ -192,6 +206,15 @@ fn merge_names_the_missing_repeated_or_foreign_part() {
     assert!(
         err.contains("foreign.heronfilm: is from another render (seed: \"99\" here, \"1\" in")
             || err.contains("foreign.heronfilm: is from another render (seed: \"99\" here"),
+        "{err}"
+    );
+    // The same shard with --variance: its film keeps squares the others lack.
+    let var = p("var.heronfilm");
+    render(&var, "1/3", &["--variance"]);
+    let err = merge(&[&parts[0], &var, &parts[2]]);
+    assert!(
+        err.contains("var.heronfilm: was rendered with --variance")
+            && err.contains("p0.heronfilm without it"),
         "{err}"
     );
     // Another split of the same render.

@@ -7,7 +7,9 @@
 //!   the CLI's EXR bit for bit; the GIL is released while rendering, and Ctrl-C stops the
 //!   render within a row of a tile (`RenderOptions::cancel`);
 //! - `trace`, `sky_profile`, `color`, `ior`: the cores of `heron trace`, `heron sky
-//!   profile`, `heron color` (in memory) and the scene files' `ior` values.
+//!   profile`, `heron color` (in memory) and the scene files' `ior` values;
+//! - `compare`: `heron compare`'s test of two images (EXR paths, render results or
+//!   arrays), with the same verdict and statistics.
 //!
 //! Errors: every bad input raises `heron.HeronError`, a subclass of `ValueError`, with
 //! the CLI's one-line message; where the CLI names a flag (`--lanes`), the message names
@@ -17,6 +19,7 @@
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+mod compare;
 mod convert;
 mod scene;
 mod tools;
@@ -93,7 +96,8 @@ pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// (`Scene.from_dict`); `Scene.render` returns numpy arrays (linear sRGB, CIE XYZ,
 /// spectral bins) equal bit for bit to the EXR `heron render` writes for the same
 /// settings. `trace`, `sky_profile`, `color` and `ior` are the CLI's `heron trace`,
-/// `heron sky profile`, `heron color` and the scene files' refractive indices.
+/// `heron sky profile`, `heron color` and the scene files' refractive indices;
+/// `compare` is `heron compare`.
 /// Bad input raises `HeronError` (a `ValueError`) with the CLI's one-line message.
 #[pymodule]
 fn heron(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -106,5 +110,6 @@ fn heron(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::sky_profile, m)?)?;
     m.add_function(wrap_pyfunction!(tools::color, m)?)?;
     m.add_function(wrap_pyfunction!(tools::ior, m)?)?;
+    m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     Ok(())
 }

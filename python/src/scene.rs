@@ -156,14 +156,16 @@ impl Scene {
     /// one per core (the image does not depend on it); spectral_bins 0 for none, else
     /// 1–470 equal bins over 360–830 nm; sampler "sobol" or "independent" (default
     /// sobol); max_depth overrides `[render] max_depth`; offset "auto", "epsilon" or
-    /// "robust" overrides `[render] offset`. The numbers equal bit for bit the EXR
-    /// channels `heron render` writes with the same settings (R, G, B; X, Y, Z with
-    /// `--xyz`; S0.* with `--spectral-bins`).
+    /// "robust" overrides `[render] offset`; variance=True also estimates each pixel's
+    /// variance (`heron render --variance`, at least 2 spp), as
+    /// `RenderResult.variance`. The numbers equal bit for bit the EXR channels `heron
+    /// render` writes with the same settings (R, G, B; X, Y, Z with `--xyz`; S0.* with
+    /// `--spectral-bins`; variance.R, .G, .B with `--variance`).
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
@@ -178,6 +180,7 @@ impl Scene {
         sampler: Option<&str>,
         max_depth: Option<i64>,
         offset: Option<&str>,
+        variance: bool,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -204,6 +207,13 @@ impl Scene {
                 })
                 .map_err(|e| lib_err(e, RENAMES))?;
             opts.threads = threads as usize;
+            if variance && opts.settings.spp < 2 {
+                return Err(err(format!(
+                    "variance: needs at least 2 samples per pixel to estimate a variance, got {}",
+                    opts.settings.spp
+                )));
+            }
+            opts.variance = variance;
             let scene = self.inner.clone();
             let (film, stats, opts) = render_interruptible(py, scene, opts)?;
             RenderResult::new(py, &film, &stats, &opts)
@@ -277,6 +287,7 @@ pub struct RenderResult {
     xyz: Py<PyArray3<f32>>,
     spectral: Option<Py<PyArray3<f32>>>,
     wavelengths: Option<Py<PyArray1<f32>>>,
+    variance: Option<Py<PyArray3<f32>>>,
     /// Samples per pixel in the image.
     #[pyo3(get)]
     spp: u32,
@@ -323,6 +334,16 @@ pub struct RenderResult {
 }
 
 impl RenderResult {
+    /// The linear sRGB array (for `heron.compare`).
+    pub(crate) fn rgb_array(&self, py: Python<'_>) -> Py<PyArray3<f32>> {
+        self.rgb.clone_ref(py)
+    }
+
+    /// The variance array, if rendered with it (for `heron.compare`).
+    pub(crate) fn variance_array(&self, py: Python<'_>) -> Option<Py<PyArray3<f32>>> {
+        self.variance.as_ref().map(|a| a.clone_ref(py))
+    }
+
     fn new(
         py: Python<'_>,
         film: &Film,
@@ -349,11 +370,16 @@ impl RenderResult {
             ),
             None => (None, None),
         };
+        let variance = match &film.variance {
+            Some(v) => Some(image(flat(v.clone()), 3)?),
+            None => None,
+        };
         Ok(RenderResult {
             rgb,
             xyz,
             spectral,
             wavelengths,
+            variance,
             spp: stats.spp,
             rays: stats.total_rays(),
             camera_rays: stats.counters.rays,
@@ -393,6 +419,14 @@ impl RenderResult {
     #[getter]
     fn spectral(&self, py: Python<'_>) -> Option<Py<PyArray3<f32>>> {
         self.spectral.as_ref().map(|a| a.clone_ref(py))
+    }
+
+    /// The variance of each pixel's R, G, B (of the mean over its samples), H×W×3
+    /// float32 (the EXR's variance.R, .G, .B), or None when rendered without
+    /// variance=True.
+    #[getter]
+    fn variance(&self, py: Python<'_>) -> Option<Py<PyArray3<f32>>> {
+        self.variance.as_ref().map(|a| a.clone_ref(py))
     }
 
     /// The spectral bins' centres in nm (float32), or None without spectral bins.

@@ -4,7 +4,10 @@
 //! Fichet, Pacanowski & Wilkie 2021 ("An OpenEXR Layout for Spectral Images", JCGT
 //! 10(3)): one emissive channel `S0.<λ>nm` per bin (λ the bin centre, written with a
 //! decimal comma as the paper specifies), the `spectralLayoutVersion` attribute "1.0"
-//! and `emissiveUnits` "W.m^-2.sr^-1".
+//! and `emissiveUnits` "W.m^-2.sr^-1". With a variance estimate (`heron render
+//! --variance`), the channels `variance.R`, `variance.G`, `variance.B`: the variance of
+//! each pixel's R, G, B value (of the mean over its samples, not of one sample; the
+//! layer `variance` in OpenEXR's `layer.channel` naming), which `heron compare` reads.
 use super::Film;
 use crate::files::Staged;
 use crate::provenance::{Provenance, PREFIX};
@@ -12,7 +15,11 @@ use crate::spectrum::color::SRGB_CHROMATICITIES;
 use exr::prelude::*;
 use std::path::Path;
 
-/// Which channels go into the EXR besides R, G, B.
+/// The names of the variance channels, for R, G and B.
+pub const VARIANCE_CHANNELS: [&str; 3] = ["variance.R", "variance.G", "variance.B"];
+
+/// Which channels go into the EXR besides R, G, B (and the variance channels, written
+/// whenever the film has a variance estimate).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ExrChannels {
     /// Add X, Y, Z (CIE 1931, the film's convention).
@@ -44,6 +51,11 @@ pub fn stage_exr(
     if which.xyz {
         for (c, name) in ["X", "Y", "Z"].iter().enumerate() {
             list.push(AnyChannel::new(*name, plane(&|i| film.xyz[i][c])));
+        }
+    }
+    if let Some(var) = &film.variance {
+        for (c, name) in VARIANCE_CHANNELS.iter().enumerate() {
+            list.push(AnyChannel::new(*name, plane(&|i| var[i][c])));
         }
     }
     let mut layer_attrs = LayerAttributes::named("heron");

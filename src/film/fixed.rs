@@ -62,6 +62,69 @@ pub fn to_f64(s: i128) -> f64 {
     s as f64 * (-FRAC_BITS as f64).exp2()
 }
 
+/// A sum of squares, exact in any grouping: each square (a non-negative f64) is
+/// truncated once to a multiple of 2⁻⁶⁴ and added to a 192-bit integer (three 64-bit
+/// limbs, least significant first, wrapping like the i128 sums above).
+///
+/// Why not an i128 like the sums: a square of a contribution near the 2⁴⁰ limit is near
+/// 2⁸⁰, and the squares of dim pixels (values near 10⁻⁶, squares near 10⁻¹²) need a
+/// fine resolution to keep their digits; 128 bits cannot hold both (2⁸⁰ · 2⁶⁴ = 2¹⁴⁴).
+/// 192 bits hold a sum of 2⁴⁸ squares of the largest contributions at a resolution of
+/// 2⁻⁶⁴ ≈ 5.4·10⁻²⁰. Three limbs rather than a u128 and a u64 keep the array 8-byte
+/// aligned, 24 bytes per value.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SquareSum(pub [u64; 3]);
+
+impl SquareSum {
+    /// `s` ≥ 0 in fixed point (2⁻⁶⁴ resolution, truncated); None when `s` is not finite,
+    /// negative or ≥ 2¹²⁸.
+    #[inline]
+    pub fn of(s: f64) -> Option<SquareSum> {
+        if !(s >= 0.0 && s < 2f64.powi(128)) {
+            return None;
+        }
+        // Both parts are exact: s's integer part is representable, s − int is exact
+        // (Sterbenz), and scaling by 2⁶⁴ is a power of two.
+        let int = s as u128;
+        let frac = ((s - int as f64) * 2f64.powi(64)) as u64;
+        Some(SquareSum([frac, int as u64, (int >> 64) as u64]))
+    }
+
+    /// Adds `o` (wrapping at 2¹⁹² like an integer: associative and commutative).
+    #[inline]
+    pub fn add(&mut self, o: SquareSum) {
+        let (l0, c0) = self.0[0].overflowing_add(o.0[0]);
+        let (l1, c1a) = self.0[1].overflowing_add(o.0[1]);
+        let (l1, c1b) = l1.overflowing_add(c0 as u64);
+        let l2 = self.0[2]
+            .wrapping_add(o.0[2])
+            .wrapping_add((c1a || c1b) as u64);
+        self.0 = [l0, l1, l2];
+    }
+
+    /// The sum as f64.
+    #[inline]
+    pub fn to_f64(self) -> f64 {
+        let [l0, l1, l2] = self.0;
+        l2 as f64 * 2f64.powi(64) + l1 as f64 + l0 as f64 * 2f64.powi(-64)
+    }
+
+    /// The limbs as 24 little-endian bytes (checkpoint files).
+    pub fn to_le_bytes(self) -> [u8; 24] {
+        let mut b = [0u8; 24];
+        for (k, l) in self.0.iter().enumerate() {
+            b[8 * k..8 * k + 8].copy_from_slice(&l.to_le_bytes());
+        }
+        b
+    }
+
+    pub fn from_le_bytes(b: [u8; 24]) -> SquareSum {
+        SquareSum(std::array::from_fn(|k| {
+            u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap())
+        }))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -140,5 +203,52 @@ mod tests {
         // And the fixed sum is as accurate as an f64 sum here.
         let exact: f64 = values.iter().map(|&x| x as f64).sum();
         assert!((to_f64(whole) - exact).abs() <= 1e-9 * exact.abs().max(1.0));
+    }
+
+    #[test]
+    fn square_sums_are_exact_in_any_grouping_and_wide_enough() {
+        // Carries across both limb boundaries.
+        let mut a = SquareSum([u64::MAX, u64::MAX, 0]);
+        a.add(SquareSum([1, 0, 0]));
+        assert_eq!(a, SquareSum([0, 0, 1]));
+        assert_eq!(SquareSum::of(1.5), Some(SquareSum([1 << 63, 1, 0])));
+        assert_eq!(
+            SquareSum::of(2f64.powi(80)).unwrap().to_f64(),
+            2f64.powi(80)
+        );
+        for bad in [-1e-30, f64::NAN, f64::INFINITY, 2f64.powi(128)] {
+            assert_eq!(SquareSum::of(bad), None, "{bad}");
+        }
+        let mut rng = Rng::new(3, 5);
+        let values: Vec<f64> = (0..5000)
+            .map(|_| {
+                let v = (rng.uniform() as f64 * 100.0 - 50.0).exp2() * rng.uniform() as f64;
+                v * v
+            })
+            .collect();
+        let sum = |v: &[f64]| {
+            v.iter().fold(SquareSum::default(), |mut a, &x| {
+                a.add(SquareSum::of(x).unwrap());
+                a
+            })
+        };
+        let whole = sum(&values);
+        for parts in [2, 3, 64] {
+            let chunk = values.len().div_ceil(parts);
+            let s = values
+                .chunks(chunk)
+                .map(sum)
+                .fold(SquareSum::default(), |mut a, b| {
+                    a.add(b);
+                    a
+                });
+            assert_eq!(s, whole, "{parts} parts");
+        }
+        let exact: f64 = values.iter().sum();
+        assert!((whole.to_f64() - exact).abs() <= 1e-12 * exact);
+        // Squares of dim values keep their digits: (10⁻⁶)² = 10⁻¹² to 10⁻⁶ relative.
+        let tiny = SquareSum::of(1e-12).unwrap().to_f64();
+        assert!((tiny / 1e-12 - 1.0).abs() < 1e-6, "{tiny}");
+        assert_eq!(SquareSum::from_le_bytes(whole.to_le_bytes()), whole);
     }
 }

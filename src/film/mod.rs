@@ -9,8 +9,9 @@ pub mod fixed;
 pub mod png;
 
 use crate::spectrum::cie::cie1931;
-use crate::spectrum::color::xyz_to_linear_srgb;
+use crate::spectrum::color::{xyz_to_linear_srgb, XYZ_TO_SRGB};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
+use fixed::SquareSum;
 
 /// Weights that turn one sample's lanes into XYZ: x̄(λ)/(N p(λ) Σȳ) for each lane.
 #[inline]
@@ -149,14 +150,71 @@ impl Splats {
     }
 }
 
-/// A finished image: mean XYZ per pixel, row-major from the top-left, and optionally
-/// the mean spectral radiance in each of `bins` per pixel (pixel-major).
+/// Linear sRGB of an XYZ triple in f64, with the film's matrix (IEC 61966-2-1).
+#[inline]
+pub fn linear_srgb_f64(xyz: [f64; 3]) -> [f64; 3] {
+    let m = &XYZ_TO_SRGB;
+    std::array::from_fn(|r| {
+        m[r][0] as f64 * xyz[0] + m[r][1] as f64 * xyz[1] + m[r][2] as f64 * xyz[2]
+    })
+}
+
+/// The squares of one contribution's linear sRGB components, in fixed point, for the
+/// variance estimate (`heron render --variance`); None if any is out of range.
+#[inline]
+pub fn rgb_squares(xyz: [f32; 3]) -> Option<[SquareSum; 3]> {
+    let rgb = linear_srgb_f64(xyz.map(f64::from));
+    Some([
+        SquareSum::of(rgb[0] * rgb[0])?,
+        SquareSum::of(rgb[1] * rgb[1])?,
+        SquareSum::of(rgb[2] * rgb[2])?,
+    ])
+}
+
+/// Adds the squares of one pixel sample's splats to `out`, per pixel: the splats a
+/// sample made (`new`, in the order made) are first summed per pixel, since a sample
+/// may splat into one pixel more than once and its contribution to that pixel is their
+/// sum. `scratch` is reused between samples. Splats out of the film's range are left
+/// out, as the film leaves them out of its sums.
+pub fn add_splat_squares(
+    new: &[(u32, [f32; 3])],
+    scratch: &mut Vec<(u32, [f32; 3])>,
+    out: &mut Vec<(u32, [SquareSum; 3])>,
+) {
+    scratch.clear();
+    for &(p, c) in new {
+        if fixed::to_fixed3(c).is_none() {
+            continue;
+        }
+        match scratch.iter_mut().find(|(q, _)| *q == p) {
+            Some((_, s)) => {
+                for j in 0..3 {
+                    s[j] += c[j];
+                }
+            }
+            None => scratch.push((p, c)),
+        }
+    }
+    for &(p, c) in scratch.iter() {
+        if let Some(sq) = rgb_squares(c) {
+            out.push((p, sq));
+        }
+    }
+}
+
+/// A finished image: mean XYZ per pixel, row-major from the top-left, optionally the
+/// mean spectral radiance in each of `bins` per pixel (pixel-major), and optionally the
+/// variance of each pixel's linear sRGB mean (`heron render --variance`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
     pub xyz: Vec<[f32; 3]>,
     pub spectral: Option<(SpectralBins, Vec<f32>)>,
+    /// Per pixel, the estimated variance of the pixel's value in linear sRGB (R, G, B):
+    /// of the mean, not of one sample (`Checkpoint::film` says how it is estimated).
+    /// Infinite where a pixel has fewer than two finite samples.
+    pub variance: Option<Vec<[f32; 3]>>,
 }
 
 impl Film {

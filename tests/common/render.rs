@@ -1,10 +1,12 @@
 //! Renders and image statistics for the tests that check rendered images against
 //! analytic answers or against each other (`tests/bidir.rs`, `tests/media.rs`,
-//! `tests/transport.rs`, `tests/render.rs`, `tests/sampler.rs`).
+//! `tests/transport.rs`, `tests/render.rs`, `tests/sampler.rs`). Two renders are held
+//! to each other by `heron compare`'s test ([`compare_xyz`]).
 //!
 //! Every render here asserts that no sample was non-finite: a NaN or infinite sample is
 //! left out of the image (and counted), so an image could look right while the
 //! integrator is broken.
+use heron::compare::{compare, Comparison, Correction, Image, Options};
 use heron::film::Film;
 use heron::render::{render, RenderOptions};
 use heron::scene::Scene;
@@ -61,4 +63,28 @@ pub fn y_of(film: &Film) -> Vec<f64> {
 /// estimates when every pixel sees the same radiance.
 pub fn mean_se_y(film: &Film) -> (f64, f64) {
     mean_se(&y_of(film))
+}
+
+/// `heron compare` of two films' CIE XYZ (standard errors from the spread within
+/// `region`-pixel regions: the films of these tests keep no variance) at family-wise
+/// level `alpha` with Šidák's correction, over the pixels of `mask`; panics if they
+/// cannot be compared. `Comparison::same` is the verdict; the report says why.
+pub fn compare_xyz(
+    a: &Film,
+    b: &Film,
+    region: u32,
+    alpha: f64,
+    mask: Option<Vec<bool>>,
+) -> Comparison {
+    compare(
+        &Image::from_film_xyz(a),
+        &Image::from_film_xyz(b),
+        &Options {
+            region,
+            alpha,
+            correction: Correction::Sidak,
+            mask,
+        },
+    )
+    .unwrap()
 }
