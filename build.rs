@@ -23,6 +23,14 @@
 //! needs no header, so there is no `rtcore_config.h` to check here: the Embree test
 //! asserts the library's version and runs the same queries against Embree 3.
 //! `scripts/test.sh` builds and tests heron this way as well.
+//!
+//! **The commit a binary was built from.** `HERON_GIT_COMMIT` (the 40-hex `git rev-parse
+//! HEAD`, or `unknown` outside a git checkout, e.g. in a source tarball without `.git`) and
+//! `HERON_GIT_STATE` (`clean`, `dirty` when the sources the binary is built from differ
+//! from that commit, or `unknown`) are set for rustc; `heron --version`,
+//! `heron.__version__` and the EXR provenance report them (src/provenance.rs). Only the
+//! local `git` is asked, never the network. `HERON_BUILD_COMMIT=NAME` states the commit
+//! instead (state `unknown`). See [`git_version`].
 use std::env;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -45,6 +53,7 @@ fn main() {
     println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
     println!("cargo::rerun-if-env-changed=HERON_EMBREE4_LIB");
     strip_features();
+    git_version();
 
     if let Some(dir) = env::var_os("HERON_EMBREE4_LIB").map(PathBuf::from) {
         link_embree4_library(&dir);
@@ -259,4 +268,94 @@ fn strip_features() {
         }
         println!("cargo::rustc-cfg=heron_strip_{n}");
     }
+}
+
+/// The files the binary is built from: a change to any of them makes the build "dirty".
+/// (README, tests, scripts and python/ do not change the binary; watching them would
+/// rebuild heron after every edit of the documentation.)
+const SOURCES: [&str; 5] = ["src", "spectra", "build.rs", "Cargo.toml", "Cargo.lock"];
+
+/// Sets `HERON_GIT_COMMIT` and `HERON_GIT_STATE` (see the module comment) from the
+/// repository this crate is the top of. A crate unpacked inside some other repository
+/// (`git rev-parse --show-toplevel` elsewhere) reports `unknown`, not that repository's
+/// commit. `git status` runs with `--no-optional-locks` so that it never rewrites the index,
+/// which cargo watches: a rewritten index would rerun this script on every build.
+fn git_version() {
+    println!("cargo::rerun-if-env-changed=HERON_BUILD_COMMIT");
+    if let Ok(stated) = env::var("HERON_BUILD_COMMIT") {
+        // A commit named by whoever builds: a source archive whose commit is known, or
+        // scripts/same_images.sh, which compares two commits' EXR bytes and so builds both
+        // with one value. Its state is unknown: nothing here checks the sources.
+        if stated.is_empty() || !stated.bytes().all(|b| b.is_ascii_graphic()) {
+            fail(&format!(
+                "heron: HERON_BUILD_COMMIT={stated:?}: expected a commit name (printable \
+                 ASCII, no spaces)"
+            ));
+        }
+        println!("cargo::rustc-env=HERON_GIT_COMMIT={stated}");
+        println!("cargo::rustc-env=HERON_GIT_STATE=unknown");
+        return;
+    }
+    let root = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
+    for s in SOURCES {
+        println!("cargo::rerun-if-changed={}", root.join(s).display());
+    }
+    let git = |args: &[&str]| -> Option<String> {
+        let out = Command::new("git")
+            .arg("--no-optional-locks")
+            .args(args)
+            .current_dir(&root)
+            .env_remove("GIT_DIR")
+            .env_remove("GIT_WORK_TREE")
+            .output()
+            .ok()?;
+        out.status
+            .success()
+            .then(|| String::from_utf8_lossy(&out.stdout).trim_end().to_string())
+    };
+    let same_dir = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    let ours =
+        git(&["rev-parse", "--show-toplevel"]).is_some_and(|top| same_dir(Path::new(&top), &root));
+    let commit = ours
+        .then(|| git(&["rev-parse", "--verify", "HEAD"]))
+        .flatten()
+        .filter(|c| c.len() == 40 && c.bytes().all(|b| b.is_ascii_hexdigit()));
+    let Some(commit) = commit else {
+        println!("cargo::rustc-env=HERON_GIT_COMMIT=unknown");
+        println!("cargo::rustc-env=HERON_GIT_STATE=unknown");
+        return;
+    };
+    // Rerun when HEAD moves (a commit, a checkout) or the index changes (git add): the
+    // HEAD file, the branch's ref (loose or packed) and the index, in the worktree's own
+    // git directory and the common one. Only existing files: a missing path would rerun
+    // this script on every build.
+    let mut watch = Vec::new();
+    if let Some(dir) = git(&["rev-parse", "--absolute-git-dir"]) {
+        let dir = PathBuf::from(dir);
+        watch.push(dir.join("HEAD"));
+        watch.push(dir.join("index"));
+    }
+    if let (Some(common), Some(head_ref)) = (
+        git(&["rev-parse", "--path-format=absolute", "--git-common-dir"]),
+        git(&["symbolic-ref", "-q", "HEAD"]),
+    ) {
+        let common = PathBuf::from(common);
+        watch.push(common.join(head_ref));
+        watch.push(common.join("packed-refs"));
+    }
+    for f in watch.iter().filter(|f| f.is_file()) {
+        println!("cargo::rerun-if-changed={}", f.display());
+    }
+    let mut status = vec!["status", "--porcelain", "--untracked-files=no", "--"];
+    status.extend(SOURCES);
+    let state = match git(&status) {
+        Some(s) if s.is_empty() => "clean",
+        Some(_) => "dirty",
+        None => "unknown",
+    };
+    println!("cargo::rustc-env=HERON_GIT_COMMIT={commit}");
+    println!("cargo::rustc-env=HERON_GIT_STATE={state}");
 }

@@ -18,6 +18,12 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+"""The crate version with the git commit heron was built from as a PEP 440 local label:
+``0.1.0+g<40 hex>``, ``.dirty`` appended when its sources differed from that commit, plain
+``0.1.0`` when built outside a git checkout."""
+__commit__: str
+"""The commit as the EXR provenance's ``heron.commit`` records it: 40 hex digits,
+``-dirty`` appended when the sources differed, or ``unknown``."""
 
 _Numbers = Union[float, Sequence[float], npt.NDArray[np.floating[Any]]]
 _Path = Union[str, os.PathLike[str]]

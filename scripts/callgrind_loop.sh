@@ -12,6 +12,8 @@
 # overstates it; 64 spp at 128² costs the same instructions as 4 spp at 512²).
 # Prints one line per (binary, scene): the instruction count ("Ir"), the instructions per
 # sample and the sha256 of the EXR (equal bytes for an optimisation that keeps the image).
+# The EXR records the commit heron was built from (heron.commit): to compare the sha256 of
+# two commits' binaries, build both with the same HERON_BUILD_COMMIT (see build.rs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bins=("$@")

@@ -10,6 +10,11 @@
 # kept between runs), and its binary and renders are kept by commit, so a second run against the
 # same BASE only renders the working tree's side. Prints one line per (scene, integrator)
 # and exits 1 if any differs. Meant for refactors: "a refactor changes no image".
+#
+# Every EXR records the commit heron was built from (heron.commit), so both sides are
+# built with HERON_BUILD_COMMIT=same-images (build.rs), the working tree's in
+# target/same-images/target too, not in target/release. (A BASE older than that attribute
+# differs in its header.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 base=$(git rev-parse "${1:-HEAD~1}")
@@ -18,7 +23,8 @@ root=$PWD/target/same-images
 mkdir -p "$root"
 
 build() { # $1: source dir, $2: target dir
-  (cd "$1" && CARGO_TARGET_DIR="$2" cargo build --release --locked --quiet --bin heron)
+  (cd "$1" && HERON_BUILD_COMMIT=same-images CARGO_TARGET_DIR="$2" \
+    cargo build --release --locked --quiet --bin heron)
 }
 
 render_all() { # $1: heron binary, $2: output dir
@@ -57,10 +63,11 @@ if [ ! -e "$base_dir/complete" ]; then
   touch "$base_dir/complete"
 fi
 
-cargo build --release --locked --quiet --bin heron
+build "$PWD" "$root/target"
+cp "$root/target/release/heron" "$root/heron-worktree"
 new_dir="$root/renders-worktree"
 rm -rf "$new_dir"
-render_all "$PWD/target/release/heron" "$new_dir"
+render_all "$root/heron-worktree" "$new_dir"
 
 differ=0
 for f in "$base_dir"/*.msg; do

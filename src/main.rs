@@ -13,7 +13,7 @@ use std::sync::Arc;
 #[derive(Parser)]
 #[command(
     name = "heron",
-    version,
+    version = heron::provenance::LONG_VERSION,
     about = "A physically faithful spectral ray tracer for optics research"
 )]
 struct Cli {

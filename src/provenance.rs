@@ -1,7 +1,8 @@
 //! Provenance: what made an image, written into every EXR heron renders as header
 //! attributes, and printed back by `heron info`.
 //!
-//! The attributes are strings named `heron.<key>`: the version of heron, the scene file's
+//! The attributes are strings named `heron.<key>`: the version of heron and the git commit
+//! it was built from ([`COMMIT`]), the scene file's
 //! name and the SHA-256 of its text, the SHA-256 of every other file it read (meshes,
 //! index and n, k tables), and the render settings that change the pixels: integrator,
 //! sampler, samples per pixel reached, seed, lanes, wavelength sampler, maximum depth,
@@ -10,6 +11,52 @@
 //! renders stay byte-identical.
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, WavelengthSampler};
+
+/// heron's version, from Cargo.toml.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The git commit this binary was built from (40 hex digits), or `unknown` when it was
+/// built outside a git checkout (a source tarball without `.git`); set by build.rs.
+pub const GIT_COMMIT: &str = env!("HERON_GIT_COMMIT");
+
+/// `clean` when the sources the binary is built from (src, spectra, build.rs,
+/// Cargo.toml, Cargo.lock) were those of [`GIT_COMMIT`], `dirty` when they differed,
+/// `unknown` without git; set by build.rs.
+pub const GIT_STATE: &str = env!("HERON_GIT_STATE");
+
+/// The provenance's `commit`: [`GIT_COMMIT`], with `-dirty` appended when the sources
+/// differed from it (as `git describe --dirty` marks a tree).
+pub const COMMIT: &str = if const_eq(GIT_STATE, "dirty") {
+    concat!(env!("HERON_GIT_COMMIT"), "-dirty")
+} else {
+    env!("HERON_GIT_COMMIT")
+};
+
+/// What `heron --version` prints after the program name, e.g. `0.1.0 (commit 3f2a…, clean)`.
+pub const LONG_VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("HERON_GIT_COMMIT"),
+    ", ",
+    env!("HERON_GIT_STATE"),
+    ")"
+);
+
+/// String equality in a const context (`==` on `str` is not const).
+const fn const_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
 
 /// The attribute-name prefix.
 pub const PREFIX: &str = "heron.";
@@ -20,8 +67,9 @@ pub const PREFIX: &str = "heron.";
 pub struct Provenance(pub Vec<(&'static str, String)>);
 
 /// The provenance keys, in the order [`Provenance::of_render`] writes them.
-pub const KEYS: [&str; 14] = [
+pub const KEYS: [&str; 15] = [
     "version",
+    "commit",
     "scene",
     "sceneSha256",
     "inputs",
@@ -79,7 +127,8 @@ impl Provenance {
             WavelengthSampler::Visible => "visible",
         };
         Provenance(vec![
-            ("version", env!("CARGO_PKG_VERSION").to_string()),
+            ("version", VERSION.to_string()),
+            ("commit", COMMIT.to_string()),
             ("scene", name),
             ("sceneSha256", scene.source_sha256.clone()),
             ("inputs", inputs),

@@ -80,6 +80,7 @@ fn render_records_what_made_the_image_and_info_prints_it() {
     let scene_hash = sha256sum(&scenes().join("cornell.toml"));
     let mesh_hash = sha256sum(&scenes().join("meshes/cornell.obj"));
     let expected = [
+        format!("commit: {}", heron::provenance::COMMIT),
         "inputs: ".to_string() + &mesh_hash + "  meshes/cornell.obj",
         "integrator: path".into(),
         "lanes: 4".into(),

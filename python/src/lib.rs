@@ -99,10 +99,23 @@ pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// `heron sky profile`, `heron color` and the scene files' refractive indices;
 /// `compare` is `heron compare`.
 /// Bad input raises `HeronError` (a `ValueError`) with the CLI's one-line message.
+/// `heron.__version__`: the crate version with the git commit as a PEP 440 local version
+/// label (PEP 440, "Local version identifiers"): `0.1.0+g<40 hex>`, `.dirty` appended when
+/// the sources differed from the commit, plain `0.1.0` when built outside git.
+fn python_version() -> String {
+    use heron_core::provenance::{GIT_COMMIT, GIT_STATE, VERSION};
+    match (GIT_COMMIT, GIT_STATE) {
+        ("unknown", _) => VERSION.to_string(),
+        (c, "dirty") => format!("{VERSION}+g{c}.dirty"),
+        (c, _) => format!("{VERSION}+g{c}"),
+    }
+}
+
 #[pymodule]
 fn heron(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("HeronError", m.py().get_type::<HeronError>())?;
-    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("__version__", python_version())?;
+    m.add("__commit__", heron_core::provenance::COMMIT)?;
     m.add_class::<scene::Scene>()?;
     m.add_class::<scene::RenderResult>()?;
     m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;

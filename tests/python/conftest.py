@@ -8,6 +8,7 @@ import pathlib
 
 import pytest
 
+import herondist
 from heronrun import REPO, SCENES, Renderer, heron_bin_path
 
 
@@ -33,3 +34,16 @@ def render(tmp_path_factory) -> Renderer:
     """render(scene_file_name, spp=, seed=, threads=, extra=(flags...)) -> Render (cached
     per session)."""
     return Renderer(tmp_path_factory)
+
+
+@pytest.fixture(scope="session")
+def dist_tarball(tmp_path_factory) -> pathlib.Path:
+    """scripts/build-dist.sh's relocatable CLI tarball, built once per session."""
+    return herondist.build_tarball(tmp_path_factory.mktemp("dist"))
+
+
+@pytest.fixture(scope="session")
+def dist_unpacked(dist_tarball, tmp_path_factory) -> pathlib.Path:
+    """The tarball unpacked, then moved elsewhere under another name (its top folder)."""
+    return herondist.unpack(dist_tarball, tmp_path_factory.mktemp("unpacked"),
+                            tmp_path_factory.mktemp("moved") / "somewhere-else")

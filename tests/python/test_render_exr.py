@@ -18,6 +18,7 @@ it, and a renderer that ignores --spp is far above it.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -208,6 +209,7 @@ def test_exr_carries_provenance_readable_by_openexr(render, tmp_path):
     scene_sha = hashlib.sha256(r.scene.read_bytes()).hexdigest()
     assert got == {
         "heron.version": got.get("heron.version"),
+        "heron.commit": got.get("heron.commit"),
         "heron.scene": "background_e.toml",
         "heron.sceneSha256": scene_sha,
         "heron.inputs": "",
@@ -223,6 +225,7 @@ def test_exr_carries_provenance_readable_by_openexr(render, tmp_path):
         "heron.spectralBins": "0",
     }, got
     assert got["heron.version"] and got["heron.maxDepth"].isdigit()
+    assert re.fullmatch(r"[0-9a-f]{40}(-dirty)?|unknown", got["heron.commit"]), got["heron.commit"]
     # An EXR without them: `heron info` says so in one line and fails.
     plain = tmp_path / "plain.exr"
     with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},

@@ -5,7 +5,9 @@ The Slurm tests start a single-node Slurm cluster on this machine from Debian's 
 (tests/slurm/cluster.sh: munged, slurmctld and slurmd in a temporary directory, found
 through SLURM_CONF), submit deploy/slurm/submit.sh's job array and dependent merge with
 sbatch, wait for them, and compare the merged EXR's bytes with one `heron render` of the
-same scene and settings. The cluster is stopped and its directory removed when the module
+same scene and settings. The sharded render runs as a user without root would (issue 26):
+from the relocatable tarball of scripts/build-dist.sh, unpacked (conftest.py's
+dist_unpacked), with the tarball's submit.sh, binary and scene. The cluster is stopped and its directory removed when the module
 ends, whether the tests passed or not.
 
 They need root (slurmd starts jobs as the submitting user) and the packages slurm-wlm and
@@ -147,9 +149,10 @@ def slurm():
         assert not directory.exists(), f"cluster.sh stop left {directory}"
 
 
-def _submit(cluster: Cluster, scene, shards: int, outdir: pathlib.Path, flags) -> dict:
-    env = dict(cluster.env, HERON_BIN=str(require_heron_bin()))
-    proc = _run(["bash", SLURM_DIR / "submit.sh", scene, shards, outdir, *flags], env=env)
+def _submit(cluster: Cluster, scene, shards: int, outdir: pathlib.Path, flags, *,
+            heron_bin=None, slurm_dir=SLURM_DIR) -> dict:
+    env = dict(cluster.env, HERON_BIN=str(heron_bin or require_heron_bin()))
+    proc = _run(["bash", slurm_dir / "submit.sh", scene, shards, outdir, *flags], env=env)
     assert proc.returncode == 0, f"submit.sh failed ({proc.returncode}): {proc.stderr}"
     ids = dict(re.findall(r"^(ARRAY_JOB|MERGE_JOB|OUTPUT)=(.*)$", proc.stdout, re.M))
     assert set(ids) == {"ARRAY_JOB", "MERGE_JOB", "OUTPUT"}, \
@@ -165,9 +168,15 @@ def _render_reference(scene, flags, out: pathlib.Path) -> pathlib.Path:
     return out
 
 
-def test_slurm_array_and_merge_equal_one_render(slurm, tmp_path):
+def test_slurm_array_and_merge_equal_one_render(slurm, dist_unpacked, tmp_path):
+    """The no-root path of the README: the relocatable tarball (scripts/build-dist.sh)
+    unpacked, its own deploy/slurm/submit.sh, binary and scene; the merged image equals
+    one render of the build tree's binary."""
     outdir = tmp_path / "run"
-    ids = _submit(slurm, SLURM_SCENE, SLURM_SHARDS, outdir, SLURM_FLAGS)
+    heron_bin = dist_unpacked / "bin" / "heron"
+    scene = dist_unpacked / "scenes" / SLURM_SCENE.name
+    ids = _submit(slurm, scene, SLURM_SHARDS, outdir, SLURM_FLAGS, heron_bin=heron_bin,
+                  slurm_dir=dist_unpacked / "deploy" / "slurm")
     array, merge = ids["ARRAY_JOB"], ids["MERGE_JOB"]
     records = slurm.wait([array, merge], "sharded render", outdir)
 
@@ -183,6 +192,9 @@ def test_slurm_array_and_merge_equal_one_render(slurm, tmp_path):
     if records[merge][0].get("Dependency") not in ("(null)", ""):
         fail(f"merge job {merge} still has a dependency: {records[merge][0]['Dependency']}")
 
+    # The array and the merge ran the tarball's binary (submit.sh passes it on).
+    for r in records[array] + records[merge]:
+        assert str(dist_unpacked) in r.get("Command", ""), r.get("Command")
     # Each task rendered its own shard (the log line render-array.sbatch prints).
     for k in range(SLURM_SHARDS):
         log = outdir / "logs" / f"render-{array}_{k}.out"
