@@ -511,6 +511,11 @@ struct RenderArgs {
     no_png: bool,
     #[command(flatten)]
     display: DisplayFlags,
+    /// Rewrite the PNG preview (atomically) with the samples so far at the first pass
+    /// boundary after every SECONDS, to watch a long render converge; the final EXR and
+    /// PNG do not change.
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+    preview_every: Option<f64>,
     /// Add the CIE XYZ channels X, Y, Z to the EXR.
     #[arg(long)]
     xyz: bool,
@@ -737,6 +742,24 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         bail!("--threads: expected at least 1");
     }
     let shown = args.display.transform()?;
+    let preview_every = match args.preview_every {
+        None => None,
+        Some(v) => {
+            let every = match std::time::Duration::try_from_secs_f64(v) {
+                Ok(d) if v.is_finite() && v > 0.0 => d,
+                _ => bail!("--preview-every: expected a finite number of seconds > 0, got {v}"),
+            };
+            if to_film {
+                bail!(
+                    "--preview-every: a .heronfilm output has no PNG preview (render to an .exr)"
+                );
+            }
+            if args.no_png {
+                bail!("--preview-every: rewrites the PNG preview, which --no-png turns off");
+            }
+            Some(every)
+        }
+    };
     let settings_args = SettingsArgs {
         spp: args.spp.map(i64::from),
         seed: args.seed,
@@ -796,6 +819,18 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot install the Ctrl-C handler: {e}"))?;
     }
     opts.stop = Some(stop.clone());
+    if let Some(every) = preview_every {
+        let png = exr_path.with_extension("png");
+        opts.preview = Some((
+            every,
+            Arc::new(move |state: &heron::checkpoint::Checkpoint| {
+                // A preview that cannot be written is not worth the render: say so and go on.
+                if let Err(e) = stage_png(&state.film(), &png, &shown).and_then(|s| s.commit()) {
+                    eprintln!("warning: --preview-every: {e}");
+                }
+            }),
+        ));
+    }
     let bar = progress_bar(args.quiet);
     if let Some(bar) = &bar {
         let b = bar.clone();

@@ -1,15 +1,18 @@
-//! Display transforms (src/spectrum/display.rs): Newton's spectrum
+//! Display transforms (src/spectrum/display.rs) and the progress image: Newton's spectrum
 //! keeps a continuous hue under `--display hue` and breaks into plateaus under `clip`;
 //! `heron display` re-encodes an EXR into the very PNG the render wrote and maps CSV rows
-//! of XYZ; bad flags and files are one-line errors. Nothing here is timed.
-use heron::render::{render, RenderOptions};
+//! of XYZ; bad flags and files are one-line errors; `--preview-every` rewrites the PNG
+//! during a render without changing the final outputs. Nothing here is timed.
+use heron::render::{render, render_state, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::Scene;
 use heron::spectrum::display::{
     linear_srgb_to_oklab, oklab_hue_deg, DisplayMode, DisplayTransform,
 };
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
@@ -446,6 +449,27 @@ fn bad_display_flags_and_inputs_are_one_line_errors() {
     let sc = scenes().join("default.toml");
     let sc = sc.to_str().unwrap();
     let out = p("r.exr");
+    for ev in ["NaN", "-1", "0", "inf", "1e300"] {
+        fails(
+            &["render", sc, "-o", &out, "--preview-every", ev],
+            "--preview-every",
+        );
+    }
+    fails(
+        &["render", sc, "-o", &out, "--preview-every", "1", "--no-png"],
+        "--preview-every",
+    );
+    fails(
+        &[
+            "render",
+            sc,
+            "-o",
+            &p("r.heronfilm"),
+            "--preview-every",
+            "1",
+        ],
+        "--preview-every",
+    );
     fails(
         &["render", sc, "-o", &out, "--exposure", "nan"],
         "--exposure",
@@ -464,4 +488,119 @@ fn bad_display_flags_and_inputs_are_one_line_errors() {
         left,
         ["bad.csv", "fake.exr", "nan.csv", "noxyz.csv", "x.txt"]
     );
+}
+
+#[test]
+fn the_preview_hook_sees_every_pass_and_leaves_the_film_unchanged() {
+    // default.toml at 64² and 2048 spp: passes of 2²² / 64² = 1024 spp, so two passes;
+    // with an interval of zero the hook runs after every pass but the last.
+    let text = std::fs::read_to_string(scenes().join("default.toml"))
+        .unwrap()
+        .replace("resolution = [512, 512]", "resolution = [64, 64]");
+    assert!(text.contains("[64, 64]"));
+    let scene = load_scene_from_str(&text, &scenes().join("default.toml")).unwrap();
+    let mut o = RenderOptions::from_scene(&scene);
+    o.settings.spp = 2048;
+    o.settings.lanes = 1;
+    let (plain, _) = render_state(&scene, &o).unwrap();
+    let calls = Arc::new(AtomicU32::new(0));
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let d = tempfile::tempdir().unwrap();
+    let png = d.path().join("preview.png");
+    {
+        let (calls, seen, png) = (calls.clone(), seen.clone(), png.clone());
+        o.preview = Some((
+            std::time::Duration::ZERO,
+            Arc::new(move |state: &heron::checkpoint::Checkpoint| {
+                calls.fetch_add(1, Ordering::SeqCst);
+                seen.lock().unwrap().push(state.spp_done);
+                // The writer --preview-every uses.
+                heron::film::png::stage_png(&state.film(), &png, &DisplayTransform::default())
+                    .unwrap()
+                    .commit()
+                    .unwrap();
+            }),
+        ));
+    }
+    let (with, stats) = render_state(&scene, &o).unwrap();
+    assert_eq!(stats.spp, 2048);
+    assert_eq!(calls.load(Ordering::SeqCst), 1);
+    assert_eq!(*seen.lock().unwrap(), [1024]);
+    let (w, h, _) = decode_png(&png);
+    assert_eq!((w, h), (64, 64));
+    assert!(plain.film() == with.film(), "the preview changed the image");
+}
+
+fn default_scene_args<'a>(sc: &'a str, out: &'a str, spp: &'a str) -> Vec<&'a str> {
+    vec![
+        "render", sc, "-o", out, "--spp", spp, "--quiet", "--lanes", "1",
+    ]
+}
+
+#[test]
+fn preview_every_leaves_the_final_exr_and_png_unchanged() {
+    // 512² at 32 spp is two passes of 16 spp; an interval of 1 ns is over at the end of
+    // the first, so a preview is written there (the final write replaces it).
+    let d = tempfile::tempdir().unwrap();
+    let sc = scenes().join("default.toml");
+    let sc = sc.to_str().unwrap();
+    let (a, b) = (d.path().join("a.exr"), d.path().join("b.exr"));
+    ok(&default_scene_args(sc, a.to_str().unwrap(), "32"));
+    let mut args = default_scene_args(sc, b.to_str().unwrap(), "32");
+    args.extend_from_slice(&["--preview-every", "1e-9"]);
+    ok(&args);
+    for ext in ["exr", "png"] {
+        assert!(
+            std::fs::read(a.with_extension(ext)).unwrap()
+                == std::fs::read(b.with_extension(ext)).unwrap(),
+            "the final .{ext} differs with --preview-every"
+        );
+    }
+    let n = std::fs::read_dir(d.path()).unwrap().count();
+    assert_eq!(n, 4, "temporary files left behind");
+}
+
+#[test]
+fn a_preview_png_appears_while_the_render_runs() {
+    // A render of 2000 passes (16 spp each at 512²), far longer than the wait: its PNG
+    // must appear, complete and decodable, before the process ends; then it is killed.
+    let d = tempfile::tempdir().unwrap();
+    let sc = scenes().join("default.toml");
+    let out = d.path().join("long.exr");
+    let png = out.with_extension("png");
+    let mut args = default_scene_args(sc.to_str().unwrap(), out.to_str().unwrap(), "32000");
+    args.extend_from_slice(&["--preview-every", "0.001"]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_heron"))
+        .args(&args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn heron");
+    // Polls until the file exists (bounded so a broken build fails instead of hanging).
+    let mut seen = false;
+    for _ in 0..30_000 {
+        if png.exists() {
+            seen = true;
+            break;
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("heron exited ({status}) before writing a preview");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let still_running = child.try_wait().unwrap().is_none();
+    child.kill().ok();
+    child.wait().ok();
+    assert!(seen, "no preview appeared");
+    assert!(
+        still_running,
+        "the render ended before its preview was seen"
+    );
+    let (w, h, px) = decode_png(&png);
+    assert_eq!((w, h), (512, 512));
+    assert!(
+        px.iter().any(|p| p.iter().any(|&v| v > 0)),
+        "the preview is black"
+    );
+    assert!(!out.exists(), "the EXR exists before the render ended");
 }
