@@ -442,9 +442,11 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 /// How linear colours become the PNG's (heron::spectrum::display).
 #[derive(clap::Args)]
 struct DisplayFlags {
-    /// How colours outside the sRGB gamut are shown: hue (moved at constant Oklab hue
-    /// toward mid-grey until they fit, Ottosson 2021; colours inside stay as they are) or
-    /// clip (each channel clipped to [0, 1]).
+    /// How colours outside the sRGB gamut are shown: hue (colours inside stay as they
+    /// are; the others get white added until no channel is negative, which keeps their
+    /// dominant wavelength, then, if still over range, are moved at constant Oklab hue
+    /// toward mid-grey until they fit, Ottosson 2021) or clip (each channel clipped to
+    /// [0, 1]).
     #[arg(long, default_value = "hue", value_parser = clap::builder::PossibleValuesParser::new(DisplayMode::NAMES))]
     display: String,
     /// Exposure in stops: linear values are multiplied by 2^EV before the display

@@ -6,9 +6,7 @@
 use heron::render::{render, render_state, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::Scene;
-use heron::spectrum::display::{
-    linear_srgb_to_oklab, oklab_hue_deg, DisplayMode, DisplayTransform,
-};
+use heron::spectrum::display::{DisplayMode, DisplayTransform};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -406,13 +404,24 @@ fn heron_display_maps_xyz_rows_of_a_csv() {
     for k in 0..3 {
         assert_eq!(rows[1][k] as f32, grey[k]);
     }
-    // 520 nm keeps its Oklab hue (about 159°); clipped, it would turn to sRGB green's.
-    let lin = |c: [f64; 3]| c.map(|v| srgb_decode((v * 255.0).round() as u8));
-    let want = oklab_hue_deg(linear_srgb_to_oklab(
-        heron::spectrum::color::xyz_to_linear_srgb([0.0267, 0.3, 0.0331]).map(f64::from),
-    ));
-    let got = oklab_hue_deg(linear_srgb_to_oklab(lin(rows[2])));
-    assert!((got - want).abs() < 1.5, "520 nm: hue {got} vs {want}");
+    // 520 nm keeps its dominant wavelength (white is added; it stays below 1), to the
+    // precision of the printed digits; clipped, it would turn 10° toward sRGB's green.
+    let want =
+        hue_xy(heron::spectrum::color::xyz_to_linear_srgb([0.0267, 0.3, 0.0331]).map(f64::from));
+    let got = hue_xy(rows[2].map(|v| {
+        // The sRGB decoding of an encoded value in [0, 1].
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    }));
+    assert!((got - want).abs() < 0.05, "520 nm: hue {got} vs {want}");
+    let clipped = hue_xy(
+        heron::spectrum::color::xyz_to_linear_srgb([0.0267, 0.3, 0.0331])
+            .map(|v| v.clamp(0.0, 1.0) as f64),
+    );
+    assert!((clipped - want).abs() > 5.0, "{clipped} vs {want}");
     // To a file, atomically; the same text.
     let to = d.path().join("out.csv");
     ok(&["display", csv.to_str().unwrap(), "-o", to.to_str().unwrap()]);

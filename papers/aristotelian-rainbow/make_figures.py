@@ -39,7 +39,7 @@ def read_texture(path: pathlib.Path):
 
 def colour_rows(lams: np.ndarray, radiance: np.ndarray, scale: float, heron: hf.Heron):
     """XYZ (heron's film convention) and display sRGB (XYZ / scale through `heron
-    display`: out-of-gamut colours kept at their Oklab hue) of spectra sampled at lams."""
+    display`: out-of-gamut colours brought in at constant hue) of spectra sampled at lams."""
     xyz = hf.spectra_to_xyz(lams, radiance)
     rgb, _ = hf.display_srgb(xyz, heron, white_y=scale)
     return xyz, rgb
@@ -61,7 +61,7 @@ def texture_figure(tex, out: pathlib.Path, scale: float, heron: hf.Heron) -> Non
                      "XYZ = sum R(t, l) xbar(l) dl / int ybar dl (CIE 1931 2 deg, "
                      "colour-science, 5 nm trapezoid); sRGB: XYZ divided by "
                      f"{scale:.6g} (same scale in every figure here), heron display "
-                     "(IEC 61966-2-1 matrix, out-of-gamut colours kept at their Oklab hue, "
+                     "(IEC 61966-2-1 matrix, out-of-gamut colours brought in at constant hue, "
                      "encoded).",
                  ])
     fig = plt.figure(figsize=(8.0, 6.0))
@@ -146,7 +146,7 @@ def colour_strip_figure(out: pathlib.Path, work: pathlib.Path, scale: float,
                          "heron sky profile --model aristotle at 360-830 nm every 5 nm.",
                          "XYZ = sum L xbar dl / int ybar dl (CIE 1931 2 deg, colour-science); "
                          f"sRGB: XYZ divided by {scale:.6g}, heron display (out-of-gamut "
-                         "colours kept at their Oklab hue, encoded).",
+                         "colours brought in at constant hue, encoded).",
                      ])
         half = 0.5 * (theta[1] - theta[0])
         x = (theta - BOW_DEG) / alpha

@@ -121,8 +121,8 @@ class Heron:
     def display(self, xyz: np.ndarray) -> np.ndarray:
         """`heron display` of XYZ rows (shape (..., 3), heron's film convention, D65 white
         at Y = 1): encoded sRGB in [0, 1], same shape. Colours outside the sRGB gamut are
-        moved at constant Oklab hue toward mid-grey until they fit (heron's PNG preview
-        transform, `--display hue`); colours inside are only encoded."""
+        brought in at constant hue (white added, then Oklab's projection toward mid-grey;
+        heron's PNG preview transform, `--display hue`); colours inside are only encoded."""
         xyz = np.asarray(xyz, dtype=float)
         flat = xyz.reshape(-1, 3)
         with tempfile.TemporaryDirectory() as tmp:
@@ -216,8 +216,8 @@ def display_srgb(xyz: np.ndarray, heron: Heron,
                  white_y: float | None = None) -> tuple[np.ndarray, float]:
     """Encoded sRGB in [0, 1] for display, from XYZ: XYZ divided by scale, with scale the
     largest linear sRGB channel (or `white_y` if given), then `heron display` (colours
-    outside the sRGB gamut moved at constant Oklab hue until they fit, as heron's PNG
-    previews do). Returns (rgb, scale)."""
+    outside the sRGB gamut brought in at constant hue, as heron's PNG previews do).
+    Returns (rgb, scale)."""
     lin = xyz_to_linear_srgb(xyz)
     scale = float(white_y) if white_y is not None else float(np.max(lin))
     if scale <= 0.0:

@@ -153,7 +153,7 @@ def dark_band(out: pathlib.Path, heron: hf.Heron) -> None:
                      "XYZ = sum p(theta, l) D65(l)/100 xbar(l) dl / int ybar dl (CIE 1931 "
                      "2 deg, colour-science); sRGB: IEC 61966-2-1 matrix, divided by "
                      f"{scale:.6g} (the largest linear channel), heron display "
-                     "(out-of-gamut colours kept at their Oklab hue, encoded).",
+                     "(out-of-gamut colours brought in at constant hue, encoded).",
                  ])
     sp = {pol: hf.read_csv(out / "data" / f"dark_band_550nm_{pol}.csv")[1] for pol in "sp"}
 

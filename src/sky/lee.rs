@@ -16,7 +16,7 @@
 //! XYZ / Y_max, where Y_max is the largest Y of that radius (each radius's brightest
 //! angle has Y = 1; bows of small drops are much dimmer, and Lee's diagrams show hue and
 //! saturation, not that), brought into the sRGB gamut by the display transform asked for
-//! (`spectrum::display`: by default at constant Oklab hue, or clipped per channel) and
+//! (`spectrum::display`: by default keeping their hue, or clipped per channel) and
 //! encoded with the sRGB transfer function.
 use super::MieSky;
 use crate::spectrum::display::DisplayTransform;

@@ -52,7 +52,8 @@
 /// How linear sRGB outside [0, 1] is brought to the display.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum DisplayMode {
-    /// Out-of-gamut colours moved at constant Oklab hue to the gamut boundary.
+    /// Colours outside the gamut brought to its boundary at constant hue (white added,
+    /// then Oklab's projection toward mid-grey).
     #[default]
     Hue,
     /// Each channel clipped to [0, 1].
