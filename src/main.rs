@@ -6,6 +6,7 @@ use heron::film::{exr::stage_exr, png::stage_png};
 use heron::render::{render_state, RenderOptions};
 use heron::scene::load_scene;
 use heron::settings::SettingsArgs;
+use heron::spectrum::display::{DisplayMode, DisplayTransform};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -45,6 +46,10 @@ enum Command {
     /// channels (heron render --variance) or from the spread within each region. Exits 0
     /// (same), 1 (different) or 2 (cannot compare).
     Compare(CompareArgs),
+    /// Encode linear colours for display as the PNG preview does: an EXR's R, G, B (linear
+    /// sRGB, as heron render writes them) into a PNG, or the X, Y, Z columns of a CSV into
+    /// encoded sRGB rows (sR,sG,sB), e.g. for figures.
+    Display(DisplayCmdArgs),
     /// Print the provenance heron wrote into an EXR: version, scene and input hashes,
     /// integrator, sampler, spp, seed, lanes, wavelengths (one `key: value` per line).
     Info {
@@ -148,6 +153,9 @@ struct SkyLeeArgs {
     /// Output CSV (written atomically); default: standard output.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// How the R, G, B columns are encoded (the X, Y, Z columns do not change).
+    #[command(flatten)]
+    display: DisplayFlags,
 }
 
 #[derive(clap::Args)]
@@ -302,6 +310,7 @@ fn cmd_sky(c: SkyCommand) -> Result<()> {
                 step_deg: a.step,
                 lambda_step_nm: a.lambda_step,
                 sun_radius_deg: a.sun_radius,
+                display: a.display.transform()?,
             })?;
             match a.output {
                 Some(path) => {
@@ -461,6 +470,48 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+/// How linear colours become the PNG's (heron::spectrum::display).
+#[derive(clap::Args)]
+struct DisplayFlags {
+    /// How colours outside the sRGB gamut are shown: hue (colours inside stay as they
+    /// are; the others get white added until no channel is negative, which keeps their
+    /// dominant wavelength, then, if still over range, are moved at constant Oklab hue
+    /// toward mid-grey until they fit, Ottosson 2021) or clip (each channel clipped to
+    /// [0, 1]).
+    #[arg(long, default_value = "hue", value_parser = clap::builder::PossibleValuesParser::new(DisplayMode::NAMES))]
+    display: String,
+    /// Exposure in stops: linear values are multiplied by 2^EV before the display
+    /// transform (0: as rendered).
+    #[arg(
+        long,
+        value_name = "EV",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    exposure: f64,
+}
+
+impl DisplayFlags {
+    fn transform(&self) -> Result<DisplayTransform> {
+        let mode =
+            DisplayMode::parse(&self.display).map_err(|e| anyhow::anyhow!("--display: {e}"))?;
+        DisplayTransform::new(mode, self.exposure).map_err(|e| anyhow::anyhow!("--exposure: {e}"))
+    }
+}
+
+#[derive(clap::Args)]
+struct DisplayCmdArgs {
+    /// An EXR (R, G, B in linear sRGB) or a CSV with a header naming columns X, Y, Z (CIE
+    /// 1931, D65 white at Y = 1, heron's film convention; other columns are ignored).
+    input: PathBuf,
+    /// The PNG to write for an EXR (required); the CSV to write for a CSV (default:
+    /// standard output). Written atomically.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    display: DisplayFlags,
+}
+
 #[derive(clap::Args)]
 struct RenderArgs {
     /// Scene file (TOML).
@@ -491,6 +542,13 @@ struct RenderArgs {
     /// Do not write the PNG preview.
     #[arg(long)]
     no_png: bool,
+    #[command(flatten)]
+    display: DisplayFlags,
+    /// Rewrite the PNG preview (atomically) with the samples so far at the first pass
+    /// boundary after every SECONDS, to watch a long render converge; the final EXR and
+    /// PNG do not change.
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+    preview_every: Option<f64>,
     /// Add the CIE XYZ channels X, Y, Z to the EXR.
     #[arg(long)]
     xyz: bool,
@@ -597,6 +655,8 @@ struct MergeArgs {
     /// Do not write the PNG preview.
     #[arg(long)]
     no_png: bool,
+    #[command(flatten)]
+    display: DisplayFlags,
 }
 
 fn parse_lanes(s: &str) -> std::result::Result<usize, String> {
@@ -625,6 +685,45 @@ struct ColorArgs {
     /// colour-science interpolates the illuminants of its SDS_ILLUMINANTS).
     #[arg(long, default_value = "cie167")]
     interpolation: heron::spectrum::interp::Interpolation,
+}
+
+fn cmd_display(a: DisplayCmdArgs) -> Result<()> {
+    let t = a.display.transform()?;
+    let ext = a
+        .input
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("exr") => {
+            let Some(out) = &a.output else {
+                bail!("--output: expected the PNG to write (heron display IN.exr -o OUT.png)");
+            };
+            check_output(out, &["png"])?;
+            let (w, h, rgb) = heron::film::exr::read_linear_srgb(&a.input)?;
+            heron::film::png::stage_png_rgb(w, h, &rgb, out, &t)?.commit()?;
+        }
+        Some("csv") => {
+            let text = std::fs::read_to_string(&a.input)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+            if let Some(out) = &a.output {
+                check_output(out, &["csv"])?;
+            }
+            let csv = heron::spectrum::display::map_xyz_csv(&text, &display(&a.input), &t)
+                .map_err(anyhow::Error::msg)?;
+            match &a.output {
+                Some(out) => heron::files::write_atomically(out, |tmp| {
+                    std::fs::write(tmp, &csv).map_err(|e| e.to_string())
+                })?,
+                None => print!("{csv}"),
+            }
+        }
+        _ => bail!(
+            "{}: expected an .exr (to a PNG) or a .csv with columns X, Y, Z",
+            a.input.display()
+        ),
+    }
+    Ok(())
 }
 
 fn cmd_color(a: ColorArgs) -> Result<()> {
@@ -693,6 +792,7 @@ fn main() {
         }
         Command::Color(args) => cmd_color(args),
         Command::Compare(args) => cmd_compare(args),
+        Command::Display(args) => cmd_display(args),
         Command::Info { exr } => cmd_info(&exr),
         Command::Stress(args) => cmd_stress(args),
         Command::Sky(c) => cmd_sky(c),
@@ -744,6 +844,25 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     if args.threads == Some(0) {
         bail!("--threads: expected at least 1");
     }
+    let shown = args.display.transform()?;
+    let preview_every = match args.preview_every {
+        None => None,
+        Some(v) => {
+            let every = match std::time::Duration::try_from_secs_f64(v) {
+                Ok(d) if v.is_finite() && v > 0.0 => d,
+                _ => bail!("--preview-every: expected a finite number of seconds > 0, got {v}"),
+            };
+            if to_film {
+                bail!(
+                    "--preview-every: a .heronfilm output has no PNG preview (render to an .exr)"
+                );
+            }
+            if args.no_png {
+                bail!("--preview-every: rewrites the PNG preview, which --no-png turns off");
+            }
+            Some(every)
+        }
+    };
     let settings_args = SettingsArgs {
         spp: args.spp.map(i64::from),
         seed: args.seed,
@@ -773,10 +892,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     }
     opts.variance = args.variance;
     let seconds = |flag: &str, v: f64| -> Result<std::time::Duration> {
-        if v.is_finite() && v >= 0.0 {
-            Ok(std::time::Duration::from_secs_f64(v))
-        } else {
-            bail!("{flag}: expected a finite number of seconds >= 0, got {v}")
+        match std::time::Duration::try_from_secs_f64(v) {
+            Ok(d) if v.is_finite() => Ok(d),
+            _ => bail!("{flag}: expected a finite number of seconds >= 0, got {v}"),
         }
     };
     if let Some(c) = &args.checkpoint {
@@ -811,6 +929,18 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot install the Ctrl-C handler: {e}"))?;
     }
     opts.stop = Some(stop.clone());
+    if let Some(every) = preview_every {
+        let png = exr_path.with_extension("png");
+        opts.preview = Some((
+            every,
+            Arc::new(move |state: &heron::checkpoint::Checkpoint| {
+                // A preview that cannot be written is not worth the render: say so and go on.
+                if let Err(e) = stage_png(&state.film(), &png, &shown).and_then(|s| s.commit()) {
+                    eprintln!("warning: --preview-every: {e}");
+                }
+            }),
+        ));
+    }
     let bar = progress_bar(args.quiet);
     if let Some(bar) = &bar {
         let b = bar.clone();
@@ -834,7 +964,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         // key records what ran, e.g. no packets for light tracing).
         let provenance = heron::provenance::Provenance::from_key(&state.key, stats.spp)
             .expect("the settings key holds the provenance");
-        write_image(&film, &exr_path, &state, &provenance, args.no_png)?;
+        let png = (!args.no_png).then_some(&shown);
+        write_image(&film, &exr_path, &state, &provenance, png)?;
     }
     let shard = args
         .shard
@@ -906,24 +1037,24 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Writes the EXR and (unless `no_png`) the PNG of `film`. Both files are staged first
-/// and renamed into place together: an error in either leaves neither behind.
+/// Writes the EXR and (given a display transform) the PNG of `film`. Both files are
+/// staged first and renamed into place together: an error in either leaves neither
+/// behind.
 fn write_image(
     film: &heron::film::Film,
     exr_path: &Path,
     state: &heron::checkpoint::Checkpoint,
     provenance: &heron::provenance::Provenance,
-    no_png: bool,
+    png: Option<&DisplayTransform>,
 ) -> Result<()> {
     let channels = heron::film::exr::ExrChannels {
         xyz: state.xyz_channels,
         spectral: film.spectral.is_some(),
     };
     let exr = stage_exr(film, exr_path, channels, provenance)?;
-    let png = if no_png {
-        None
-    } else {
-        Some(stage_png(film, &exr_path.with_extension("png"))?)
+    let png = match png {
+        None => None,
+        Some(d) => Some(stage_png(film, &exr_path.with_extension("png"), d)?),
     };
     exr.commit()?;
     if let Some(p) = png {
@@ -934,6 +1065,7 @@ fn write_image(
 
 fn cmd_merge(args: MergeArgs) -> Result<()> {
     check_output(&args.output, &["exr"])?;
+    let shown = args.display.transform()?;
     let parts = args
         .parts
         .iter()
@@ -953,7 +1085,8 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
             )
         })?;
     let film = total.film();
-    write_image(&film, &args.output, &total, &provenance, args.no_png)?;
+    let png = (!args.no_png).then_some(&shown);
+    write_image(&film, &args.output, &total, &provenance, png)?;
     eprintln!(
         "{}: merged {} part{}: {}x{} at {} spp, {} rays ({} camera/continued, {} shadow), {} non-finite samples",
         display(&args.output),

@@ -54,7 +54,14 @@ pub struct RenderOptions {
     /// Also sum the squares of each pixel's contributions, for the variance of each
     /// pixel's value (`heron render --variance`); off, the render does no extra work.
     pub variance: bool,
+    /// The progress image: called with the film's state so far after a pass (not the
+    /// last) once this long has passed since the render started or since the last call
+    /// (zero: after every pass). It only reads the state, so the image is unchanged.
+    pub preview: Option<(Duration, PreviewFn)>,
 }
+
+/// What [`RenderOptions::preview`] calls (`--preview-every` rewrites the PNG with it).
+pub type PreviewFn = std::sync::Arc<dyn Fn(&Checkpoint) + Send + Sync>;
 
 impl RenderOptions {
     /// A render of `scene` with its own settings, on every core, with no checkpoints.
@@ -70,6 +77,7 @@ impl RenderOptions {
             cancel: None,
             progress: None,
             variance: false,
+            preview: None,
         }
     }
 }
@@ -421,6 +429,7 @@ pub(crate) fn render_passes(
     );
     let start = Instant::now();
     let mut last_checkpoint = Instant::now();
+    let mut last_preview = Instant::now();
     for &(s0, s1) in &passes[first_pass..] {
         let results: Vec<TileResult> = pool.install(|| {
             tiles
@@ -536,6 +545,12 @@ pub(crate) fn render_passes(
         if stop && !last {
             stats.stopped = true;
             break;
+        }
+        if let Some((every, preview)) = &opts.preview {
+            if !last && last_preview.elapsed() >= *every {
+                preview(&state);
+                last_preview = Instant::now();
+            }
         }
     }
     stats.wall = start.elapsed();

@@ -36,4 +36,4 @@ grid="$(seq -s, 360 5 830)"
 "$heron" sky profile --model aristotle --sun-radius 0.2666 --lambda "$grid" \
     --from 41.6 --to 42.4 --step 0.002 > "$work/spectral_solar_disk.csv"
 
-"$py" "$here/make_figures.py" --texture "$repo/spectra/aristotle_bow.csv" --out "$out" --work "$work"
+"$py" "$here/make_figures.py" --heron "$heron" --texture "$repo/spectra/aristotle_bow.csv" --out "$out" --work "$work"

@@ -37,17 +37,17 @@ def read_texture(path: pathlib.Path):
     return data[:, 0], data[:, 1], lams, data[:, 2:]
 
 
-def colour_rows(lams: np.ndarray, radiance: np.ndarray, scale: float):
-    """XYZ (heron's film convention) and display sRGB (linear sRGB / scale, clipped,
-    encoded) of spectra sampled at lams."""
+def colour_rows(lams: np.ndarray, radiance: np.ndarray, scale: float, heron: hf.Heron):
+    """XYZ (heron's film convention) and display sRGB (XYZ / scale through `heron
+    display`: out-of-gamut colours brought in at constant hue) of spectra sampled at lams."""
     xyz = hf.spectra_to_xyz(lams, radiance)
-    rgb, _ = hf.display_srgb(xyz, white_y=scale)
+    rgb, _ = hf.display_srgb(xyz, heron, white_y=scale)
     return xyz, rgb
 
 
-def texture_figure(tex, out: pathlib.Path, scale: float) -> None:
+def texture_figure(tex, out: pathlib.Path, scale: float, heron: hf.Heron) -> None:
     t, alpha, lams, R = tex
-    xyz, rgb = colour_rows(lams, R, scale)
+    xyz, rgb = colour_rows(lams, R, scale, heron)
     peak = lams[np.argmax(R, axis=1)]
     peak = np.where(alpha > 0, peak, np.nan)
     hf.write_csv(out / "data" / "texture_colour.csv",
@@ -59,8 +59,10 @@ def texture_figure(tex, out: pathlib.Path, scale: float) -> None:
                      "derive_texture_csv): t = smoothstep lookup coordinate (0 inner edge, "
                      "1 outer edge), alpha = coverage.",
                      "XYZ = sum R(t, l) xbar(l) dl / int ybar dl (CIE 1931 2 deg, "
-                     "colour-science, 5 nm trapezoid); sRGB: IEC 61966-2-1 matrix, divided "
-                     f"by {scale:.6g}, clipped, encoded (same scale in every figure here).",
+                     "colour-science, 5 nm trapezoid); sRGB: XYZ divided by "
+                     f"{scale:.6g} (same scale in every figure here), heron display "
+                     "(IEC 61966-2-1 matrix, out-of-gamut colours brought in at constant hue, "
+                     "encoded).",
                  ])
     fig = plt.figure(figsize=(8.0, 6.0))
     gs = fig.add_gridspec(3, 2, height_ratios=[3.0, 1.3, 0.5], width_ratios=[40, 1])
@@ -127,13 +129,14 @@ def profiles_figure(out: pathlib.Path) -> None:
     hf.save_png(fig, out / "figures" / "profiles.png")
 
 
-def colour_strip_figure(out: pathlib.Path, work: pathlib.Path, scale: float) -> None:
+def colour_strip_figure(out: pathlib.Path, work: pathlib.Path, scale: float,
+                        heron: hf.Heron) -> None:
     fig, axes = plt.subplots(len(SUNS), 1, figsize=(8.0, 3.4))
     for ax, (name, (alpha, label)) in zip(axes, SUNS.items()):
         header, data = hf.read_csv(work / f"spectral_{name}.csv")
         lams = np.array(hf.profile_columns(header))
         theta = data[:, 0]
-        xyz, rgb = colour_rows(lams, data[:, 1:], scale)
+        xyz, rgb = colour_rows(lams, data[:, 1:], scale, heron)
         hf.write_csv(out / "data" / f"colour_strip_{name}.csv",
                      ["theta_deg", "X", "Y", "Z", "sR", "sG", "sB"],
                      [(theta[i], *xyz[i], *rgb[i]) for i in range(len(theta))],
@@ -142,8 +145,8 @@ def colour_strip_figure(out: pathlib.Path, work: pathlib.Path, scale: float) -> 
                          f"Colour of the Aristotelian bow, {label}, background 0: "
                          "heron sky profile --model aristotle at 360-830 nm every 5 nm.",
                          "XYZ = sum L xbar dl / int ybar dl (CIE 1931 2 deg, colour-science); "
-                         f"sRGB: IEC 61966-2-1 matrix, divided by {scale:.6g}, clipped, "
-                         "encoded.",
+                         f"sRGB: XYZ divided by {scale:.6g}, heron display (out-of-gamut "
+                         "colours brought in at constant hue, encoded).",
                      ])
         half = 0.5 * (theta[1] - theta[0])
         x = (theta - BOW_DEG) / alpha
@@ -163,18 +166,20 @@ def colour_strip_figure(out: pathlib.Path, work: pathlib.Path, scale: float) -> 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--heron", required=True, type=pathlib.Path)
     ap.add_argument("--texture", required=True, type=pathlib.Path)
     ap.add_argument("--out", required=True, type=pathlib.Path)
     ap.add_argument("--work", required=True, type=pathlib.Path)
     args = ap.parse_args()
     hf.setup_matplotlib()
+    heron = hf.Heron(args.heron)
     tex = read_texture(args.texture)
     # One display scale for every colour here: the largest linear sRGB channel of any
     # texture row (the profiles only ever return texture values).
     scale = float(np.max(hf.xyz_to_linear_srgb(hf.spectra_to_xyz(tex[2], tex[3]))))
-    texture_figure(tex, args.out, scale)
+    texture_figure(tex, args.out, scale, heron)
     profiles_figure(args.out)
-    colour_strip_figure(args.out, args.work, scale)
+    colour_strip_figure(args.out, args.work, scale, heron)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 """Shared helpers for the figure sets in papers/: running heron, writing CSV with a
-fixed precision, saving byte-identical PNGs, and spectra to sRGB.
+fixed precision, saving byte-identical PNGs, and spectra to sRGB (the last step, from XYZ
+to the display's encoded sRGB, is heron's own: `heron display`, the transform of its PNG
+previews, so no colour maths is written twice).
 
 Every figure script imports this module (it sits next to them in papers/common) and
 is run by the set's make.sh with the project's .venv Python. Nothing here reads the
@@ -15,6 +17,7 @@ import math
 import os
 import pathlib
 import subprocess
+import tempfile
 from typing import Iterable, Sequence
 
 import matplotlib
@@ -115,6 +118,22 @@ class Heron:
                              f"(status {proc.returncode}):\n{proc.stderr}")
         return proc.stdout
 
+    def display(self, xyz: np.ndarray) -> np.ndarray:
+        """`heron display` of XYZ rows (shape (..., 3), heron's film convention, D65 white
+        at Y = 1): encoded sRGB in [0, 1], same shape. Colours outside the sRGB gamut are
+        brought in at constant hue (white added, then Oklab's projection toward mid-grey;
+        heron's PNG preview transform, `--display hue`); colours inside are only encoded."""
+        xyz = np.asarray(xyz, dtype=float)
+        flat = xyz.reshape(-1, 3)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "xyz.csv"
+            path.write_text("X,Y,Z\n" + "".join(f"{x!r},{y!r},{z!r}\n" for x, y, z in flat))
+            text = self.run("display", str(path))
+        lines = text.splitlines()
+        assert lines[0] == "sR,sG,sB", lines[0]
+        rgb = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=float)
+        return rgb.reshape(xyz.shape)
+
     def trace(self, scene: str, origin, direction, lam_nm: float, path: str | None = None):
         args = ["trace", scene, "--origin", ",".join(repr(float(v)) for v in origin),
                 "--dir", ",".join(repr(float(v)) for v in direction),
@@ -172,11 +191,6 @@ def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
     return np.asarray(xyz, dtype=float) @ XYZ_TO_SRGB.T
 
 
-def srgb_encode(rgb: np.ndarray) -> np.ndarray:
-    rgb = np.clip(np.asarray(rgb, dtype=float), 0.0, 1.0)
-    return np.where(rgb <= 0.0031308, 12.92 * rgb, 1.055 * np.power(rgb, 1 / 2.4) - 0.055)
-
-
 def spectra_to_xyz(lam_nm: np.ndarray, radiance: np.ndarray) -> np.ndarray:
     """XYZ = Σ L(λ) x̄(λ) Δλ / Σ ȳ(λ) Δλ over the given wavelengths (trapezoid weights),
     heron's film convention. radiance: shape (..., len(lam_nm))."""
@@ -198,15 +212,17 @@ def d65(lam_nm: np.ndarray) -> np.ndarray:
                      np.asarray(sd.values, float), left=0.0, right=0.0)
 
 
-def display_srgb(xyz: np.ndarray, white_y: float | None = None) -> tuple[np.ndarray, float]:
-    """Encoded sRGB in [0, 1] for display, from XYZ: linear sRGB scaled by 1/scale with
-    scale = the largest linear channel (or `white_y` if given), negative values (out of
-    gamut) clipped to 0, then the sRGB transfer function. Returns (rgb, scale)."""
+def display_srgb(xyz: np.ndarray, heron: Heron,
+                 white_y: float | None = None) -> tuple[np.ndarray, float]:
+    """Encoded sRGB in [0, 1] for display, from XYZ: XYZ divided by scale, with scale the
+    largest linear sRGB channel (or `white_y` if given), then `heron display` (colours
+    outside the sRGB gamut brought in at constant hue, as heron's PNG previews do).
+    Returns (rgb, scale)."""
     lin = xyz_to_linear_srgb(xyz)
     scale = float(white_y) if white_y is not None else float(np.max(lin))
     if scale <= 0.0:
         scale = 1.0
-    return srgb_encode(np.clip(lin / scale, 0.0, 1.0)), scale
+    return heron.display(np.asarray(xyz, dtype=float) / scale), scale
 
 
 def profile_columns(header: Sequence[str]) -> list[float]:

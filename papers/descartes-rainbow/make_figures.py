@@ -136,13 +136,13 @@ def deviation_curve(heron: hf.Heron, out: pathlib.Path) -> None:
     hf.save_png(fig, out / "figures" / "deviation_curve.png")
 
 
-def dark_band(out: pathlib.Path) -> None:
+def dark_band(out: pathlib.Path, heron: hf.Heron) -> None:
     header, data = hf.read_csv(out / "data" / "dark_band_unpolarised.csv")
     lams = np.array(hf.profile_columns(header))
     theta, p = data[:, 0], data[:, 1:]
     # Colour of the drop-scattered sunlight: p(θ, λ) · D65(λ) → XYZ → display sRGB.
     xyz = hf.spectra_to_xyz(lams, p * hf.d65(lams)[None, :] / 100.0)
-    rgb, scale = hf.display_srgb(xyz)
+    rgb, scale = hf.display_srgb(xyz, heron)
     hf.write_csv(out / "data" / "dark_band_srgb.csv",
                  ["theta_deg", "X", "Y", "Z", "sR", "sG", "sB"],
                  [(theta[i], *xyz[i], *rgb[i]) for i in range(len(theta))],
@@ -152,7 +152,8 @@ def dark_band(out: pathlib.Path) -> None:
                      "by D65/100, from data/dark_band_unpolarised.csv.",
                      "XYZ = sum p(theta, l) D65(l)/100 xbar(l) dl / int ybar dl (CIE 1931 "
                      "2 deg, colour-science); sRGB: IEC 61966-2-1 matrix, divided by "
-                     f"{scale:.6g} (the largest linear channel), clipped, encoded.",
+                     f"{scale:.6g} (the largest linear channel), heron display "
+                     "(out-of-gamut colours brought in at constant hue, encoded).",
                  ])
     sp = {pol: hf.read_csv(out / "data" / f"dark_band_550nm_{pol}.csv")[1] for pol in "sp"}
 
@@ -234,7 +235,7 @@ def main() -> None:
     heron = hf.Heron(args.heron)
     rainbow_angle(heron, args.out, args.work)
     deviation_curve(heron, args.out)
-    dark_band(args.out)
+    dark_band(args.out, heron)
     drop_size(args.out)
 
 

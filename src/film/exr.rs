@@ -180,3 +180,45 @@ pub fn read_provenance(path: &Path) -> crate::Result<Vec<(String, String)>> {
     out.sort();
     Ok(out)
 }
+
+/// The R, G, B channels of the EXR at `path` (the first layer that has them; half,
+/// float or integer samples), as heron writes them: linear sRGB. Returns the width, the
+/// height and the pixels row-major from the top-left. A file whose `chromaticities`
+/// attribute names other primaries or another white point is refused (no attribute means
+/// Rec. 709 primaries and D65, sRGB's, as OpenEXR specifies). Errors name the file.
+pub fn read_linear_srgb(path: &Path) -> crate::Result<(u32, u32, Vec<[f32; 3]>)> {
+    let err = |message: String| crate::HeronError::Io {
+        path: path.to_path_buf(),
+        message,
+    };
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |size, _| (size.width(), vec![[0.0f32; 3]; size.area()]),
+        |(w, px): &mut (usize, Vec<[f32; 3]>), at, (r, g, b, _): (f32, f32, f32, f32)| {
+            px[at.y() * *w + at.x()] = [r, g, b];
+        },
+    )
+    .map_err(|e| err(format!("cannot read R, G, B from it as OpenEXR: {e}")))?;
+    if let Some(c) = image.attributes.chromaticities {
+        let [r, g, b, wp] = SRGB_CHROMATICITIES;
+        let got = [c.red, c.green, c.blue, c.white];
+        let same = [r, g, b, wp]
+            .iter()
+            .zip(&got)
+            .all(|(w, v)| (w[0] - v.0).abs() < 1e-3 && (w[1] - v.1).abs() < 1e-3);
+        if !same {
+            return Err(err(format!(
+                "expected linear sRGB (chromaticities R {r:?}, G {g:?}, B {b:?}, white {wp:?}), \
+                 the file has R ({}, {}), G ({}, {}), B ({}, {}), white ({}, {})",
+                c.red.0, c.red.1, c.green.0, c.green.1, c.blue.0, c.blue.1, c.white.0, c.white.1
+            )));
+        }
+    }
+    let size = image.layer_data.size;
+    let (w, h) = (size.width(), size.height());
+    if w == 0 || h == 0 || w > u32::MAX as usize || h > u32::MAX as usize {
+        return Err(err(format!("expected a non-empty image, got {w}×{h}")));
+    }
+    let (_, px) = image.layer_data.channel_data.pixels;
+    Ok((w as u32, h as u32, px))
+}

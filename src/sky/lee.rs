@@ -15,8 +15,11 @@
 //! that returns the sun's light with p = 1 sr⁻¹. Colours: linear sRGB (IEC 61966-2-1) of
 //! XYZ / Y_max, where Y_max is the largest Y of that radius (each radius's brightest
 //! angle has Y = 1; bows of small drops are much dimmer, and Lee's diagrams show hue and
-//! saturation, not that), clipped to [0, 1] and encoded with the sRGB transfer function.
+//! saturation, not that), brought into the sRGB gamut by the display transform asked for
+//! (`spectrum::display`: by default keeping their hue, or clipped per channel) and
+//! encoded with the sRGB transfer function.
 use super::MieSky;
+use crate::spectrum::display::DisplayTransform;
 use crate::spectrum::{cie, color};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
@@ -33,6 +36,8 @@ pub struct LeeRequest {
     pub step_deg: f64,
     pub lambda_step_nm: f64,
     pub sun_radius_deg: f64,
+    /// How the R, G, B columns are encoded.
+    pub display: DisplayTransform,
 }
 
 /// First and last wavelength of the colour sums, nm.
@@ -191,7 +196,8 @@ pub fn lee_xyz(req: &LeeRequest) -> Result<LeeDiagram> {
 }
 
 /// The CSV of a request: `radius_mm,theta_deg,X,Y,Z,R,G,B` (R, G, B: encoded sRGB in
-/// [0, 1] of XYZ / the radius's largest Y, see the module documentation).
+/// [0, 1] of XYZ / the radius's largest Y through the request's display transform, see the
+/// module documentation).
 pub fn lee_csv(req: &LeeRequest) -> Result<String> {
     let LeeDiagram {
         radii_mm: radii,
@@ -208,15 +214,11 @@ pub fn lee_csv(req: &LeeRequest) -> Result<String> {
                 (c[1] * k) as f32,
                 (c[2] * k) as f32,
             ]);
+            let [sr, sg, sb] = req.display.encode(lin);
             writeln!(
                 out,
-                "{r},{t},{:.6e},{:.6e},{:.6e},{:.6},{:.6},{:.6}",
-                c[0],
-                c[1],
-                c[2],
-                color::srgb_encode(lin[0]),
-                color::srgb_encode(lin[1]),
-                color::srgb_encode(lin[2])
+                "{r},{t},{:.6e},{:.6e},{:.6e},{sr:.6},{sg:.6},{sb:.6}",
+                c[0], c[1], c[2],
             )
             .unwrap();
         }

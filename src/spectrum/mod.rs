@@ -6,6 +6,7 @@ pub mod cie;
 pub mod color;
 pub mod csv;
 pub mod dense;
+pub mod display;
 pub mod interp;
 pub mod ior;
 pub mod metals;
