@@ -688,8 +688,9 @@ fn assert_same_hit(single: Option<Hit>, other: Option<Hit>, what: &str, ray: &Ra
 }
 
 /// The 4- and 16-wide packets (both coherence hints) and Embree 3's stream API find the
-/// single-ray hits, with inactive and invalid lanes left out; on Embree 4 the stream
-/// reports that it is unavailable.
+/// single-ray hits, and the 4-, 8- and 16-wide occlusion queries the single-ray
+/// occlusion, with inactive and invalid lanes left out; on Embree 4 the stream reports
+/// that it is unavailable.
 #[test]
 fn packets_of_4_and_16_and_streams_agree_with_single_rays() {
     let dev = device();
@@ -714,6 +715,10 @@ fn packets_of_4_and_16_and_streams_agree_with_single_rays() {
         let h16 = scene.intersect16_with(&rays, active, coherence);
         let lo: [RayQuery; 4] = std::array::from_fn(|i| rays[i]);
         let h4 = scene.intersect4_with(&lo, (active & 0xf) as u8, coherence);
+        let o16 = scene.occluded16_with(&rays, active, coherence);
+        let o4 = scene.occluded4_with(&lo, (active & 0xf) as u8, coherence);
+        let half: [RayQuery; 8] = std::array::from_fn(|i| rays[i]);
+        let o8 = scene.occluded8_with(&half, (active & 0xff) as u8, coherence);
         let mut stream = [None; 16];
         let has_stream = scene.intersect_stream(&rays, coherence, &mut scratch, &mut stream);
         assert_eq!(has_stream, heron::accel::embree::BINDINGS_MAJOR == 3);
@@ -724,11 +729,29 @@ fn packets_of_4_and_16_and_streams_agree_with_single_rays() {
             }
             if active & (1 << i) == 0 {
                 assert_eq!(h16[i], None, "inactive lane {i} reported a hit");
+                assert_eq!(o16 & (1 << i), 0, "inactive lane {i} reported occlusion");
                 continue;
             }
             assert_same_hit(single, h16[i], "16-wide", &rays[i]);
             if i < 4 {
                 assert_same_hit(single, h4[i], "4-wide", &rays[i]);
+            }
+            // Occlusion where the closest hit is clear of the segment's ends (Embree
+            // promises nothing for hits at them).
+            let clear = single.is_none_or(|h| {
+                let len = rays[i].dir.length();
+                ((h.t - rays[i].tfar) * len).abs() >= 1e-3
+                    && ((h.t - rays[i].tnear) * len).abs() >= 1e-3
+            });
+            if clear {
+                let occluded = scene.occluded1(&rays[i]);
+                assert_eq!(o16 & (1 << i) != 0, occluded, "16-wide occlusion, lane {i}");
+                if i < 8 {
+                    assert_eq!(o8 & (1 << i) != 0, occluded, "8-wide occlusion, lane {i}");
+                }
+                if i < 4 {
+                    assert_eq!(o4 & (1 << i) != 0, occluded, "4-wide occlusion, lane {i}");
+                }
             }
         }
     }
@@ -835,6 +858,39 @@ fn invalid_rays_give_no_hit() {
     assert!(hits[..7].iter().all(Option::is_none));
     assert!(hits[7].is_some());
     assert_eq!(scene.occluded8(&rays, 0xff), 0x80);
+    // Every width: each bad ray in every lane position (the packets test four lanes at a
+    // time), beside good rays, and the stream.
+    let mut scratch = StreamScratch::default();
+    for (k, q) in bad.iter().enumerate() {
+        for lane in 0..16 {
+            let mut r16 = [good; 16];
+            r16[lane] = *q;
+            let want: u16 = !(1 << lane);
+            let h16 = scene.intersect16_with(&r16, 0xffff, RayCoherence::Incoherent);
+            let got = (0..16).fold(0u16, |m, i| m | ((h16[i].is_some() as u16) << i));
+            assert_eq!(got, want, "bad ray {k} in lane {lane} of 16");
+            assert_eq!(
+                scene.occluded16_with(&r16, 0xffff, RayCoherence::Coherent),
+                want,
+                "bad ray {k} in lane {lane} of 16 (occlusion)"
+            );
+            if lane < 4 {
+                let r4: [RayQuery; 4] = std::array::from_fn(|i| r16[i]);
+                let h4 = scene.intersect4_with(&r4, 0xf, RayCoherence::Incoherent);
+                let got = (0..4).fold(0u8, |m, i| m | ((h4[i].is_some() as u8) << i));
+                assert_eq!(got, want as u8 & 0xf, "bad ray {k} in lane {lane} of 4");
+                assert_eq!(
+                    scene.occluded4_with(&r4, 0xf, RayCoherence::Incoherent),
+                    want as u8 & 0xf
+                );
+            }
+            let mut stream = [None; 16];
+            if scene.intersect_stream(&r16, RayCoherence::Incoherent, &mut scratch, &mut stream) {
+                let got = (0..16).fold(0u16, |m, i| m | ((stream[i].is_some() as u16) << i));
+                assert_eq!(got, want, "bad ray {k} at {lane} of a stream");
+            }
+        }
+    }
 }
 
 #[test]

@@ -342,11 +342,13 @@ pub fn ray_sets(scene: &embree::Scene, o: &TraversalOptions) -> Result<[Vec<RayQ
 /// A reusable pass of heron's own queries over `rays`.
 struct HeronTracer {
     scratch: embree::StreamScratch,
-    stream_hits: Vec<Option<Hit>>,
 }
 
 impl HeronTracer {
     /// One pass; None where the library lacks the query (the stream API on Embree 4).
+    /// Never inlined, so that `scripts/callgrind_traversal.sh` can count its instructions
+    /// per pass (as the C program's `trace1` … `trace_stream`).
+    #[inline(never)]
     fn trace(
         &mut self,
         scene: &embree::Scene,
@@ -389,12 +391,12 @@ impl HeronTracer {
             Width::Sixteen => packets!(16, u16, intersect16_each),
             Width::Stream => {
                 for c in rays.chunks(STREAM_CHUNK) {
-                    let hits = &mut self.stream_hits[..c.len()];
-                    if !scene.intersect_stream(c, coherence, &mut self.scratch, hits) {
+                    let traced =
+                        scene.intersect_stream_each(c, coherence, &mut self.scratch, |_, h| {
+                            add(&Some(h))
+                        });
+                    if !traced {
                         return None;
-                    }
-                    for h in hits.iter() {
-                        add(h);
                     }
                 }
             }
@@ -434,7 +436,6 @@ pub fn run_traversal(mesh: &Mesh, o: &TraversalOptions) -> Result<TraversalRepor
     };
     let mut tracer = HeronTracer {
         scratch: embree::StreamScratch::default(),
-        stream_hits: vec![None; STREAM_CHUNK],
     };
     let coherence = [RayCoherence::Coherent, RayCoherence::Incoherent];
     let mut rows = Vec::new();

@@ -40,13 +40,26 @@ pub use crate::error::EmbreeError;
 /// `dir` need not be normalised; `t` is measured in units of `dir`. Embree needs a finite
 /// origin and direction, a non-zero direction and `0 <= tnear <= tfar` (`tfar` may be
 /// infinite); queries answer other rays with "no hit" / "not occluded" without tracing.
+///
+/// Laid out as the first 32 bytes of Embree's `RTCRay` (origin, tnear, direction, and
+/// `tfar` where `RTCRay` has `time`), so a query copies it into Embree's record with two
+/// 16-byte moves.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayQuery {
     pub origin: Vec3,
-    pub dir: Vec3,
     pub tnear: f32,
+    pub dir: Vec3,
     pub tfar: f32,
 }
+
+const _: () = {
+    use std::mem::{align_of, offset_of, size_of};
+    assert!(size_of::<RayQuery>() == 32 && align_of::<RayQuery>() == 4);
+    assert!(offset_of!(RayQuery, tnear) == 12);
+    assert!(offset_of!(RayQuery, dir) == 16);
+    assert!(offset_of!(RayQuery, tfar) == 28);
+};
 
 /// A closest hit. `ng` is Embree's unnormalised geometric normal; `u`, `v` are the
 /// barycentric coordinates for triangles.

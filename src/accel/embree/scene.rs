@@ -372,9 +372,12 @@ impl std::fmt::Debug for Scene {
 /// Rays Embree can take: finite origin and direction, non-zero direction,
 /// `0 <= tnear <= tfar` (tfar may be +inf). `rtcIntersect1(3)`: "The ray segment has to
 /// be in the range [0, ∞]". Others are answered "no hit" without calling Embree (NaN rays
-/// can make Embree traverse the whole tree; Debian does not build it with
-/// `EMBREE_IGNORE_INVALID_RAYS`).
-#[inline]
+/// can make Embree traverse the whole tree, and Debian's build asserts on a negative
+/// tnear; it is not built with `EMBREE_IGNORE_INVALID_RAYS`).
+///
+/// This is the rule as written; the queries compute it with vector instructions
+/// ([`write_ray`], [`fill_packet`]) and tests hold both to it.
+#[inline(always)]
 fn valid_ray(r: &RayQuery) -> bool {
     r.origin.is_finite()
         && r.dir.is_finite()
@@ -382,6 +385,67 @@ fn valid_ray(r: &RayQuery) -> bool {
         && r.tnear >= 0.0
         && r.tnear.is_finite()
         && r.tfar >= r.tnear
+}
+
+/// Writes Embree's record of one ray (all 48 bytes of an `RTCRay`: `time` 0, `mask` all
+/// bits, `id` and `flags` 0) and returns whether Embree may trace it ([`valid_ray`]).
+///
+/// On x86_64 this is two 16-byte loads of the [`RayQuery`] (whose layout is the start of
+/// `RTCRay`'s), the validity of all eight values tested in two vectors, and three 16-byte
+/// stores: about twenty instructions, which every single-ray query of a render pays.
+///
+/// # Safety
+/// `out` points to a writable `RTCRay` (16-byte aligned, as the type is).
+#[inline(always)]
+unsafe fn write_ray(r: &RayQuery, out: *mut sys::RTCRay) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE and SSE2 are part of the x86_64 baseline. RayQuery is repr(C) and 32
+        // bytes (asserted in mod.rs): the two unaligned loads read its [origin, tnear]
+        // and [dir, tfar] and nothing beyond. RTCRay is repr(C, align(16)), 48 bytes, with
+        // org_x..tnear at 0, dir_x..time at 16 and tfar, mask, id, flags at 32 (asserted
+        // in sys.rs): the three aligned stores write exactly the record the caller gave.
+        unsafe {
+            let p = (r as *const RayQuery).cast::<f32>();
+            let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(4)));
+            let xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+            // [dir, 0]: lane 3 becomes RTCRay's `time` (0, no motion blur).
+            let dir = _mm_and_ps(b, xyz);
+            // [tfar, mask = all bits, id = 0, flags = 0].
+            let tail = _mm_move_ss(
+                _mm_castsi128_ps(_mm_setr_epi32(0, -1, 0, 0)),
+                _mm_shuffle_ps(b, b, 0xff),
+            );
+            let q = out.cast::<f32>();
+            _mm_store_ps(q, a);
+            _mm_store_ps(q.add(4), dir);
+            _mm_store_ps(q.add(8), tail);
+            let zero = _mm_setzero_ps();
+            // x - x is 0 for a finite x and NaN for ±inf and NaN, and a NaN survives the
+            // sum (IEEE 754 §6.2): one compare tests origin, tnear and direction.
+            let finite = _mm_cmpeq_ps(_mm_add_ps(_mm_sub_ps(a, a), _mm_sub_ps(dir, dir)), zero);
+            // Lane 3: tnear >= 0 and tfar >= tnear; lanes 0-2 pass.
+            let segment = _mm_or_ps(_mm_and_ps(_mm_cmpge_ps(a, zero), _mm_cmpge_ps(b, a)), xyz);
+            (_mm_movemask_ps(_mm_and_ps(finite, segment)) == 0xf)
+                & (_mm_movemask_ps(_mm_cmpneq_ps(dir, zero)) != 0)
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        // SAFETY: the caller guarantees `out`.
+        unsafe { out.write(to_rtc_ray(r)) };
+        valid_ray(r)
+    }
+}
+
+impl RayQuery {
+    /// Whether Embree may trace this ray (finite origin and direction, non-zero
+    /// direction, `0 <= tnear <= tfar`); queries answer other rays without calling
+    /// Embree.
+    pub fn is_valid(&self) -> bool {
+        valid_ray(self)
+    }
 }
 
 /// The hit of a single-ray record after a query, or None if it missed.
@@ -397,6 +461,7 @@ fn hit_of(rh: &sys::RTCRayHit) -> Option<Hit> {
     })
 }
 
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 #[inline]
 fn to_rtc_ray(r: &RayQuery) -> sys::RTCRay {
     sys::RTCRay {
@@ -420,43 +485,159 @@ fn to_rtc_ray(r: &RayQuery) -> sys::RTCRay {
 #[derive(Default)]
 pub struct StreamScratch(Vec<sys::RTCRayHit>);
 
-/// Generates, for one packet width, the SoA packet builder and the closest-hit query
-/// `rtcIntersectW(3)`: lanes whose bit in `active` is 0 (or whose ray is invalid) are
-/// inactive and get None.
-macro_rules! packet_query {
-    ($(#[$doc:meta])* $name:ident, $each:ident, $build:ident, $w:literal, $mask:ty,
-     $valid:ident, $ray:ident, $hit:ident, $rayhit:ident, $sysfn:ident) => {
-        /// Fills the SoA packet `p` and the valid mask in place (a packet is up to 768
-        /// bytes; returning it by value cost a memcpy per query); false if no lane is
-        /// active. Every lane is copied and only the mask depends on the lane's validity,
-        /// so the copy has no branches (Embree reads no field of an inactive lane).
-        #[inline]
-        fn $build(
-            rays: &[RayQuery; $w],
-            active: $mask,
-            valid: &mut sys::$valid,
-            p: &mut sys::$ray,
-        ) -> bool {
-            let mut any = false;
-            for (i, r) in rays.iter().enumerate() {
-                let on = active & (1 << i) != 0 && valid_ray(r);
-                any |= on;
-                valid.0[i] = -(on as i32);
-                p.org_x[i] = r.origin.x;
-                p.org_y[i] = r.origin.y;
-                p.org_z[i] = r.origin.z;
-                p.tnear[i] = r.tnear;
-                p.dir_x[i] = r.dir.x;
-                p.dir_y[i] = r.dir.y;
-                p.dir_z[i] = r.dir.z;
-                p.tfar[i] = r.tfar;
-                p.mask[i] = u32::MAX;
-            }
-            any
-        }
+/// `RTCRayW`'s fields in order (rtcore_ray.h), each an array of W lanes.
+const RAY_FIELDS: usize = 12;
+/// `RTCHitW`'s leading float fields (`Ng_x`, `Ng_y`, `Ng_z`, `u`, `v`); the ID fields
+/// (`primID`, `geomID`, `instID`, and Embree 4's `instPrimID`) follow.
+const HIT_FLOAT_FIELDS: usize = 5;
 
+/// Writes every byte of the SoA ray packet `p` (an `RTCRayW`, [`RAY_FIELDS`] arrays of W
+/// lanes) and of the valid mask (W `int`s, -1 active, 0 inactive) from `rays`, and
+/// returns whether any lane is active. A lane is active when its bit in `active` is set
+/// and its ray is valid ([`valid_ray`]); Embree reads no field of an inactive lane.
+///
+/// On x86_64 each group of four rays is two 4×4 transposes of 16-byte loads (a ray's
+/// [origin, tnear] and [dir, tfar]) stored as whole vectors, with the four lanes'
+/// validity computed on the transposed vectors: about four instructions per ray and
+/// field group, no branch per lane. (The same transpose as `_MM_TRANSPOSE4_PS` in
+/// Intel's `xmmintrin.h`.)
+///
+/// # Safety
+/// `p` points to an `RTCRayW` and `valid` to W `i32`s, both aligned to 16 bytes and
+/// writable; W is a multiple of 4.
+#[inline(always)]
+unsafe fn fill_packet<const W: usize>(
+    rays: &[RayQuery; W],
+    active: u32,
+    p: *mut f32,
+    valid: *mut i32,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE and SSE2 are part of the x86_64 baseline. Loads read the W rays
+        // (32 bytes each, repr(C), asserted in mod.rs) and nothing beyond; stores write
+        // field f's lanes k..k+4 at `p + f·W + k`, inside the packet and 16-byte aligned
+        // since W and k are multiples of 4 (the caller guarantees `p` and `valid`).
+        unsafe {
+            let q = rays.as_ptr().cast::<f32>();
+            let zero = _mm_setzero_ps();
+            let ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
+            let lane_bits = _mm_setr_epi32(1, 2, 4, 8);
+            let mut any = _mm_setzero_ps();
+            let mut k = 0;
+            while k < W {
+                let r = q.add(8 * k);
+                let (a0, a1, a2, a3) = (
+                    _mm_loadu_ps(r),
+                    _mm_loadu_ps(r.add(8)),
+                    _mm_loadu_ps(r.add(16)),
+                    _mm_loadu_ps(r.add(24)),
+                );
+                let (b0, b1, b2, b3) = (
+                    _mm_loadu_ps(r.add(4)),
+                    _mm_loadu_ps(r.add(12)),
+                    _mm_loadu_ps(r.add(20)),
+                    _mm_loadu_ps(r.add(28)),
+                );
+                let transpose = |v0, v1, v2, v3| {
+                    let (t0, t1) = (_mm_unpacklo_ps(v0, v1), _mm_unpacklo_ps(v2, v3));
+                    let (t2, t3) = (_mm_unpackhi_ps(v0, v1), _mm_unpackhi_ps(v2, v3));
+                    (
+                        _mm_movelh_ps(t0, t1),
+                        _mm_movehl_ps(t1, t0),
+                        _mm_movelh_ps(t2, t3),
+                        _mm_movehl_ps(t3, t2),
+                    )
+                };
+                let (ox, oy, oz, tnear) = transpose(a0, a1, a2, a3);
+                let (dx, dy, dz, tfar) = transpose(b0, b1, b2, b3);
+                let fields = [ox, oy, oz, tnear, dx, dy, dz, zero, tfar, ones, zero, zero];
+                for (f, v) in fields.into_iter().enumerate() {
+                    _mm_store_ps(p.add(f * W + k), v);
+                }
+                // valid_ray, four lanes at once: x - x is 0 for a finite x and NaN for
+                // ±inf and NaN, and a NaN survives the sum (IEEE 754 §6.2).
+                let d = |v| _mm_sub_ps(v, v);
+                let sum = _mm_add_ps(
+                    _mm_add_ps(_mm_add_ps(d(ox), d(oy)), _mm_add_ps(d(oz), d(tnear))),
+                    _mm_add_ps(_mm_add_ps(d(dx), d(dy)), d(dz)),
+                );
+                let nonzero = _mm_or_ps(
+                    _mm_or_ps(_mm_cmpneq_ps(dx, zero), _mm_cmpneq_ps(dy, zero)),
+                    _mm_cmpneq_ps(dz, zero),
+                );
+                let ok = _mm_and_ps(
+                    _mm_and_ps(_mm_cmpeq_ps(sum, zero), nonzero),
+                    _mm_and_ps(_mm_cmpge_ps(tnear, zero), _mm_cmpge_ps(tfar, tnear)),
+                );
+                let bits = _mm_and_si128(_mm_set1_epi32((active >> k) as i32), lane_bits);
+                let on = _mm_and_ps(ok, _mm_castsi128_ps(_mm_cmpeq_epi32(bits, lane_bits)));
+                _mm_store_ps(valid.add(k).cast::<f32>(), on);
+                any = _mm_or_ps(any, on);
+                k += 4;
+            }
+            _mm_movemask_ps(any) != 0
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let mut any = false;
+        for (i, r) in rays.iter().enumerate() {
+            let lane = [
+                r.origin.x, r.origin.y, r.origin.z, r.tnear, r.dir.x, r.dir.y, r.dir.z, 0.0, r.tfar,
+            ];
+            for (f, v) in lane.into_iter().enumerate() {
+                // SAFETY: field f, lane i of the packet the caller guarantees.
+                unsafe { p.add(f * W + i).write(v) };
+            }
+            for (f, v) in [u32::MAX, 0, 0].into_iter().enumerate() {
+                // SAFETY: as above (mask, id, flags).
+                unsafe { p.add((9 + f) * W + i).cast::<u32>().write(v) };
+            }
+            let on = (active >> i) & 1 != 0 && valid_ray(r);
+            // SAFETY: lane i of the mask the caller guarantees.
+            unsafe { valid.add(i).write(-(on as i32)) };
+            any |= on;
+        }
+        any
+    }
+}
+
+/// Writes every byte of the SoA hit packet `h` (an `RTCHitW` of `bytes` bytes) as
+/// `rtcIntersectW(3)` requires before the call: the float fields 0, the ID fields
+/// (`primID`, `geomID`, instance IDs) `RTC_INVALID_GEOMETRY_ID`.
+///
+/// # Safety
+/// `h` points to a writable `RTCHitW` of `bytes` bytes, aligned to 16; W is a multiple
+/// of 4.
+#[inline(always)]
+unsafe fn clear_hits<const W: usize>(h: *mut u32, bytes: usize) {
+    let fields = bytes / (4 * W);
+    for f in 0..fields {
+        let v = if f < HIT_FLOAT_FIELDS {
+            0
+        } else {
+            sys::RTC_INVALID_GEOMETRY_ID
+        };
+        for i in 0..W {
+            // SAFETY: field f, lane i, inside the `bytes` the caller guarantees.
+            unsafe { h.add(f * W + i).write(v) };
+        }
+    }
+}
+
+/// Generates, for one packet width, the closest-hit query `rtcIntersectW(3)` and the
+/// occlusion query `rtcOccludedW(3)`: lanes whose bit in `active` is 0 (or whose ray is
+/// invalid) are inactive and get None / not occluded.
+macro_rules! packet_query {
+    ($(#[$doc:meta])* $name:ident, $each:ident, $occluded:ident, $w:literal, $mask:ty,
+     $valid:ident, $ray:ident, $hit:ident, $rayhit:ident, $isect:ident, $occl:ident) => {
         /// Calls `f(lane, hit)` for every active lane that hits, in lane order; the
         /// cheapest form of the packet query, since no `Option` is built for a miss.
+        ///
+        /// The packet (up to 1.3 kB) is built in place, every byte written once: no
+        /// zeroing, no copies, no allocation.
         #[inline]
         pub fn $each(
             &self,
@@ -465,21 +646,43 @@ macro_rules! packet_query {
             coherence: RayCoherence,
             mut f: impl FnMut(usize, Hit),
         ) {
-            let mut valid = sys::$valid::default();
-            let mut rh = sys::$rayhit {
-                ray: sys::$ray::default(),
-                hit: sys::$hit::invalid(),
+            let mut valid = std::mem::MaybeUninit::<sys::$valid>::uninit();
+            let mut rh = std::mem::MaybeUninit::<sys::$rayhit>::uninit();
+            let rp = rh.as_mut_ptr();
+            // SAFETY: `rh` and `valid` are aligned to the packet width (≥ 16 bytes) and
+            // W is 4, 8 or 16. `fill_packet` writes all of the ray packet and the mask,
+            // `clear_hits` all of the hit packet (RTCRayHitW has no padding: the ray is
+            // 48·W bytes, the hit 32·W or 36·W, and the alignment is 4·W), so both are
+            // initialised afterwards.
+            let (valid, mut rh) = unsafe {
+                let any = fill_packet::<$w>(
+                    rays,
+                    active as u32,
+                    std::ptr::addr_of_mut!((*rp).ray).cast::<f32>(),
+                    valid.as_mut_ptr().cast::<i32>(),
+                );
+                if !any {
+                    return;
+                }
+                clear_hits::<$w>(
+                    std::ptr::addr_of_mut!((*rp).hit).cast::<u32>(),
+                    std::mem::size_of::<sys::$hit>(),
+                );
+                (valid.assume_init(), rh.assume_init())
             };
-            if !Self::$build(rays, active, &mut valid, &mut rh.ray) {
-                return;
-            }
+            const _: () = assert!(std::mem::size_of::<sys::$ray>() == RAY_FIELDS * 4 * $w);
+            const _: () = assert!(
+                std::mem::size_of::<sys::$rayhit>()
+                    == std::mem::size_of::<sys::$ray>() + std::mem::size_of::<sys::$hit>()
+            );
+            let coherent = coherence == RayCoherence::Coherent;
             // SAFETY: committed, unmodified scene; `valid` and `rh` are aligned to the
             // packet width, valid and exclusive for the call.
-            unsafe {
-                sys::$sysfn(&valid, self.raw, &mut rh, coherence == RayCoherence::Coherent)
-            };
+            unsafe { sys::$isect(&valid, self.raw, &mut rh, coherent) };
+            // Embree writes hit lanes only, so a lane that is inactive or missed still
+            // holds the invalid geometry ID.
             for i in 0..$w {
-                if valid.0[i] != 0 && rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID {
+                if rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID {
                     f(
                         i,
                         Hit {
@@ -506,6 +709,36 @@ macro_rules! packet_query {
             self.$each(rays, active, coherence, |i, h| out[i] = Some(h));
             out
         }
+
+        /// A bit mask of the active lanes that are occluded (`rtcOccludedW(3)`, which
+        /// sets `tfar = -inf` on occluded lanes), with an explicit coherence hint.
+        pub fn $occluded(&self, rays: &[RayQuery; $w], active: $mask, coherence: RayCoherence) -> $mask {
+            let mut valid = std::mem::MaybeUninit::<sys::$valid>::uninit();
+            let mut ray = std::mem::MaybeUninit::<sys::$ray>::uninit();
+            // SAFETY: as in the closest-hit query; `fill_packet` writes all of the ray
+            // packet and the mask.
+            let (valid, mut ray) = unsafe {
+                let any = fill_packet::<$w>(
+                    rays,
+                    active as u32,
+                    ray.as_mut_ptr().cast::<f32>(),
+                    valid.as_mut_ptr().cast::<i32>(),
+                );
+                if !any {
+                    return 0;
+                }
+                (valid.assume_init(), ray.assume_init())
+            };
+            let coherent = coherence == RayCoherence::Coherent;
+            // SAFETY: committed, unmodified scene; `valid` and `ray` are aligned to the
+            // packet width, valid and exclusive for the call.
+            unsafe { sys::$occl(&valid, self.raw, &mut ray, coherent) };
+            let mut m: $mask = 0;
+            for i in 0..$w {
+                m |= (((valid.0[i] != 0) & (ray.tfar[i] == f32::NEG_INFINITY)) as $mask) << i;
+            }
+            m
+        }
     };
 }
 
@@ -522,16 +755,22 @@ impl Scene {
 
     /// [`Scene::intersect1`] with an explicit coherence hint for the intersect context.
     pub fn intersect1_with(&self, ray: &RayQuery, coherence: RayCoherence) -> Option<Hit> {
-        if !valid_ray(ray) {
-            return None;
-        }
+        let mut r = std::mem::MaybeUninit::<sys::RTCRay>::uninit();
+        // SAFETY: `write_ray` writes the whole aligned record.
+        let record = unsafe {
+            if !write_ray(ray, r.as_mut_ptr()) {
+                return None;
+            }
+            r.assume_init()
+        };
         let mut rh = sys::RTCRayHit {
-            ray: to_rtc_ray(ray),
+            ray: record,
             hit: sys::RTCHit::invalid(),
         };
+        let coherent = coherence == RayCoherence::Coherent;
         // SAFETY: `self.raw` is a committed scene that nothing modifies (see the Send/Sync
         // impls); `rh` is a valid, aligned, exclusive ray/hit record.
-        unsafe { sys::intersect1(self.raw, &mut rh, coherence == RayCoherence::Coherent) };
+        unsafe { sys::intersect1(self.raw, &mut rh, coherent) };
         hit_of(&rh)
     }
 
@@ -545,12 +784,17 @@ impl Scene {
 
     /// [`Scene::occluded1`] with an explicit coherence hint.
     pub fn occluded1_with(&self, ray: &RayQuery, coherence: RayCoherence) -> bool {
-        if !valid_ray(ray) {
-            return false;
-        }
-        let mut r = to_rtc_ray(ray);
+        let mut r = std::mem::MaybeUninit::<sys::RTCRay>::uninit();
+        // SAFETY: `write_ray` writes the whole aligned record.
+        let mut r = unsafe {
+            if !write_ray(ray, r.as_mut_ptr()) {
+                return false;
+            }
+            r.assume_init()
+        };
+        let coherent = coherence == RayCoherence::Coherent;
         // SAFETY: as in intersect1_with.
-        unsafe { sys::occluded1(self.raw, &mut r, coherence == RayCoherence::Coherent) };
+        unsafe { sys::occluded1(self.raw, &mut r, coherent) };
         r.tfar == f32::NEG_INFINITY
     }
 
@@ -564,15 +808,18 @@ impl Scene {
 
     packet_query!(
         /// [`Scene::intersect8`] with an explicit coherence hint.
-        intersect8_with, intersect8_each, packet8, 8, u8, ValidMask8, RTCRay8, RTCHit8, RTCRayHit8, intersect8
+        intersect8_with, intersect8_each, occluded8_with, 8, u8, ValidMask8, RTCRay8, RTCHit8,
+        RTCRayHit8, intersect8, occluded8
     );
     packet_query!(
         /// 4-wide packet (`rtcIntersect4(3)`), as [`Scene::intersect8_with`].
-        intersect4_with, intersect4_each, packet4, 4, u8, ValidMask4, RTCRay4, RTCHit4, RTCRayHit4, intersect4
+        intersect4_with, intersect4_each, occluded4_with, 4, u8, ValidMask4, RTCRay4, RTCHit4,
+        RTCRayHit4, intersect4, occluded4
     );
     packet_query!(
         /// 16-wide packet (`rtcIntersect16(3)`), as [`Scene::intersect8_with`].
-        intersect16_with, intersect16_each, packet16, 16, u16, ValidMask16, RTCRay16, RTCHit16, RTCRayHit16, intersect16
+        intersect16_with, intersect16_each, occluded16_with, 16, u16, ValidMask16, RTCRay16,
+        RTCHit16, RTCRayHit16, intersect16, occluded16
     );
 
     /// Closest hits of a stream of single rays with Embree 3's stream API
@@ -587,27 +834,54 @@ impl Scene {
         hits: &mut [Option<Hit>],
     ) -> bool {
         assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        let records = &mut scratch.0;
-        records.clear();
-        records.extend(rays.iter().map(|r| {
-            let mut ray = to_rtc_ray(r);
-            if !valid_ray(r) {
-                // An empty segment: Embree reports no hit for it.
-                ray.tnear = 0.0;
-                ray.tfar = -1.0;
-            }
-            sys::RTCRayHit {
-                ray,
-                hit: sys::RTCHit::invalid(),
-            }
-        }));
-        // SAFETY: committed, unmodified scene; the records are valid, aligned and
-        // exclusive for the call.
-        if !unsafe { sys::intersect1m(self.raw, records, coherence == RayCoherence::Coherent) } {
+        if !sys::STREAM_API {
             return false;
         }
-        for (h, rh) in hits.iter_mut().zip(records.iter()) {
-            *h = hit_of(rh);
+        hits.fill(None);
+        self.intersect_stream_each(rays, coherence, scratch, |i, h| hits[i] = Some(h))
+    }
+
+    /// [`Scene::intersect_stream`] calling `f(index, hit)` for every ray that hits, in
+    /// order, straight from Embree's records (no `Option` per ray), as the packet
+    /// queries' `intersectW_each`. Invalid rays get an empty segment (`tnear 0`,
+    /// `tfar -1`), for which Embree reports no hit.
+    pub fn intersect_stream_each(
+        &self,
+        rays: &[RayQuery],
+        coherence: RayCoherence,
+        scratch: &mut StreamScratch,
+        mut f: impl FnMut(usize, Hit),
+    ) -> bool {
+        if !sys::STREAM_API {
+            return false;
+        }
+        let records = &mut scratch.0;
+        if records.len() < rays.len() {
+            records.resize(
+                rays.len(),
+                sys::RTCRayHit {
+                    ray: sys::RTCRay::default(),
+                    hit: sys::RTCHit::invalid(),
+                },
+            );
+        }
+        let records = &mut records[..rays.len()];
+        for (rec, r) in records.iter_mut().zip(rays) {
+            // SAFETY: `rec.ray` is an aligned, exclusive RTCRay.
+            if !unsafe { write_ray(r, &mut rec.ray) } {
+                rec.ray.tnear = 0.0;
+                rec.ray.tfar = -1.0;
+            }
+            rec.hit = sys::RTCHit::invalid();
+        }
+        let coherent = coherence == RayCoherence::Coherent;
+        // SAFETY: committed, unmodified scene; the records are valid, aligned and
+        // exclusive for the call.
+        unsafe { sys::intersect1m(self.raw, records, coherent) };
+        for (i, rec) in records.iter().enumerate() {
+            if let Some(h) = hit_of(rec) {
+                f(i, h);
+            }
         }
         true
     }
@@ -617,16 +891,7 @@ impl Scene {
     /// `rtcOccluded8(3)` with a COHERENT context; occluded lanes come back with
     /// `tfar = -inf`.
     pub fn occluded8(&self, rays: &[RayQuery; 8], active: u8) -> u8 {
-        let mut valid = sys::ValidMask8::default();
-        let mut ray = sys::RTCRay8::default();
-        if !Self::packet8(rays, active, &mut valid, &mut ray) {
-            return 0;
-        }
-        // SAFETY: as in intersect8.
-        unsafe { sys::occluded8(&valid, self.raw, &mut ray, true) };
-        (0..8)
-            .filter(|&i| valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY)
-            .fold(0u8, |m, i| m | (1 << i))
+        self.occluded8_with(rays, active, RayCoherence::Coherent)
     }
 
     /// Number of geometries; IDs are `0..geometry_count()`.

@@ -474,6 +474,20 @@ mod embree3_queries {
             context: *mut RTCIntersectContext,
             rayhit: *mut RTCRayHit4,
         );
+        /// `rtcOccluded4(3)`.
+        pub fn rtcOccluded4(
+            valid: *const i32,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            ray: *mut RTCRay4,
+        );
+        /// `rtcOccluded16(3)`.
+        pub fn rtcOccluded16(
+            valid: *const i32,
+            scene: RTCScene,
+            context: *mut RTCIntersectContext,
+            ray: *mut RTCRay16,
+        );
         /// `rtcIntersect16(3)`: packet 64-byte aligned.
         pub fn rtcIntersect16(
             valid: *const i32,
@@ -520,6 +534,9 @@ mod embree3_queries {
         // SAFETY: as in `intersect1`; the packet and the mask are align(64).
         unsafe { rtcIntersect16(valid.0.as_ptr(), scene, &mut ctx, rayhit) }
     }
+
+    /// Whether the library has the stream API (`rtcIntersect1M`): Embree 3 does.
+    pub const STREAM_API: bool = true;
 
     /// Closest hits of a stream of single rays (Embree 3's stream API); returns true.
     ///
@@ -599,6 +616,36 @@ mod embree3_queries {
         // SAFETY: as in `intersect8`.
         unsafe { rtcOccluded8(valid.0.as_ptr(), scene, &mut ctx, ray) }
     }
+
+    /// Occlusion of a 4-ray packet.
+    ///
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn occluded4(
+        valid: &ValidMask4,
+        scene: RTCScene,
+        ray: &mut RTCRay4,
+        coherent: bool,
+    ) {
+        let mut ctx = context(coherent);
+        // SAFETY: as in `intersect4`.
+        unsafe { rtcOccluded4(valid.0.as_ptr(), scene, &mut ctx, ray) }
+    }
+
+    /// Occlusion of a 16-ray packet.
+    ///
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn occluded16(
+        valid: &ValidMask16,
+        scene: RTCScene,
+        ray: &mut RTCRay16,
+        coherent: bool,
+    ) {
+        let mut ctx = context(coherent);
+        // SAFETY: as in `intersect16`.
+        unsafe { rtcOccluded16(valid.0.as_ptr(), scene, &mut ctx, ray) }
+    }
 }
 
 /// Embree 4 (tested with 4.4): `rtcIntersect1(scene, rayhit, args)` etc., with
@@ -636,6 +683,18 @@ mod embree4_queries {
             rayhit: *mut RTCRayHit16,
             args: *mut c_void,
         );
+        pub fn rtcOccluded4(
+            valid: *const i32,
+            scene: RTCScene,
+            ray: *mut RTCRay4,
+            args: *mut c_void,
+        );
+        pub fn rtcOccluded16(
+            valid: *const i32,
+            scene: RTCScene,
+            ray: *mut RTCRay16,
+            args: *mut c_void,
+        );
     }
 
     /// # Safety
@@ -661,6 +720,9 @@ mod embree4_queries {
         // SAFETY: as in `intersect1`; the packet and the mask are align(64).
         unsafe { rtcIntersect16(valid.0.as_ptr(), scene, rayhit, std::ptr::null_mut()) }
     }
+
+    /// Whether the library has the stream API: Embree 4 removed it.
+    pub const STREAM_API: bool = false;
 
     /// Embree 4 removed the stream API (`rtcIntersect1M` and friends): returns false and
     /// leaves the records untouched.
@@ -712,5 +774,29 @@ mod embree4_queries {
     ) {
         // SAFETY: as in `intersect8`.
         unsafe { rtcOccluded8(valid.0.as_ptr(), scene, ray, std::ptr::null_mut()) }
+    }
+
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn occluded4(
+        valid: &ValidMask4,
+        scene: RTCScene,
+        ray: &mut RTCRay4,
+        _coherent: bool,
+    ) {
+        // SAFETY: as in `intersect4`.
+        unsafe { rtcOccluded4(valid.0.as_ptr(), scene, ray, std::ptr::null_mut()) }
+    }
+
+    /// # Safety
+    /// As [`intersect1`].
+    pub unsafe fn occluded16(
+        valid: &ValidMask16,
+        scene: RTCScene,
+        ray: &mut RTCRay16,
+        _coherent: bool,
+    ) {
+        // SAFETY: as in `intersect16`.
+        unsafe { rtcOccluded16(valid.0.as_ptr(), scene, ray, std::ptr::null_mut()) }
     }
 }
