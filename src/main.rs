@@ -340,6 +340,21 @@ enum BenchCommand {
     /// Write the deterministic procedural test mesh (a bumpy sphere of 2·N² triangles,
     /// the one the criterion traversal bench uses) as OBJ, for side-by-side runs with
     /// Embree's own viewer.
+    /// Record every query a render sends to Embree (rendered on one thread, so in the
+    /// render's own order) to a ray log, for `heron bench replay`.
+    Record(RecordArgs),
+    /// Replay a ray log through a raw-Embree C program and through heron's wrapper,
+    /// interleaved, checking that both find what the render found.
+    Replay {
+        /// The ray log (`heron bench record`).
+        log: PathBuf,
+        /// Timed replays of each (after one warm-up); the table reports medians.
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+        rounds: u32,
+    },
+    /// Record a render's rays, then time the render (one thread) against the raw-Embree
+    /// replay of those rays, interleaved: how far heron is from Embree's own speed.
+    Limit(LimitArgs),
     Mesh {
         /// Grid resolution N; 708 gives about one million triangles.
         #[arg(long, default_value_t = 708, value_parser = clap::value_parser!(u32).range(4..=8192))]
@@ -348,6 +363,44 @@ enum BenchCommand {
         #[arg(short, long)]
         output: PathBuf,
     },
+}
+
+/// The render a ray log records.
+#[derive(clap::Args)]
+struct RecordedRender {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Samples per pixel (overrides the scene's render.spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Random seed (overrides the scene's render.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Integrator (overrides the scene's render.integrator).
+    #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
+    integrator: Option<String>,
+}
+
+#[derive(clap::Args)]
+struct RecordArgs {
+    #[command(flatten)]
+    render: RecordedRender,
+    /// Output ray log (.rays).
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct LimitArgs {
+    #[command(flatten)]
+    render: RecordedRender,
+    /// Timed rounds of the render and the replays (after one warm-up); the table reports
+    /// medians.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    rounds: u32,
+    /// Keep the ray log in this file (.rays; default: a temporary file, removed).
+    #[arg(long)]
+    keep: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -787,6 +840,9 @@ fn main() {
         Command::Trace(args) => cmd_trace(args),
         Command::Converge(args) => cmd_converge(args),
         Command::Bench(BenchCommand::Traversal(args)) => cmd_bench_traversal(args),
+        Command::Bench(BenchCommand::Record(args)) => cmd_bench_record(args),
+        Command::Bench(BenchCommand::Replay { log, rounds }) => cmd_bench_replay(&log, rounds),
+        Command::Bench(BenchCommand::Limit(args)) => cmd_bench_limit(args),
         Command::Bench(BenchCommand::Mesh { n, output }) => {
             heron::bench::write_obj(&heron::bench::procedural_mesh(n), &output).map_err(Into::into)
         }
@@ -1171,6 +1227,85 @@ fn cmd_trace(a: TraceArgs) -> Result<()> {
         &choices,
     )?;
     println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(())
+}
+
+/// The scene and render options of a recorded render.
+fn recorded_render(r: &RecordedRender) -> Result<(heron::scene::Scene, RenderOptions)> {
+    let settings_args = SettingsArgs {
+        spp: r.spp.map(i64::from),
+        seed: r.seed,
+        integrator: r.integrator.as_deref(),
+        ..Default::default()
+    };
+    settings_args.check().map_err(anyhow::Error::msg)?;
+    let scene = load_scene(&r.scene)?;
+    let mut opts = RenderOptions::from_scene(&scene);
+    opts.settings
+        .apply(&settings_args)
+        .map_err(anyhow::Error::msg)?;
+    opts.threads = 1;
+    Ok((scene, opts))
+}
+
+fn recorded_title(r: &RecordedRender, opts: &RenderOptions) -> String {
+    format!(
+        "{}, {}, {} spp, one thread, Embree {}",
+        r.scene.display(),
+        opts.settings.integrator.name(),
+        opts.settings.spp,
+        heron::accel::embree::Device::new("")
+            .map(|d| {
+                let (a, b, c) = d.version();
+                format!("{a}.{b}.{c}")
+            })
+            .unwrap_or_else(|_| "?".into())
+    )
+}
+
+fn cmd_bench_record(a: RecordArgs) -> Result<()> {
+    check_output(&a.output, &["rays"])?;
+    let (scene, opts) = recorded_render(&a.render)?;
+    let (file, counted) = heron::bench::limit::record(&scene, &opts)?;
+    file.write(&a.output)?;
+    let t = file.log.tally;
+    println!("# {}", recorded_title(&a.render, &opts));
+    println!(
+        "rays {} (the render counted {counted}), calls {}, hits {}, occluded {}: {}",
+        t.rays,
+        t.calls,
+        t.hits,
+        t.occluded,
+        a.output.display()
+    );
+    Ok(())
+}
+
+fn cmd_bench_replay(log: &Path, rounds: u32) -> Result<()> {
+    let r = heron::bench::limit::replay(log, rounds)?;
+    println!(
+        "# ray log {}, replayed on one thread, median of {rounds} rounds",
+        log.display()
+    );
+    print!("{}", r.text());
+    Ok(())
+}
+
+fn cmd_bench_limit(a: LimitArgs) -> Result<()> {
+    if let Some(k) = &a.keep {
+        if k.extension().and_then(|e| e.to_str()) != Some("rays") {
+            bail!("--keep {}: expected a path ending in .rays", k.display());
+        }
+    }
+    let (scene, opts) = recorded_render(&a.render)?;
+    let r = heron::bench::limit::limit(&scene, &opts, a.keep.as_deref(), a.rounds)?;
+    println!(
+        "# {}, median of {} rounds; the render counted {} rays",
+        recorded_title(&a.render, &opts),
+        a.rounds,
+        r.counted_rays
+    );
+    print!("{}", r.text());
     Ok(())
 }
 

@@ -1,11 +1,12 @@
-/* heron's raw-Embree traversal benchmark (`heron bench traversal` builds it with gcc).
+/* heron's raw-Embree program (`heron bench traversal --raw`, `heron bench replay` and
+ * `heron bench limit` build it with gcc).
  *
- * It traces the rays heron wrote out, on the mesh heron wrote out, through Embree's C
- * API with nothing around it, so that heron's time on the same rays, in the same packet
- * grouping and with the same scene flags, can be reported as a ratio: heron's FFI
- * overhead. Embree's declarations are written here by hand (as heron's are in
- * src/accel/embree/sys.rs) so the program builds without headers, against Debian's
- * Embree 3 or the header-less Embree 4 of the embreex wheel (-DHERON_EMBREE4).
+ * It traces rays heron wrote out, on geometry heron wrote out, through Embree's C API
+ * with nothing around it, so that heron's time on the same rays, in the same packet
+ * grouping and with the same scene flags, can be reported as a ratio. Embree's
+ * declarations are written here by hand (as heron's are in src/accel/embree/sys.rs) so
+ * the program builds without headers, against Debian's Embree 3 or the header-less
+ * Embree 4 of the embreex wheel (-DHERON_EMBREE4).
  *
  *   embree_raw MESH RAYS_COHERENT RAYS_INCOHERENT
  *
@@ -15,6 +16,14 @@
  * API; SET 0 coherent, 1 incoherent) and answers each with one pass over the set:
  * "NANOSECONDS HITS PRIMID_SUM TFAR_SUM", or "unavailable" (the stream API on Embree 4).
  * "quit" ends it.
+ *
+ *   embree_raw --replay RAYLOG
+ *
+ * RAYLOG: a ray log of `heron bench record` (src/bench/limit.rs describes the file;
+ * heron has checked it before starting this program): the scene's geometry, then the
+ * calls a render made, each an 8-byte header (op, coherent, valid lanes, ray count) and
+ * its rays. After "ready" each "replay" makes every call again, in order, and answers
+ * "NANOSECONDS CALLS RAYS HITS PRIMID_SUM TFAR_SUM OCCLUDED"; "quit" ends it.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <stdint.h>
@@ -29,9 +38,9 @@ typedef struct RTCSceneTy *RTCScene;
 typedef struct RTCGeometryTy *RTCGeometry;
 
 #define RTC_INVALID_GEOMETRY_ID ((unsigned)-1)
-enum { RTC_GEOMETRY_TYPE_TRIANGLE = 0 };
+enum { RTC_GEOMETRY_TYPE_TRIANGLE = 0, RTC_GEOMETRY_TYPE_SPHERE_POINT = 50 };
 enum { RTC_BUFFER_TYPE_INDEX = 0, RTC_BUFFER_TYPE_VERTEX = 1 };
-enum { RTC_FORMAT_UINT3 = 0x5003, RTC_FORMAT_FLOAT3 = 0x9003 };
+enum { RTC_FORMAT_UINT3 = 0x5003, RTC_FORMAT_FLOAT3 = 0x9003, RTC_FORMAT_FLOAT4 = 0x9004 };
 enum { RTC_SCENE_FLAG_ROBUST = 1 << 2 };
 enum { RTC_BUILD_QUALITY_HIGH = 2 };
 
@@ -93,12 +102,21 @@ PACKET(16, 64)
 #ifdef HERON_EMBREE4
 /* Embree 4: no context; NULL arguments are the defaults of rtcInitIntersectArguments. */
 void rtcIntersect1(RTCScene, struct RTCRayHit *, void *args);
+void rtcOccluded1(RTCScene, struct RTCRay *, void *args);
 void rtcIntersect4(const int *, RTCScene, struct RTCRayHit4 *, void *args);
 void rtcIntersect8(const int *, RTCScene, struct RTCRayHit8 *, void *args);
 void rtcIntersect16(const int *, RTCScene, struct RTCRayHit16 *, void *args);
-#define CTX_DECL(coherent) (void)(coherent)
-#define I1(s, rh) rtcIntersect1(s, rh, NULL)
-#define IN(W, v, s, rh) rtcIntersect##W(v, s, rh, NULL)
+void rtcOccluded4(const int *, RTCScene, struct RTCRay4 *, void *args);
+void rtcOccluded8(const int *, RTCScene, struct RTCRay8 *, void *args);
+void rtcOccluded16(const int *, RTCScene, struct RTCRay16 *, void *args);
+typedef struct {
+    int unused;
+} Ctx;
+static inline void ctx_init(Ctx *c, int coherent) { (void)c; (void)coherent; }
+#define I1(s, c, rh) ((void)(c), rtcIntersect1(s, rh, NULL))
+#define O1(s, c, r) ((void)(c), rtcOccluded1(s, r, NULL))
+#define IN(W, v, s, c, rh) ((void)(c), rtcIntersect##W(v, s, rh, NULL))
+#define ON(W, v, s, c, r) ((void)(c), rtcOccluded##W(v, s, r, NULL))
 #else
 /* Embree 3 with RTC_MAX_INSTANCE_LEVEL_COUNT 1 and RTC_MIN_WIDTH 0 (Debian's build). */
 struct RTCIntersectContext {
@@ -106,20 +124,34 @@ struct RTCIntersectContext {
     void *filter;
     unsigned instID[1];
 };
-void rtcIntersect1(RTCScene, struct RTCIntersectContext *, struct RTCRayHit *);
-void rtcIntersect4(const int *, RTCScene, struct RTCIntersectContext *, struct RTCRayHit4 *);
-void rtcIntersect8(const int *, RTCScene, struct RTCIntersectContext *, struct RTCRayHit8 *);
-void rtcIntersect16(const int *, RTCScene, struct RTCIntersectContext *, struct RTCRayHit16 *);
-void rtcIntersect1M(RTCScene, struct RTCIntersectContext *, struct RTCRayHit *, unsigned M,
-                    size_t byteStride);
+typedef struct RTCIntersectContext Ctx;
+void rtcIntersect1(RTCScene, Ctx *, struct RTCRayHit *);
+void rtcOccluded1(RTCScene, Ctx *, struct RTCRay *);
+void rtcIntersect4(const int *, RTCScene, Ctx *, struct RTCRayHit4 *);
+void rtcIntersect8(const int *, RTCScene, Ctx *, struct RTCRayHit8 *);
+void rtcIntersect16(const int *, RTCScene, Ctx *, struct RTCRayHit16 *);
+void rtcOccluded4(const int *, RTCScene, Ctx *, struct RTCRay4 *);
+void rtcOccluded8(const int *, RTCScene, Ctx *, struct RTCRay8 *);
+void rtcOccluded16(const int *, RTCScene, Ctx *, struct RTCRay16 *);
+void rtcIntersect1M(RTCScene, Ctx *, struct RTCRayHit *, unsigned M, size_t byteStride);
 /* rtcInitIntersectContext: INCOHERENT (0) or COHERENT (1), no filter. */
-#define CTX_DECL(coherent)                                                                \
-    struct RTCIntersectContext ctx = {(coherent) ? 1 : 0, NULL, {RTC_INVALID_GEOMETRY_ID}}
-#define I1(s, rh) rtcIntersect1(s, &ctx, rh)
-#define IN(W, v, s, rh) rtcIntersect##W(v, s, &ctx, rh)
+static inline void ctx_init(Ctx *c, int coherent) {
+    c->flags = coherent ? 1 : 0;
+    c->filter = NULL;
+    c->instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+#define I1(s, c, rh) rtcIntersect1(s, c, rh)
+#define O1(s, c, r) rtcOccluded1(s, c, r)
+#define IN(W, v, s, c, rh) rtcIntersect##W(v, s, c, rh)
+#define ON(W, v, s, c, r) rtcOccluded##W(v, s, c, r)
 #endif
 
-/* heron's stream chunk (src/bench/mod.rs STREAM_CHUNK). */
+/* One function per benchmark pass, never inlined, so that scripts/callgrind_traversal.sh
+ * can count each pass's instructions (as heron's HeronTracer::trace). */
+#define NOINLINE __attribute__((noinline))
+
+/* heron's stream chunk (src/bench/mod.rs STREAM_CHUNK); a logged stream is longer at
+ * most by heron's own chunking, which the replay keeps. */
 #define STREAM_CHUNK 256
 
 typedef struct {
@@ -127,7 +159,7 @@ typedef struct {
 } Ray;
 
 typedef struct {
-    uint64_t hits, prim_sum;
+    uint64_t calls, rays, hits, prim_sum, occluded;
     double t_sum;
 } Tally;
 
@@ -160,7 +192,7 @@ static Ray *read_rays(const char *path, uint32_t *count) {
     return rays;
 }
 
-static void tally(Tally *t, unsigned geom, unsigned prim, float tfar) {
+static inline void tally_hit(Tally *t, unsigned geom, unsigned prim, float tfar) {
     if (geom != RTC_INVALID_GEOMETRY_ID) {
         t->hits++;
         t->prim_sum += prim;
@@ -168,83 +200,283 @@ static void tally(Tally *t, unsigned geom, unsigned prim, float tfar) {
     }
 }
 
-static void set_ray(struct RTCRay *r, const Ray *q) {
+static inline void set_ray(struct RTCRay *r, const Ray *q) {
     r->org_x = q->o[0]; r->org_y = q->o[1]; r->org_z = q->o[2]; r->tnear = q->tnear;
     r->dir_x = q->d[0]; r->dir_y = q->d[1]; r->dir_z = q->d[2]; r->time = 0.0f;
     r->tfar = q->tfar; r->mask = ~0u; r->id = 0; r->flags = 0;
 }
 
-static void set_hit(struct RTCHit *h) {
+static inline void set_hit(struct RTCHit *h) {
     memset(h, 0, sizeof *h);
     h->geomID = h->primID = h->instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
-#define TRACE_PACKETS(W)                                                                  \
-    static void trace##W(RTCScene s, const Ray *rays, uint32_t n, int coherent, Tally *t) { \
-        CTX_DECL(coherent);                                                               \
-        for (uint32_t b = 0; b < n; b += W) {                                             \
-            struct RTCRayHit##W rh;                                                       \
-            int __attribute__((aligned(4 * W))) valid[W];                                 \
-            memset(&rh.ray, 0, sizeof rh.ray);                                            \
-            for (int i = 0; i < W; i++) {                                                 \
-                valid[i] = b + i < n ? -1 : 0;                                            \
-                if (!valid[i]) continue;                                                  \
-                const Ray *q = &rays[b + i];                                              \
-                rh.ray.org_x[i] = q->o[0]; rh.ray.org_y[i] = q->o[1];                     \
-                rh.ray.org_z[i] = q->o[2]; rh.ray.tnear[i] = q->tnear;                    \
-                rh.ray.dir_x[i] = q->d[0]; rh.ray.dir_y[i] = q->d[1];                     \
-                rh.ray.dir_z[i] = q->d[2]; rh.ray.tfar[i] = q->tfar;                      \
-                rh.ray.mask[i] = ~0u;                                                     \
-            }                                                                             \
-            memset(&rh.hit, 0, sizeof rh.hit);                                            \
-            for (int i = 0; i < W; i++)                                                   \
-                rh.hit.geomID[i] = rh.hit.primID[i] = rh.hit.instID[0][i] =               \
-                    RTC_INVALID_GEOMETRY_ID;                                              \
-            IN(W, valid, s, &rh);                                                         \
-            for (int i = 0; i < W; i++)                                                   \
-                if (valid[i]) tally(t, rh.hit.geomID[i], rh.hit.primID[i], rh.ray.tfar[i]); \
-        }                                                                                 \
-    }
-TRACE_PACKETS(4)
-TRACE_PACKETS(8)
-TRACE_PACKETS(16)
-
-static void trace1(RTCScene s, const Ray *rays, uint32_t n, int coherent, Tally *t) {
-    CTX_DECL(coherent);
-    for (uint32_t i = 0; i < n; i++) {
-        struct RTCRayHit rh;
-        set_ray(&rh.ray, &rays[i]);
-        set_hit(&rh.hit);
-        I1(s, &rh);
-        tally(t, rh.hit.geomID, rh.hit.primID, rh.ray.tfar);
-    }
+/* One query of each kind, as Embree's tutorials make it: the records filled from the
+ * ray, the call, the answer read. Packets copy the active lanes only. */
+static inline void intersect1(RTCScene s, Ctx *c, const Ray *q, Tally *t) {
+    struct RTCRayHit rh;
+    set_ray(&rh.ray, q);
+    set_hit(&rh.hit);
+    I1(s, c, &rh);
+    tally_hit(t, rh.hit.geomID, rh.hit.primID, rh.ray.tfar);
 }
 
-/* Returns 0 when the stream API does not exist (Embree 4). */
-static int trace_stream(RTCScene s, const Ray *rays, uint32_t n, int coherent, Tally *t) {
+static inline void occluded1(RTCScene s, Ctx *c, const Ray *q, Tally *t) {
+    struct RTCRay r;
+    set_ray(&r, q);
+    O1(s, c, &r);
+    t->occluded += r.tfar == -__builtin_inff();
+}
+
+#define SET_LANES(W, r)                                                                   \
+    memset(&(r), 0, sizeof(r));                                                           \
+    for (int i = 0; i < W; i++) {                                                         \
+        if (!valid[i]) continue;                                                          \
+        const Ray *q = &rays[i];                                                          \
+        (r).org_x[i] = q->o[0]; (r).org_y[i] = q->o[1]; (r).org_z[i] = q->o[2];           \
+        (r).tnear[i] = q->tnear; (r).dir_x[i] = q->d[0]; (r).dir_y[i] = q->d[1];          \
+        (r).dir_z[i] = q->d[2]; (r).tfar[i] = q->tfar; (r).mask[i] = ~0u;                 \
+    }
+
+#define PACKET_QUERIES(W)                                                                 \
+    static inline void intersect##W(RTCScene s, Ctx *c, const Ray *rays, const int *valid, \
+                                    Tally *t) {                                           \
+        struct RTCRayHit##W rh;                                                           \
+        SET_LANES(W, rh.ray)                                                              \
+        memset(&rh.hit, 0, sizeof rh.hit);                                                \
+        for (int i = 0; i < W; i++)                                                       \
+            rh.hit.geomID[i] = rh.hit.primID[i] = rh.hit.instID[0][i] =                   \
+                RTC_INVALID_GEOMETRY_ID;                                                  \
+        IN(W, valid, s, c, &rh);                                                          \
+        for (int i = 0; i < W; i++)                                                       \
+            if (valid[i]) tally_hit(t, rh.hit.geomID[i], rh.hit.primID[i], rh.ray.tfar[i]); \
+    }                                                                                     \
+    static inline void occluded##W(RTCScene s, Ctx *c, const Ray *rays, const int *valid, \
+                                   Tally *t) {                                            \
+        struct RTCRay##W r;                                                               \
+        SET_LANES(W, r)                                                                   \
+        ON(W, valid, s, c, &r);                                                           \
+        for (int i = 0; i < W; i++)                                                       \
+            if (valid[i]) t->occluded += r.tfar[i] == -__builtin_inff();                  \
+    }                                                                                     \
+    NOINLINE static void trace##W(RTCScene s, const Ray *rays, uint32_t n, int coherent,  \
+                                  Tally *t) {                                             \
+        Ctx c;                                                                            \
+        ctx_init(&c, coherent);                                                           \
+        for (uint32_t b = 0; b < n; b += W) {                                             \
+            int __attribute__((aligned(4 * W))) valid[W];                                 \
+            for (int i = 0; i < W; i++) valid[i] = b + i < n ? -1 : 0;                    \
+            intersect##W(s, &c, rays + b, valid, t);                                      \
+        }                                                                                 \
+    }
+PACKET_QUERIES(4)
+PACKET_QUERIES(8)
+PACKET_QUERIES(16)
+
+NOINLINE static void trace1(RTCScene s, const Ray *rays, uint32_t n, int coherent, Tally *t) {
+    Ctx c;
+    ctx_init(&c, coherent);
+    for (uint32_t i = 0; i < n; i++) intersect1(s, &c, &rays[i], t);
+}
+
+/* Embree 3's stream query over n rays; 0 on Embree 4, which has none. */
+static inline int stream(RTCScene s, Ctx *c, const Ray *rays, uint32_t n, Tally *t) {
 #ifdef HERON_EMBREE4
-    (void)s; (void)rays; (void)n; (void)coherent; (void)t;
+    (void)s; (void)c; (void)rays; (void)n; (void)t;
     return 0;
 #else
-    CTX_DECL(coherent);
-    static struct RTCRayHit rh[STREAM_CHUNK];
-    for (uint32_t b = 0; b < n; b += STREAM_CHUNK) {
-        uint32_t m = n - b < STREAM_CHUNK ? n - b : STREAM_CHUNK;
-        for (uint32_t i = 0; i < m; i++) {
-            set_ray(&rh[i].ray, &rays[b + i]);
-            set_hit(&rh[i].hit);
-        }
-        rtcIntersect1M(s, &ctx, rh, m, sizeof rh[0]);
-        for (uint32_t i = 0; i < m; i++) tally(t, rh[i].hit.geomID, rh[i].hit.primID, rh[i].ray.tfar);
+    static struct RTCRayHit *rh;
+    static uint32_t cap;
+    if (n > cap) {
+        free(rh);
+        rh = aligned_alloc(16, (size_t)n * sizeof *rh);
+        if (!rh) die("out of memory");
+        cap = n;
     }
+    for (uint32_t i = 0; i < n; i++) {
+        set_ray(&rh[i].ray, &rays[i]);
+        set_hit(&rh[i].hit);
+    }
+    rtcIntersect1M(s, c, rh, n, sizeof rh[0]);
+    for (uint32_t i = 0; i < n; i++) tally_hit(t, rh[i].hit.geomID, rh[i].hit.primID, rh[i].ray.tfar);
     return 1;
 #endif
 }
 
+/* Returns 0 when the stream API does not exist (Embree 4). */
+NOINLINE static int trace_stream(RTCScene s, const Ray *rays, uint32_t n, int coherent, Tally *t) {
+    Ctx c;
+    ctx_init(&c, coherent);
+    for (uint32_t b = 0; b < n; b += STREAM_CHUNK) {
+        uint32_t m = n - b < STREAM_CHUNK ? n - b : STREAM_CHUNK;
+        if (!stream(s, &c, rays + b, m, t)) return 0;
+    }
+    return 1;
+}
+
+/* A ray log's calls (see the top of this file and src/accel/embree/record.rs). */
+enum { OP_OCCLUDED = 0x80, CALL_HEADER = 8 };
+
+/* Every call of the log, in order; 0 if the log has a stream call and Embree has none.
+ * The rays are read in place (`calls` is 16-byte aligned, and every ray starts 8 + 32k
+ * bytes into it). */
+NOINLINE static int replay(RTCScene s, const unsigned char *calls, size_t len, Tally *t) {
+    const unsigned char *p = calls, *end = calls + len;
+    while (p < end) {
+        unsigned op = p[0];
+        uint16_t bits;
+        uint32_t n;
+        memcpy(&bits, p + 2, 2);
+        memcpy(&n, p + 4, 4);
+        const Ray *rays = (const Ray *)(const void *)(p + CALL_HEADER);
+        Ctx c;
+        ctx_init(&c, p[1]);
+        p += CALL_HEADER + (size_t)n * sizeof(Ray);
+        t->calls++;
+        int __attribute__((aligned(64))) valid[16];
+        if ((op & 0x7f) > 1)
+            for (int i = 0; i < 16; i++) valid[i] = (bits >> i) & 1 ? -1 : 0;
+        t->rays += op == 0 ? n : (uint64_t)__builtin_popcount(bits);
+        switch (op) {
+        case 1: intersect1(s, &c, rays, t); break;
+        case OP_OCCLUDED | 1: occluded1(s, &c, rays, t); break;
+        case 4: intersect4(s, &c, rays, valid, t); break;
+        case 8: intersect8(s, &c, rays, valid, t); break;
+        case 16: intersect16(s, &c, rays, valid, t); break;
+        case OP_OCCLUDED | 4: occluded4(s, &c, rays, valid, t); break;
+        case OP_OCCLUDED | 8: occluded8(s, &c, rays, valid, t); break;
+        case OP_OCCLUDED | 16: occluded16(s, &c, rays, valid, t); break;
+        case 0:
+            if (!stream(s, &c, rays, n, t)) return 0;
+            break;
+        default: die("bad call in the ray log");
+        }
+    }
+    return 1;
+}
+
+static RTCDevice dev;
+
+static RTCScene new_scene(void) {
+    RTCScene scene = rtcNewScene(dev);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    return scene;
+}
+
+static void add_mesh(RTCScene scene, uint32_t nv, uint32_t nt, const unsigned char *v,
+                     const unsigned char *idx) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    void *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, nv);
+    void *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, nt);
+    if (!vb || !ib) die("rtcSetNewGeometryBuffer failed");
+    memcpy(vb, v, (size_t)nv * 12);
+    memcpy(ib, idx, (size_t)nt * 12);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+}
+
+static void add_sphere(RTCScene scene, const unsigned char *xyzr) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    void *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 16, 1);
+    if (!vb) die("rtcSetNewGeometryBuffer failed");
+    memcpy(vb, xyzr, 16);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+}
+
+static void commit(RTCScene scene) {
+    rtcCommitScene(scene);
+    if (rtcGetDeviceError(dev) != 0) die("Embree reported an error while building");
+    printf("ready\n");
+    fflush(stdout);
+}
+
+static long long now_ns(void) {
+    struct timespec a;
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    return (long long)a.tv_sec * 1000000000LL + a.tv_nsec;
+}
+
+/* The ray log: magic, geometry, calls, tally (src/bench/limit.rs). heron checked it. */
+static int main_replay(const char *path) {
+    size_t len;
+    unsigned char *f = read_file(path, &len);
+    if (len < 16 || memcmp(f, "heron-rays 1\n", 13) != 0) die("not a heron ray log");
+    const unsigned char *p = f + 16, *end = f + len;
+#define NEED(k) if ((size_t)(end - p) < (size_t)(k)) die("ray log too short")
+    uint32_t ngeom;
+    NEED(4);
+    memcpy(&ngeom, p, 4);
+    p += 4;
+    RTCScene scene = new_scene();
+    for (uint32_t g = 0; g < ngeom; g++) {
+        uint32_t kind;
+        NEED(4);
+        memcpy(&kind, p, 4);
+        p += 4;
+        if (kind == 0) {
+            uint32_t nv, nt;
+            NEED(8);
+            memcpy(&nv, p, 4);
+            memcpy(&nt, p + 4, 4);
+            p += 8;
+            NEED((size_t)nv * 12 + (size_t)nt * 12);
+            add_mesh(scene, nv, nt, p, p + (size_t)nv * 12);
+            p += (size_t)nv * 12 + (size_t)nt * 12;
+        } else if (kind == 1) {
+            NEED(16);
+            add_sphere(scene, p);
+            p += 16;
+        } else {
+            die("bad geometry kind in the ray log");
+        }
+    }
+    uint64_t clen;
+    NEED(8);
+    memcpy(&clen, p, 8);
+    p += 8;
+    NEED(clen);
+    unsigned char *calls = aligned_alloc(16, clen + 16);
+    if (!calls) die("out of memory");
+    memcpy(calls, p, clen);
+    free(f);
+    commit(scene);
+
+    char line[64];
+    while (fgets(line, sizeof line, stdin)) {
+        if (strncmp(line, "quit", 4) == 0) break;
+        if (strncmp(line, "replay", 6) != 0) die("bad command");
+        Tally t = {0, 0, 0, 0, 0, 0.0};
+        long long a = now_ns();
+        int ok = replay(scene, calls, clen, &t);
+        long long b = now_ns();
+        if (ok)
+            printf("%lld %llu %llu %llu %llu %.17g %llu\n", b - a, (unsigned long long)t.calls,
+                   (unsigned long long)t.rays, (unsigned long long)t.hits,
+                   (unsigned long long)t.prim_sum, t.t_sum, (unsigned long long)t.occluded);
+        else
+            printf("unavailable\n");
+        fflush(stdout);
+    }
+    rtcReleaseScene(scene);
+    free(calls);
+    return 0;
+}
+
 int main(int argc, char **argv) {
-    if (argc != 4) die("usage: embree_raw MESH RAYS_COHERENT RAYS_INCOHERENT");
     /* FTZ and DAZ, as heron sets them on its threads (Embree's recommendation). */
     _mm_setcsr(_mm_getcsr() | 0x8040);
+    dev = rtcNewDevice("");
+    if (!dev) die("rtcNewDevice failed");
+    if (argc == 3 && strcmp(argv[1], "--replay") == 0) {
+        int r = main_replay(argv[2]);
+        rtcReleaseDevice(dev);
+        return r;
+    }
+    if (argc != 4) die("usage: embree_raw MESH RAYS_COHERENT RAYS_INCOHERENT | --replay RAYLOG");
     size_t len;
     unsigned char *mesh = read_file(argv[1], &len);
     uint32_t nv, nt;
@@ -256,34 +488,18 @@ int main(int argc, char **argv) {
     sets[0] = read_rays(argv[2], &counts[0]);
     sets[1] = read_rays(argv[3], &counts[1]);
 
-    RTCDevice dev = rtcNewDevice("");
-    if (!dev) die("rtcNewDevice failed");
-    RTCScene scene = rtcNewScene(dev);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    void *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, nv);
-    void *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, nt);
-    if (!vb || !ib) die("rtcSetNewGeometryBuffer failed");
-    memcpy(vb, mesh + 8, (size_t)nv * 12);
-    memcpy(ib, mesh + 8 + (size_t)nv * 12, (size_t)nt * 12);
+    RTCScene scene = new_scene();
+    add_mesh(scene, nv, nt, mesh + 8, mesh + 8 + (size_t)nv * 12);
     free(mesh);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(scene, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(scene);
-    if (rtcGetDeviceError(dev) != 0) die("Embree reported an error while building");
-    printf("ready\n");
-    fflush(stdout);
+    commit(scene);
 
     char line[64];
     while (fgets(line, sizeof line, stdin)) {
         if (strncmp(line, "quit", 4) == 0) break;
         int width, set;
         if (sscanf(line, "%d %d", &width, &set) != 2 || set < 0 || set > 1) die("bad command");
-        Tally t = {0, 0, 0.0};
-        struct timespec a, b;
-        clock_gettime(CLOCK_MONOTONIC, &a);
+        Tally t = {0, 0, 0, 0, 0, 0.0};
+        long long a = now_ns();
         int ok = 1;
         switch (width) {
         case 1: trace1(scene, sets[set], counts[set], set == 0, &t); break;
@@ -293,10 +509,9 @@ int main(int argc, char **argv) {
         case 0: ok = trace_stream(scene, sets[set], counts[set], set == 0, &t); break;
         default: die("bad width");
         }
-        clock_gettime(CLOCK_MONOTONIC, &b);
-        long long ns = (long long)(b.tv_sec - a.tv_sec) * 1000000000LL + (b.tv_nsec - a.tv_nsec);
+        long long b = now_ns();
         if (ok)
-            printf("%lld %llu %llu %.17g\n", ns, (unsigned long long)t.hits,
+            printf("%lld %llu %llu %.17g\n", b - a, (unsigned long long)t.hits,
                    (unsigned long long)t.prim_sum, t.t_sum);
         else
             printf("unavailable\n");

@@ -2,7 +2,9 @@
 //! primary (coherent) camera rays and incoherent secondary rays (one random direction
 //! in the hemisphere of each primary hit), as single rays, packets of 4, 8 or 16, or
 //! Embree 3's ray streams, each timed beside a raw-Embree C program tracing the very
-//! same rays ([`raw`]), so the table shows heron's own overhead as a ratio.
+//! same rays ([`raw`]), so the table shows heron's own overhead as a ratio; and a real
+//! render's rays recorded and replayed through the same C program ([`limit`]), so that a
+//! render's time can be put beside raw Embree's time for its rays.
 //!
 //! The camera follows Embree's tutorial viewer (`viewer --benchmark`): eye, look-at,
 //! up and a vertical field of view, one ray through each pixel centre.
@@ -14,6 +16,7 @@ use glam::Vec3;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+pub mod limit;
 pub mod raw;
 
 use raw::{RawEmbree, Tally};

@@ -3,12 +3,16 @@
 //! This module is the only place in heron where `unsafe` is allowed. Its public API is
 //! safe: RAII wrappers for device, scene and geometry, a scene that is immutable once
 //! committed (so it can be shared by all worker threads), and query functions for single
-//! rays and 8-wide packets.
+//! rays, packets of 4, 8 and 16 (closest hit and occlusion) and Embree 3's streams.
 //!
 //! * `sys.rs` (private): the `extern "C"` declarations and `#[repr(C)]` structs, with the
 //!   Embree 3/4 difference behind `cfg(heron_embree4)` (set by build.rs).
 //! * [`Device`] (device.rs): `rtcNewDevice`, the error callback, error checks.
-//! * [`SceneBuilder`], [`Scene`] (scene.rs): geometry, commit, queries.
+//! * [`SceneBuilder`], [`Scene`] (scene.rs): geometry, commit, queries (their records
+//!   built with SSE, so that heron's queries cost what Embree's own C API costs:
+//!   `heron bench traversal --raw`).
+//! * [`record`]: the ray log, every query a scene sends while recording
+//!   ([`Scene::record`]), for `heron bench record`/`replay`/`limit`.
 //!
 //! References are to the Embree 3 API man pages shipped in `libembree-dev`
 //! (`man rtcIntersect1`), the same text as the "Embree API" chapter of the Embree 3
@@ -21,6 +25,7 @@
 #![allow(unsafe_code)]
 
 mod device;
+pub mod record;
 mod scene;
 mod sys;
 
@@ -29,6 +34,7 @@ pub use device::Device;
 /// The Embree major version heron's bindings were compiled for (build.rs sets
 /// `cfg(heron_embree4)` for 4); the library's own version must agree.
 pub const BINDINGS_MAJOR: u32 = if cfg!(heron_embree4) { 4 } else { 3 };
+pub use record::{QueryTally, RayLog};
 pub use scene::{Scene, SceneBuilder, StreamScratch};
 
 use glam::Vec3;

@@ -1,11 +1,13 @@
 //! Scene building (`rtcNewScene(3)`, `rtcNewGeometry(3)`, `rtcAttachGeometry(3)`,
 //! `rtcCommitScene(3)`) and ray queries on committed scenes (`rtcIntersect1(3)`,
-//! `rtcOccluded1(3)`, `rtcIntersect8(3)`, `rtcOccluded8(3)`).
-use std::sync::Arc;
+//! `rtcOccluded1(3)`, `rtcIntersect4/8/16(3)`, `rtcOccluded4/8/16(3)`,
+//! `rtcIntersect1M(3)`).
+use std::sync::{Arc, OnceLock};
 
 use glam::Vec3;
 
 use super::device::DeviceInner;
+use super::record::{RayLog, Recorder};
 use super::sys;
 use super::{Device, EmbreeError, Hit, RayCoherence, RayQuery};
 
@@ -37,6 +39,9 @@ pub struct Scene {
     device: Arc<DeviceInner>,
     geometry_count: u32,
     bounds: Option<(Vec3, Vec3)>,
+    /// Set once by [`Scene::record`]; until then every query's only cost for it is one
+    /// load and a branch never taken.
+    recorder: OnceLock<Recorder>,
 }
 
 // SAFETY: a committed Scene is never modified: no method takes `&mut self` or calls a
@@ -334,6 +339,7 @@ impl<'d> SceneBuilder<'d> {
             device,
             geometry_count: self.next_id,
             bounds,
+            recorder: OnceLock::new(),
         })
     }
 }
@@ -479,6 +485,21 @@ fn to_rtc_ray(r: &RayQuery) -> sys::RTCRay {
         id: 0,
         flags: 0,
     }
+}
+
+/// A stream's records as rays, for the recorder (before the call).
+#[cold]
+#[inline(never)]
+fn sent_rays(records: &[sys::RTCRayHit]) -> Vec<RayQuery> {
+    records
+        .iter()
+        .map(|r| RayQuery {
+            origin: Vec3::new(r.ray.org_x, r.ray.org_y, r.ray.org_z),
+            tnear: r.ray.tnear,
+            dir: Vec3::new(r.ray.dir_x, r.ray.dir_y, r.ray.dir_z),
+            tfar: r.ray.tfar,
+        })
+        .collect()
 }
 
 /// The record buffer of [`Scene::intersect_stream`], reused between calls.
@@ -627,6 +648,14 @@ unsafe fn clear_hits<const W: usize>(h: *mut u32, bytes: usize) {
     }
 }
 
+/// A valid mask (-1 active, 0 inactive per lane) as a bit per lane.
+fn lane_bits(valid: &[i32]) -> u16 {
+    valid
+        .iter()
+        .enumerate()
+        .fold(0, |m, (i, &v)| m | (((v != 0) as u16) << i))
+}
+
 /// Generates, for one packet width, the closest-hit query `rtcIntersectW(3)` and the
 /// occlusion query `rtcOccludedW(3)`: lanes whose bit in `active` is 0 (or whose ray is
 /// invalid) are inactive and get None / not occluded.
@@ -646,55 +675,88 @@ macro_rules! packet_query {
             coherence: RayCoherence,
             mut f: impl FnMut(usize, Hit),
         ) {
-            let mut valid = std::mem::MaybeUninit::<sys::$valid>::uninit();
-            let mut rh = std::mem::MaybeUninit::<sys::$rayhit>::uninit();
-            let rp = rh.as_mut_ptr();
-            // SAFETY: `rh` and `valid` are aligned to the packet width (≥ 16 bytes) and
-            // W is 4, 8 or 16. `fill_packet` writes all of the ray packet and the mask,
-            // `clear_hits` all of the hit packet (RTCRayHitW has no padding: the ray is
-            // 48·W bytes, the hit 32·W or 36·W, and the alignment is 4·W), so both are
-            // initialised afterwards.
-            let (valid, mut rh) = unsafe {
-                let any = fill_packet::<$w>(
-                    rays,
-                    active as u32,
-                    std::ptr::addr_of_mut!((*rp).ray).cast::<f32>(),
-                    valid.as_mut_ptr().cast::<i32>(),
-                );
-                if !any {
-                    return;
-                }
-                clear_hits::<$w>(
-                    std::ptr::addr_of_mut!((*rp).hit).cast::<u32>(),
-                    std::mem::size_of::<sys::$hit>(),
-                );
-                (valid.assume_init(), rh.assume_init())
-            };
-            const _: () = assert!(std::mem::size_of::<sys::$ray>() == RAY_FIELDS * 4 * $w);
-            const _: () = assert!(
-                std::mem::size_of::<sys::$rayhit>()
-                    == std::mem::size_of::<sys::$ray>() + std::mem::size_of::<sys::$hit>()
-            );
-            let coherent = coherence == RayCoherence::Coherent;
-            // SAFETY: committed, unmodified scene; `valid` and `rh` are aligned to the
-            // packet width, valid and exclusive for the call.
-            unsafe { sys::$isect(&valid, self.raw, &mut rh, coherent) };
-            // Embree writes hit lanes only, so a lane that is inactive or missed still
-            // holds the invalid geometry ID.
-            for i in 0..$w {
-                if rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID {
-                    f(
-                        i,
-                        Hit {
-                            t: rh.ray.tfar[i],
-                            geom_id: rh.hit.geomID[i],
-                            prim_id: rh.hit.primID[i],
-                            ng: Vec3::new(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]),
-                            u: rh.hit.u[i],
-                            v: rh.hit.v[i],
-                        },
+            /// The query, and its log when recording; as `Scene::intersect1_query`,
+            /// always inlined so that the log's code is compiled out where `rec` is None.
+            #[inline(always)]
+            fn query(
+                scene: &Scene,
+                rays: &[RayQuery; $w],
+                active: $mask,
+                coherent: bool,
+                f: &mut impl FnMut(usize, Hit),
+                rec: Option<&Recorder>,
+            ) {
+                let mut valid = std::mem::MaybeUninit::<sys::$valid>::uninit();
+                let mut rh = std::mem::MaybeUninit::<sys::$rayhit>::uninit();
+                let rp = rh.as_mut_ptr();
+                // SAFETY: `rh` and `valid` are aligned to the packet width (≥ 16 bytes)
+                // and W is 4, 8 or 16. `fill_packet` writes all of the ray packet and the
+                // mask, `clear_hits` all of the hit packet (RTCRayHitW has no padding: the
+                // ray is 48·W bytes, the hit 32·W or 36·W, and the alignment is 4·W), so
+                // both are initialised afterwards.
+                let (valid, mut rh) = unsafe {
+                    let any = fill_packet::<$w>(
+                        rays,
+                        active as u32,
+                        std::ptr::addr_of_mut!((*rp).ray).cast::<f32>(),
+                        valid.as_mut_ptr().cast::<i32>(),
                     );
+                    if !any {
+                        return;
+                    }
+                    clear_hits::<$w>(
+                        std::ptr::addr_of_mut!((*rp).hit).cast::<u32>(),
+                        std::mem::size_of::<sys::$hit>(),
+                    );
+                    (valid.assume_init(), rh.assume_init())
+                };
+                const _: () = assert!(std::mem::size_of::<sys::$ray>() == RAY_FIELDS * 4 * $w);
+                const _: () = assert!(
+                    std::mem::size_of::<sys::$rayhit>()
+                        == std::mem::size_of::<sys::$ray>() + std::mem::size_of::<sys::$hit>()
+                );
+                // SAFETY: committed, unmodified scene; `valid` and `rh` are aligned to the
+                // packet width, valid and exclusive for the call.
+                unsafe { sys::$isect(&valid, scene.raw, &mut rh, coherent) };
+                let lane = |i: usize| Hit {
+                    t: rh.ray.tfar[i],
+                    geom_id: rh.hit.geomID[i],
+                    prim_id: rh.hit.primID[i],
+                    ng: Vec3::new(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]),
+                    u: rh.hit.u[i],
+                    v: rh.hit.v[i],
+                };
+                // Embree writes hit lanes only, so a lane that is inactive or missed still
+                // holds the invalid geometry ID.
+                let hit = |i: usize| rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID;
+                if let Some(rec) = rec {
+                    let hits: [Option<Hit>; $w] = std::array::from_fn(|i| hit(i).then(|| lane(i)));
+                    rec.packet(false, rays, lane_bits(&valid.0), coherent, &hits, 0);
                 }
+                for i in 0..$w {
+                    if hit(i) {
+                        f(i, lane(i));
+                    }
+                }
+            }
+
+            #[cold]
+            #[inline(never)]
+            fn recorded(
+                scene: &Scene,
+                rays: &[RayQuery; $w],
+                active: $mask,
+                coherent: bool,
+                f: &mut impl FnMut(usize, Hit),
+                rec: &Recorder,
+            ) {
+                query(scene, rays, active, coherent, f, Some(rec))
+            }
+
+            let coherent = coherence == RayCoherence::Coherent;
+            match self.recorder.get() {
+                None => query(self, rays, active, coherent, &mut f, None),
+                Some(rec) => recorded(self, rays, active, coherent, &mut f, rec),
             }
         }
 
@@ -713,31 +775,61 @@ macro_rules! packet_query {
         /// A bit mask of the active lanes that are occluded (`rtcOccludedW(3)`, which
         /// sets `tfar = -inf` on occluded lanes), with an explicit coherence hint.
         pub fn $occluded(&self, rays: &[RayQuery; $w], active: $mask, coherence: RayCoherence) -> $mask {
-            let mut valid = std::mem::MaybeUninit::<sys::$valid>::uninit();
-            let mut ray = std::mem::MaybeUninit::<sys::$ray>::uninit();
-            // SAFETY: as in the closest-hit query; `fill_packet` writes all of the ray
-            // packet and the mask.
-            let (valid, mut ray) = unsafe {
-                let any = fill_packet::<$w>(
-                    rays,
-                    active as u32,
-                    ray.as_mut_ptr().cast::<f32>(),
-                    valid.as_mut_ptr().cast::<i32>(),
-                );
-                if !any {
-                    return 0;
+            /// As in the closest-hit query.
+            #[inline(always)]
+            fn query(
+                scene: &Scene,
+                rays: &[RayQuery; $w],
+                active: $mask,
+                coherent: bool,
+                rec: Option<&Recorder>,
+            ) -> $mask {
+                let mut valid = std::mem::MaybeUninit::<sys::$valid>::uninit();
+                let mut ray = std::mem::MaybeUninit::<sys::$ray>::uninit();
+                // SAFETY: as in the closest-hit query; `fill_packet` writes all of the
+                // ray packet and the mask.
+                let (valid, mut ray) = unsafe {
+                    let any = fill_packet::<$w>(
+                        rays,
+                        active as u32,
+                        ray.as_mut_ptr().cast::<f32>(),
+                        valid.as_mut_ptr().cast::<i32>(),
+                    );
+                    if !any {
+                        return 0;
+                    }
+                    (valid.assume_init(), ray.assume_init())
+                };
+                // SAFETY: committed, unmodified scene; `valid` and `ray` are aligned to
+                // the packet width, valid and exclusive for the call.
+                unsafe { sys::$occl(&valid, scene.raw, &mut ray, coherent) };
+                let mut m: $mask = 0;
+                for i in 0..$w {
+                    m |= (((valid.0[i] != 0) & (ray.tfar[i] == f32::NEG_INFINITY)) as $mask) << i;
                 }
-                (valid.assume_init(), ray.assume_init())
-            };
-            let coherent = coherence == RayCoherence::Coherent;
-            // SAFETY: committed, unmodified scene; `valid` and `ray` are aligned to the
-            // packet width, valid and exclusive for the call.
-            unsafe { sys::$occl(&valid, self.raw, &mut ray, coherent) };
-            let mut m: $mask = 0;
-            for i in 0..$w {
-                m |= (((valid.0[i] != 0) & (ray.tfar[i] == f32::NEG_INFINITY)) as $mask) << i;
+                if let Some(rec) = rec {
+                    rec.packet(true, rays, lane_bits(&valid.0), coherent, &[], m as u16);
+                }
+                m
             }
-            m
+
+            #[cold]
+            #[inline(never)]
+            fn recorded(
+                scene: &Scene,
+                rays: &[RayQuery; $w],
+                active: $mask,
+                coherent: bool,
+                rec: &Recorder,
+            ) -> $mask {
+                query(scene, rays, active, coherent, Some(rec))
+            }
+
+            let coherent = coherence == RayCoherence::Coherent;
+            match self.recorder.get() {
+                None => query(self, rays, active, coherent, None),
+                Some(rec) => recorded(self, rays, active, coherent, rec),
+            }
         }
     };
 }
@@ -755,6 +847,29 @@ impl Scene {
 
     /// [`Scene::intersect1`] with an explicit coherence hint for the intersect context.
     pub fn intersect1_with(&self, ray: &RayQuery, coherence: RayCoherence) -> Option<Hit> {
+        let coherent = coherence == RayCoherence::Coherent;
+        match self.recorder.get() {
+            None => self.intersect1_query(ray, coherent, None),
+            Some(rec) => self.intersect1_recorded(ray, coherent, rec),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn intersect1_recorded(&self, ray: &RayQuery, coherent: bool, rec: &Recorder) -> Option<Hit> {
+        self.intersect1_query(ray, coherent, Some(rec))
+    }
+
+    /// The query, and its log when recording. Always inlined, so that where `rec` is the
+    /// constant None (every query while not recording) the log's code is compiled out:
+    /// the recorder's whole cost is the `OnceLock::get` branch in front.
+    #[inline(always)]
+    fn intersect1_query(
+        &self,
+        ray: &RayQuery,
+        coherent: bool,
+        rec: Option<&Recorder>,
+    ) -> Option<Hit> {
         let mut r = std::mem::MaybeUninit::<sys::RTCRay>::uninit();
         // SAFETY: `write_ray` writes the whole aligned record.
         let record = unsafe {
@@ -767,11 +882,14 @@ impl Scene {
             ray: record,
             hit: sys::RTCHit::invalid(),
         };
-        let coherent = coherence == RayCoherence::Coherent;
         // SAFETY: `self.raw` is a committed scene that nothing modifies (see the Send/Sync
         // impls); `rh` is a valid, aligned, exclusive ray/hit record.
         unsafe { sys::intersect1(self.raw, &mut rh, coherent) };
-        hit_of(&rh)
+        let hit = hit_of(&rh);
+        if let Some(rec) = rec {
+            rec.intersect1(ray, coherent, hit.as_ref());
+        }
+        hit
     }
 
     /// Whether anything lies along `ray` within `[tnear, tfar]` (`rtcOccluded1(3)`,
@@ -784,6 +902,22 @@ impl Scene {
 
     /// [`Scene::occluded1`] with an explicit coherence hint.
     pub fn occluded1_with(&self, ray: &RayQuery, coherence: RayCoherence) -> bool {
+        let coherent = coherence == RayCoherence::Coherent;
+        match self.recorder.get() {
+            None => self.occluded1_query(ray, coherent, None),
+            Some(rec) => self.occluded1_recorded(ray, coherent, rec),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn occluded1_recorded(&self, ray: &RayQuery, coherent: bool, rec: &Recorder) -> bool {
+        self.occluded1_query(ray, coherent, Some(rec))
+    }
+
+    /// As [`Scene::intersect1_query`].
+    #[inline(always)]
+    fn occluded1_query(&self, ray: &RayQuery, coherent: bool, rec: Option<&Recorder>) -> bool {
         let mut r = std::mem::MaybeUninit::<sys::RTCRay>::uninit();
         // SAFETY: `write_ray` writes the whole aligned record.
         let mut r = unsafe {
@@ -792,10 +926,13 @@ impl Scene {
             }
             r.assume_init()
         };
-        let coherent = coherence == RayCoherence::Coherent;
-        // SAFETY: as in intersect1_with.
+        // SAFETY: as in intersect1_query.
         unsafe { sys::occluded1(self.raw, &mut r, coherent) };
-        r.tfar == f32::NEG_INFINITY
+        let occluded = r.tfar == f32::NEG_INFINITY;
+        if let Some(rec) = rec {
+            rec.occluded1(ray, coherent, occluded);
+        }
+        occluded
     }
 
     /// Coherent 8-wide packet; lanes whose bit in `active` is 0 are ignored and get None.
@@ -875,6 +1012,8 @@ impl Scene {
             rec.hit = sys::RTCHit::invalid();
         }
         let coherent = coherence == RayCoherence::Coherent;
+        // The rays as Embree gets them (the call overwrites `tfar` of hits).
+        let sent = self.recorder.get().map(|_| sent_rays(records));
         // SAFETY: committed, unmodified scene; the records are valid, aligned and
         // exclusive for the call.
         unsafe { sys::intersect1m(self.raw, records, coherent) };
@@ -882,6 +1021,10 @@ impl Scene {
             if let Some(h) = hit_of(rec) {
                 f(i, h);
             }
+        }
+        if let (Some(rec), Some(sent)) = (self.recorder.get(), sent) {
+            let hits: Vec<Hit> = records.iter().filter_map(hit_of).collect();
+            rec.stream(&sent, coherent, &hits);
         }
         true
     }
@@ -892,6 +1035,20 @@ impl Scene {
     /// `tfar = -inf`.
     pub fn occluded8(&self, rays: &[RayQuery; 8], active: u8) -> u8 {
         self.occluded8_with(rays, active, RayCoherence::Coherent)
+    }
+
+    /// Starts recording every query this scene sends to Embree (see [`RayLog`]); the
+    /// calls accumulate until [`Scene::take_recording`]. Recording cannot be stopped, so
+    /// a render to be timed uses a scene that never recorded. Calls from several threads
+    /// interleave in no fixed order: record a render on one thread.
+    pub fn record(&self) {
+        self.recorder.get_or_init(Recorder::default);
+    }
+
+    /// The calls recorded since [`Scene::record`] or the last take (None if this scene
+    /// never recorded); recording goes on into an empty log.
+    pub fn take_recording(&self) -> Option<RayLog> {
+        self.recorder.get().map(Recorder::take)
     }
 
     /// Number of geometries; IDs are `0..geometry_count()`.
