@@ -146,9 +146,10 @@ static inline void ctx_init(Ctx *c, int coherent) {
 #define ON(W, v, s, c, r) rtcOccluded##W(v, s, c, r)
 #endif
 
-/* One function per benchmark pass, never inlined, so that scripts/callgrind_traversal.sh
- * can count each pass's instructions (as heron's HeronTracer::trace). */
-#define NOINLINE __attribute__((noinline))
+/* One function per benchmark pass, never inlined nor cloned (gcc's .constprop copies
+ * would rename it), so that scripts/callgrind_traversal.sh can count each pass's
+ * instructions (as heron's HeronTracer::trace). */
+#define NOINLINE __attribute__((noinline, noclone))
 
 /* heron's stream chunk (src/bench/mod.rs STREAM_CHUNK); a logged stream is longer at
  * most by heron's own chunking, which the replay keeps. */

@@ -360,12 +360,11 @@ impl HeronTracer {
         coherence: RayCoherence,
     ) -> Option<Tally> {
         let mut t = Tally::default();
-        let mut add = |h: &Option<Hit>| {
-            if let Some(h) = h {
-                t.hits += 1;
-                t.prim_sum += h.prim_id as u64;
-                t.t_sum += h.t as f64;
-            }
+        // By value, as a renderer reads its hits (the C program reads Embree's record).
+        let mut add = |h: Hit| {
+            t.hits += 1;
+            t.prim_sum += h.prim_id as u64;
+            t.t_sum += h.t as f64;
         };
         macro_rules! packets {
             ($w:literal, $mask:ty, $query:ident) => {
@@ -373,11 +372,11 @@ impl HeronTracer {
                     // Full chunks are borrowed in place, as the C program reads its rays.
                     let active = <$mask>::MAX >> ($w - c.len());
                     match <&[RayQuery; $w]>::try_from(c) {
-                        Ok(p) => scene.$query(p, active, coherence, |_, h| add(&Some(h))),
+                        Ok(p) => scene.$query(p, active, coherence, |_, h| add(h)),
                         Err(_) => {
                             let mut p = [c[0]; $w];
                             p[..c.len()].copy_from_slice(c);
-                            scene.$query(&p, active, coherence, |_, h| add(&Some(h)))
+                            scene.$query(&p, active, coherence, |_, h| add(h))
                         }
                     }
                 }
@@ -386,7 +385,9 @@ impl HeronTracer {
         match width {
             Width::One => {
                 for r in rays {
-                    add(&scene.intersect1_with(r, coherence));
+                    if let Some(h) = scene.intersect1_with(r, coherence) {
+                        add(h);
+                    }
                 }
             }
             Width::Four => packets!(4, u8, intersect4_each),
@@ -395,9 +396,7 @@ impl HeronTracer {
             Width::Stream => {
                 for c in rays.chunks(STREAM_CHUNK) {
                     let traced =
-                        scene.intersect_stream_each(c, coherence, &mut self.scratch, |_, h| {
-                            add(&Some(h))
-                        });
+                        scene.intersect_stream_each(c, coherence, &mut self.scratch, |_, h| add(h));
                     if !traced {
                         return None;
                     }

@@ -761,6 +761,7 @@ macro_rules! packet_query {
         }
 
         $(#[$doc])*
+        #[inline]
         pub fn $name(
             &self,
             rays: &[RayQuery; $w],
@@ -774,6 +775,7 @@ macro_rules! packet_query {
 
         /// A bit mask of the active lanes that are occluded (`rtcOccludedW(3)`, which
         /// sets `tfar = -inf` on occluded lanes), with an explicit coherence hint.
+        #[inline]
         pub fn $occluded(&self, rays: &[RayQuery; $w], active: $mask, coherence: RayCoherence) -> $mask {
             /// As in the closest-hit query.
             #[inline(always)]
@@ -846,6 +848,11 @@ impl Scene {
     }
 
     /// [`Scene::intersect1`] with an explicit coherence hint for the intersect context.
+    ///
+    /// `#[inline]`, as every query: heron is built in several codegen units, and only an
+    /// inline function can be inlined into a caller in another unit (a call per ray is a
+    /// fifth of what the wrapper adds to Embree's own work).
+    #[inline]
     pub fn intersect1_with(&self, ray: &RayQuery, coherence: RayCoherence) -> Option<Hit> {
         let coherent = coherence == RayCoherence::Coherent;
         match self.recorder.get() {
@@ -901,6 +908,7 @@ impl Scene {
     }
 
     /// [`Scene::occluded1`] with an explicit coherence hint.
+    #[inline]
     pub fn occluded1_with(&self, ray: &RayQuery, coherence: RayCoherence) -> bool {
         let coherent = coherence == RayCoherence::Coherent;
         match self.recorder.get() {
@@ -939,6 +947,7 @@ impl Scene {
     ///
     /// `rtcIntersect8(3)` with the valid mask (-1 active, 0 inactive) and a COHERENT
     /// context. Lane `i` is bit `1 << i`; invalid rays are treated as inactive.
+    #[inline]
     pub fn intersect8(&self, rays: &[RayQuery; 8], active: u8) -> [Option<Hit>; 8] {
         self.intersect8_with(rays, active, RayCoherence::Coherent)
     }
@@ -1033,6 +1042,7 @@ impl Scene {
     ///
     /// `rtcOccluded8(3)` with a COHERENT context; occluded lanes come back with
     /// `tfar = -inf`.
+    #[inline]
     pub fn occluded8(&self, rays: &[RayQuery; 8], active: u8) -> u8 {
         self.occluded8_with(rays, active, RayCoherence::Coherent)
     }

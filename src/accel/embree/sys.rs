@@ -558,12 +558,14 @@ mod embree3_queries {
         true
     }
 
+    /// `rtcInitIntersectContext` with the coherence flag, without a branch (it is made
+    /// for every query).
+    #[inline(always)]
     fn context(coherent: bool) -> RTCIntersectContext {
-        let mut ctx = rtc_init_intersect_context();
-        if coherent {
-            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        RTCIntersectContext {
+            flags: coherent as u32 * RTC_INTERSECT_CONTEXT_FLAG_COHERENT,
+            ..rtc_init_intersect_context()
         }
-        ctx
     }
 
     /// Closest hit of one ray.
