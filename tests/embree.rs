@@ -848,10 +848,66 @@ fn invalid_rays_give_no_hit() {
             ..good
         },
     ];
+    assert!(good.is_valid());
     for q in &bad {
+        assert!(!q.is_valid(), "{q:?}");
         assert_eq!(scene.intersect1(q), None, "{q:?}");
         assert!(!scene.occluded1(q), "{q:?}");
     }
+    // Edge cases the vector check must agree on: tnear = tfar, -0 tnear, infinite tfar,
+    // a direction with one non-zero component (valid); infinite tnear (not).
+    let edge = [
+        (
+            RayQuery {
+                tnear: 2.0,
+                tfar: 2.0,
+                ..good
+            },
+            true,
+        ),
+        (
+            RayQuery {
+                tnear: -0.0,
+                ..good
+            },
+            true,
+        ),
+        (
+            RayQuery {
+                dir: Vec3::new(0.0, 0.0, 1e-30),
+                ..good
+            },
+            true,
+        ),
+        (
+            RayQuery {
+                tnear: f32::INFINITY,
+                tfar: f32::INFINITY,
+                ..good
+            },
+            false,
+        ),
+    ];
+    for (q, valid) in edge {
+        assert_eq!(q.is_valid(), valid, "{q:?}");
+        let lanes = [q; 4];
+        // An invalid ray is never traced: not occluded.
+        if !valid {
+            assert_eq!(
+                scene.occluded4_with(&lanes, 0xf, RayCoherence::Incoherent),
+                0
+            );
+            assert!(!scene.occluded1(&q));
+        }
+    }
+    // A tnear of -0 is 0: traced, and it hits, singly and in every lane.
+    let q = RayQuery {
+        tnear: -0.0,
+        ..good
+    };
+    assert!(scene.intersect1(&q).is_some());
+    let h = scene.intersect4_with(&[q; 4], 0xf, RayCoherence::Incoherent);
+    assert!(h.iter().all(Option::is_some), "{h:?}");
     let mut rays = [good; 8];
     rays[..7].copy_from_slice(&bad);
     let hits = scene.intersect8(&rays, 0xff);

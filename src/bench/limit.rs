@@ -644,7 +644,8 @@ fn timed_rounds(
             Ok(())
         } else {
             Err(HeronError::Invalid(format!(
-                "{}: {what} found {got:?}, but the recorded render found {want:?}",
+                "{}: {what} found {got:?}, but the recorded render found {want:?} (a log \
+                 replays exactly only with the Embree library and CPU that recorded it)",
                 path.display()
             )))
         }
