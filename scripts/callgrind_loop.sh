@@ -6,6 +6,7 @@
 #
 #   scripts/callgrind_loop.sh [HERON_BINARY...]     (default: target/release/heron)
 #   SPP=64 SIZE=128 scripts/callgrind_loop.sh ...   (per-sample cost at a real sample count)
+#   FLAGS="--packets paths" scripts/callgrind_loop.sh  (extra render flags)
 #
 # SPP (default 4) is the samples per pixel; SIZE, if set, renders a SIZE×SIZE copy of each
 # scene (the Sobol' sampler's per-pixel work is shared by a pixel's samples, so 4 spp
@@ -16,6 +17,7 @@
 # two commits' binaries, build both with the same HERON_BUILD_COMMIT (see build.rs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck disable=SC2086  # FLAGS is split into flags on purpose
 bins=("$@")
 [ ${#bins[@]} -gt 0 ] || bins=(target/release/heron)
 spp=${SPP:-4}
@@ -34,7 +36,7 @@ for bin in "${bins[@]}"; do
     valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --collect-atstart=no \
       --toggle-collect='*render_passes*' \
       "$bin" render "$tmp/$scene.toml" -o "$tmp/cg.exr" --spp "$spp" --threads 1 --quiet \
-      --no-png >"$tmp/out" 2>"$tmp/log"
+      --no-png ${FLAGS:-} >"$tmp/out" 2>"$tmp/log"
     ir=$(grep -E '^(summary|totals):' "$tmp/cg.out" | head -n 1 | awk '{print $2}')
     px=$(cat "$tmp/out" "$tmp/log" | grep -oE ': [0-9]+x[0-9]+ at' | head -n 1 | grep -oE '[0-9]+x[0-9]+' || true)
     per=""

@@ -6,6 +6,9 @@
 #   scripts/same_images.sh [BASE] [SPP]     (SPP default 4; 2 spp with --lanes 8 reaches
 #                                            every kernel branch the scene uses)
 #
+# NEW_ARGS (environment) adds flags to the working tree's renders only, e.g.
+# NEW_ARGS="--packets camera" to compare a new default's alternative with the old default.
+#
 # BASE is built in a git worktree under target/same-images/ (its own target directory,
 # kept between runs), and its binary and renders are kept by commit, so a second run against the
 # same BASE only renders the working tree's side. Prints one line per (scene, integrator)
@@ -27,15 +30,16 @@ build() { # $1: source dir, $2: target dir
     cargo build --release --locked --quiet --bin heron)
 }
 
-render_all() { # $1: heron binary, $2: output dir
+render_all() { # $1: heron binary, $2: output dir, $3...: extra flags
   mkdir -p "$2"
   for scene in scenes/*.toml; do
     name=$(basename "$scene" .toml)
     for integ in whitted path lighttrace bdpt; do
       out="$2/$name.$integ"
       [ -e "$out.done" ] && continue
+      # shellcheck disable=SC2086
       if "$1" render "$scene" -o "$out.exr" --spp "$spp" --integrator "$integ" \
-        --no-png --quiet --threads 2 >"$out.log" 2>&1; then
+        --no-png --quiet --threads 2 ${3:-} >"$out.log" 2>&1; then
         :
       else
         echo "exit $?" >>"$out.log"
@@ -67,7 +71,7 @@ build "$PWD" "$root/target"
 cp "$root/target/release/heron" "$root/heron-worktree"
 new_dir="$root/renders-worktree"
 rm -rf "$new_dir"
-render_all "$root/heron-worktree" "$new_dir"
+render_all "$root/heron-worktree" "$new_dir" "${NEW_ARGS:-}"
 
 differ=0
 for f in "$base_dir"/*.msg; do

@@ -17,7 +17,7 @@ cargo test --release --locked
 embree4_lib="$(echo "$PWD"/.venv/lib/python3*/site-packages/embreex.libs)"
 HERON_EMBREE4_LIB="$embree4_lib" CARGO_TARGET_DIR="$PWD/target/embree4" \
     cargo test --release --locked --test embree --test render --test stability --test bench_traversal \
-    --test bench_limit
+    --test bench_limit --test packets
 
 # pytest exits 5 when it collects nothing; any non-zero exit fails this script.
 HERON_BIN="$PWD/target/release/heron" .venv/bin/python -m pytest tests/python -q

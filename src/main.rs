@@ -589,8 +589,15 @@ struct RenderArgs {
     /// Wavelengths carried per path: 1, 4 or 8.
     #[arg(long, default_value_t = 8, value_parser = parse_lanes)]
     lanes: usize,
-    /// Trace camera rays one by one instead of in 8-wide Embree packets.
-    #[arg(long)]
+    /// How rays go to Embree: paths (the paths of 8 pixel samples advance together, their
+    /// closest-hit and shadow rays sent as 8-wide packets; whitted and path), camera
+    /// (camera rays in packets, every later ray alone: the one-path-at-a-time engine) or
+    /// off (every ray alone). They agree up to the last bits of Embree's hits. Default
+    /// auto: paths under whitted, camera otherwise (the faster here; BENCHMARKS.md).
+    #[arg(long, value_name = "HOW")]
+    packets: Option<String>,
+    /// Every ray alone: the same as --packets off.
+    #[arg(long, conflicts_with = "packets")]
     no_packets: bool,
     /// Do not write the PNG preview.
     #[arg(long)]
@@ -930,6 +937,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         max_depth: args.max_depth.map(i64::from),
         offset: args.offset.as_deref(),
         kernel: Some(&args.kernel),
+        packets: args.packets.as_deref(),
         no_packets: args.no_packets,
     };
     // Before the scene loads, which may take seconds (sky and medium tables).

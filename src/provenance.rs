@@ -143,7 +143,7 @@ impl Provenance {
                 "offset",
                 settings.ray_offset(settings.integrator).to_string(),
             ),
-            ("packets", settings.packets.to_string()),
+            ("packets", settings.packets.provenance().to_string()),
             ("spectralBins", settings.spectral_bins.to_string()),
         ])
     }

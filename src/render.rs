@@ -8,18 +8,18 @@
 //! Splats (contributions an integrator makes to other pixels than its own) are kept in
 //! a list per tile, in the order they were made, and added to the film tile by tile in
 //! tile order, pass by pass. So the image is bit-identical whatever the thread count.
-use crate::accel::embree::{self, RayQuery};
+use crate::accel::embree::{self, RayCoherence, RayQuery};
 use crate::checkpoint::{Checkpoint, Shard};
 use crate::film::fixed::{to_fixed, to_fixed3, SquareSum};
 use crate::film::{
     add_splat_squares, add_to_bins, rgb_squares, xyz_of_sample, Film, SpectralBins, Splats,
 };
 use crate::geometry::{Ray, ShapeKind};
-use crate::integrator::{self, Context, TraceCounters};
+use crate::integrator::{self, Context, Deferred, PathState, TraceCounters};
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene};
-use crate::settings::{KernelFlags, RenderSettings};
-use crate::spectrum::SampledWavelengths;
+use crate::settings::{IntegratorKind, KernelFlags, Packets, RenderSettings};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -238,11 +238,36 @@ fn render_with(
     let k = Features::of(scene)
         .choose(kind, opts.settings.kernel)
         .map_err(HeronError::Invalid)?;
+    let mut opts = opts.clone();
+    // `auto` resolved: the provenance records what ran (light tracing has no camera
+    // rays, so no camera packets).
+    opts.settings.packets = match (kind, opts.settings.packets) {
+        (IntegratorKind::Whitted, Packets::Auto) => Packets::Paths,
+        (IntegratorKind::LightTrace, Packets::Paths) => Packets::Paths,
+        (IntegratorKind::LightTrace, _) => Packets::Off,
+        (_, Packets::Auto) => Packets::Camera,
+        (_, p) => p,
+    };
+    // Light tracing and BDPT have no steps: with `paths`, each pixel sample sends its
+    // connections' shadow rays 8 at a time (toolkit `Connections`).
+    let paths =
+        opts.settings.packets == Packets::Paths && integrator::path_fns::<1>(kind, 0).is_some();
     let integrate = move |n: Lanes| -> SampleFn {
-        match n {
-            Lanes::One => SampleFn::One(integrator::kernel::<1>(kind, k)),
-            Lanes::Four => SampleFn::Four(integrator::kernel::<4>(kind, k)),
-            Lanes::Eight => SampleFn::Eight(integrator::kernel::<8>(kind, k)),
+        let p = |f1, f4, f8| match n {
+            Lanes::One => f1,
+            Lanes::Four => f4,
+            Lanes::Eight => f8,
+        };
+        match (paths, n) {
+            (true, _) => p(
+                integrator::path_fns::<1>(kind, k).map(SampleFn::PathsOne),
+                integrator::path_fns::<4>(kind, k).map(SampleFn::PathsFour),
+                integrator::path_fns::<8>(kind, k).map(SampleFn::PathsEight),
+            )
+            .expect("an integrator with a step"),
+            (false, Lanes::One) => SampleFn::One(integrator::kernel::<1>(kind, k)),
+            (false, Lanes::Four) => SampleFn::Four(integrator::kernel::<4>(kind, k)),
+            (false, Lanes::Eight) => SampleFn::Eight(integrator::kernel::<8>(kind, k)),
         }
     };
     // Every render can stop, checkpoint or resume at a pass boundary. A splatting
@@ -259,8 +284,6 @@ fn render_with(
     } else {
         ((1u32 << 22) / npix).max(1)
     };
-    let mut opts = opts.clone();
-    opts.settings.packets &= kind.uses_camera_rays();
     let (state, mut stats) = render_passes(&ctx, pool, &opts, pass, &integrate)?;
     stats.kernel = k;
     Ok((state, stats))
@@ -311,6 +334,10 @@ pub(crate) enum SampleFn {
     One(SampleFnN<1>),
     Four(SampleFnN<4>),
     Eight(SampleFnN<8>),
+    /// The packet engine's (`Packets::Paths`).
+    PathsOne(integrator::PathFns<1>),
+    PathsFour(integrator::PathFns<4>),
+    PathsEight(integrator::PathFns<8>),
 }
 
 /// Renders `spp` samples per pixel (or the shard's share of them) in passes of
@@ -456,6 +483,24 @@ pub(crate) fn render_passes(
                         (SampleFn::Eight(f), true) => {
                             render_tile::<8, true>(ctx, opts, x0, y0, s0..s1, f)
                         }
+                        (SampleFn::PathsOne(f), false) => {
+                            render_tile_paths::<1, false>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::PathsFour(f), false) => {
+                            render_tile_paths::<4, false>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::PathsEight(f), false) => {
+                            render_tile_paths::<8, false>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::PathsOne(f), true) => {
+                            render_tile_paths::<1, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::PathsFour(f), true) => {
+                            render_tile_paths::<4, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::PathsEight(f), true) => {
+                            render_tile_paths::<8, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
                     };
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     if let Some(p) = &opts.progress {
@@ -594,7 +639,123 @@ struct TileResult {
     first_nonfinite: Option<(u32, u32, u32)>,
 }
 
-/// One tile's samples of one pass; `VARIANCE` also sums the squares (`--variance`).
+/// One tile's sums of one pass, as its samples arrive.
+struct TileSums {
+    w: u32,
+    nb: usize,
+    bins: SpectralBins,
+    xyz: Vec<[i128; 3]>,
+    spectral: Vec<i128>,
+    good: Vec<u32>,
+    sq: Vec<[SquareSum; 3]>,
+    nonfinite: u64,
+    /// The first sample left out, in the one-path-at-a-time engine's order (its key:
+    /// row, packet, sample, lane), whichever order the samples finished in.
+    first_nonfinite: Option<([u32; 4], (u32, u32, u32))>,
+}
+
+impl TileSums {
+    fn new(w: u32, h: u32, nb: usize, variance: bool) -> Self {
+        let n = (w * h) as usize;
+        TileSums {
+            w,
+            nb,
+            bins: SpectralBins { count: nb },
+            xyz: vec![[0i128; 3]; n],
+            spectral: vec![0i128; n * nb],
+            good: vec![0u32; n],
+            sq: if variance {
+                vec![[SquareSum::default(); 3]; n]
+            } else {
+                Vec::new()
+            },
+            nonfinite: 0,
+            first_nonfinite: None,
+        }
+    }
+
+    /// Adds the radiance `l` at wavelengths `wl` of sample `s` of the tile's pixel
+    /// (`x`, `y`) (tile coordinates; the tile starts at `origin`). The sums are exact
+    /// integers, so the order in which samples arrive does not change them.
+    #[inline]
+    fn add<const N: usize, const VARIANCE: bool>(
+        &mut self,
+        origin: (u32, u32),
+        (x, y, s): (u32, u32, u32),
+        l: &SampledSpectrum<N>,
+        wl: &SampledWavelengths<N>,
+    ) {
+        let (nb, i) = (self.nb, (y * self.w + x) as usize);
+        // A sample whose radiance is not finite, or too large for the film's fixed-point
+        // sums (film/fixed.rs), is left out and counted.
+        let v = if l.is_finite() {
+            Some(xyz_of_sample(l, wl))
+        } else {
+            None
+        };
+        let c = v.and_then(to_fixed3);
+        // The bins are added only when the XYZ is in range, and the XYZ only when the
+        // bins were.
+        let ok = c.is_some()
+            && (nb == 0
+                || add_to_bins(&self.bins, &mut self.spectral[i * nb..(i + 1) * nb], l, wl));
+        let (Some(c), true) = (c, ok) else {
+            self.nonfinite += 1;
+            let key = [y, x / PACKET as u32, s, x % PACKET as u32];
+            if self.first_nonfinite.map_or(true, |(k, _)| key < k) {
+                self.first_nonfinite = Some((key, (origin.0 + x, origin.1 + y, s)));
+            }
+            return;
+        };
+        for (a, b) in self.xyz[i].iter_mut().zip(c) {
+            *a = a.wrapping_add(b);
+        }
+        self.good[i] += 1;
+        if VARIANCE {
+            // In range: v passed to_fixed3.
+            if let Some(q) = v.and_then(rgb_squares) {
+                for (a, b) in self.sq[i].iter_mut().zip(q) {
+                    a.add(b);
+                }
+            }
+        }
+    }
+
+    fn result(
+        self,
+        (x0, y0, w, h): (u32, u32, u32, u32),
+        splats: Splats,
+        splat_sq: Vec<(u32, [SquareSum; 3])>,
+        counters: TraceCounters,
+    ) -> TileResult {
+        TileResult {
+            x0,
+            y0,
+            w,
+            h,
+            xyz: self.xyz,
+            spectral: self.spectral,
+            good: self.good,
+            sq: self.sq,
+            splat_sq,
+            splats,
+            counters,
+            nonfinite: self.nonfinite,
+            first_nonfinite: self.first_nonfinite.map(|(_, p)| p),
+        }
+    }
+}
+
+/// Whether the render was abandoned (`RenderOptions::cancel`).
+#[inline]
+fn cancelled(opts: &RenderOptions) -> bool {
+    opts.cancel
+        .as_ref()
+        .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+}
+
+/// One tile's samples of one pass, one path at a time (camera rays in packets with
+/// `Packets::Camera`); `VARIANCE` also sums the squares (`--variance`).
 fn render_tile<const N: usize, const VARIANCE: bool>(
     ctx: &Context,
     opts: &RenderOptions,
@@ -606,23 +767,10 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
-    let bins = SpectralBins {
-        count: opts.settings.spectral_bins,
-    };
-    let nb = opts.settings.spectral_bins;
-    let mut xyz = vec![[0i128; 3]; (w * h) as usize];
-    let mut spectral = vec![0i128; (w * h) as usize * nb];
-    let mut good = vec![0u32; (w * h) as usize];
-    let mut sq = if VARIANCE {
-        vec![[SquareSum::default(); 3]; (w * h) as usize]
-    } else {
-        Vec::new()
-    };
+    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE);
     let mut splat_sq = Vec::new();
     let mut scratch = Vec::new();
     let mut counters = TraceCounters::default();
-    let mut nonfinite = 0u64;
-    let mut first_nonfinite = None;
     let mut splats = Splats::with_bins(
         cam.width * cam.height,
         (opts.settings.spectral_bins > 0).then_some(SpectralBins {
@@ -644,13 +792,8 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
         tfar: f32::INFINITY,
     }; PACKET];
     let mut wls = [SampledWavelengths::<N>::sample_uniform(0.0); PACKET];
-    let cancelled = || {
-        opts.cancel
-            .as_ref()
-            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
-    };
     for y in 0..h {
-        if cancelled() {
+        if cancelled(opts) {
             break;
         }
         for xs in (0..w).step_by(PACKET) {
@@ -670,7 +813,9 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
                         SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
                     rays[k].dir = cam.direction(px as f32 + j.x, py as f32 + j.y);
                 }
-                let hits = if opts.settings.packets {
+                let hits = if opts.settings.packets.camera()
+                    && opts.settings.integrator.uses_camera_rays()
+                {
                     counters.rays += lanes as u64;
                     Some(ctx.accel.intersect8(&rays, active))
                 } else {
@@ -695,68 +840,181 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
                             &mut splat_sq,
                         );
                     }
-                    let i = (y * w + xs + k as u32) as usize;
-                    // A sample whose radiance is not finite, or too large for the film's
-                    // fixed-point sums (film/fixed.rs), is left out and counted.
-                    let v = if l.is_finite() {
-                        Some(xyz_of_sample(&l, &wls[k]))
-                    } else {
-                        None
-                    };
-                    let c = v.and_then(to_fixed3);
-                    // The bins are added only when the XYZ is in range, and the XYZ
-                    // only when the bins were.
-                    let ok = c.is_some()
-                        && (nb == 0
-                            || add_to_bins(
-                                &bins,
-                                &mut spectral[i * nb..(i + 1) * nb],
-                                &l,
-                                &wls[k],
-                            ));
-                    let (Some(c), true) = (c, ok) else {
-                        nonfinite += 1;
-                        first_nonfinite = first_nonfinite.or(Some((x0 + xs + k as u32, y0 + y, s)));
-                        continue;
-                    };
-                    for j in 0..3 {
-                        xyz[i][j] = xyz[i][j].wrapping_add(c[j]);
-                    }
-                    good[i] += 1;
-                    if VARIANCE {
-                        // In range: v passed to_fixed3.
-                        if let Some(q) = v.and_then(rgb_squares) {
-                            for (a, b) in sq[i].iter_mut().zip(q) {
-                                a.add(b);
-                            }
-                        }
-                    }
+                    sums.add::<N, VARIANCE>((x0, y0), (xs + k as u32, y, s), &l, &wls[k]);
                 }
             }
         }
     }
-    TileResult {
-        x0,
-        y0,
-        w,
-        h,
-        xyz,
-        spectral,
-        good,
-        sq,
-        splat_sq,
-        splats,
-        counters,
-        nonfinite,
-        first_nonfinite,
+    sums.result((x0, y0, w, h), splats, splat_sq, counters)
+}
+
+/// A path of the packet engine: its pixel sample (tile coordinates and sample index),
+/// its state, the ray it traces next and its wavelengths.
+struct Lane<const N: usize> {
+    pixel: (u32, u32, u32),
+    state: PathState<N>,
+    ray: Ray,
+    wl: SampledWavelengths<N>,
+}
+
+/// One tile's samples of one pass with packets of paths (`Packets::Paths`): PACKET
+/// paths advance together, their closest-hit rays go to Embree as one packet, then each
+/// takes a step (integrator::StepFn), then their shadow rays go as packets (one per
+/// round when a step has several, the seed's one per light) and what the unblocked ones
+/// carry is added; a path that has ended gives its pixel its sample and its lane the
+/// tile's next pixel sample, in the one-path-at-a-time engine's order. Every pixel
+/// sample draws its own random numbers (start_pixel_sample), and the film's sums are
+/// exact, so the image is the one-path-at-a-time engine's, up to the last bits of
+/// Embree's packet kernels.
+fn render_tile_paths<const N: usize, const VARIANCE: bool>(
+    ctx: &Context,
+    opts: &RenderOptions,
+    x0: u32,
+    y0: u32,
+    samples: std::ops::Range<u32>,
+    fns: &integrator::PathFns<N>,
+) -> TileResult {
+    let cam = &ctx.scene.camera;
+    let w = TILE.min(cam.width - x0);
+    let h = TILE.min(cam.height - y0);
+    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE);
+    let mut counters = TraceCounters::default();
+    let base = Sampler::new(
+        opts.settings.sampler,
+        opts.settings.seed,
+        cam.width,
+        cam.height,
+        opts.settings.spp,
+    );
+    let mut samplers: [Sampler; PACKET] = std::array::from_fn(|_| base.clone());
+    let mut lanes: [Option<Lane<N>>; PACKET] = std::array::from_fn(|_| None);
+    let mut shadows: [Deferred<N>; PACKET] = std::array::from_fn(|_| Deferred::default());
+    let mut queries = [RayQuery {
+        origin: cam.eye,
+        dir: glam::Vec3::Z,
+        tnear: 0.0,
+        tfar: f32::INFINITY,
+    }; PACKET];
+    // Lane k takes the samples of the pixels in columns k, k + PACKET, … in the
+    // one-path-at-a-time engine's order (rows, packets of PACKET pixels, samples), as
+    // that engine's lane k does: a pixel's samples follow each other on one sampler,
+    // whose per-pixel caches (sampler/sobol.rs) then serve them all.
+    let ns = samples.len() as u32;
+    let blocks = w.div_ceil(PACKET as u32);
+    let mut next = [0u32; PACKET];
+    let mut take = |k: usize| -> Option<(u32, u32, u32)> {
+        let x = |n: u32| (n / ns % blocks) * PACKET as u32 + k as u32;
+        // A lane past the tile's right edge has no pixels.
+        while next[k] < h * blocks * ns && x(next[k]) >= w {
+            next[k] += ns;
+        }
+        let n = next[k];
+        if n >= h * blocks * ns {
+            return None;
+        }
+        next[k] += 1;
+        Some((x(n), n / (ns * blocks), samples.start + n % ns))
+    };
+    loop {
+        if cancelled(opts) {
+            break;
+        }
+        // Refill: every free lane takes the next pixel sample.
+        let mut active = 0u8;
+        for k in 0..PACKET {
+            if lanes[k].is_none() {
+                if let Some((x, y, s)) = take(k) {
+                    let (px, py) = (x0 + x, y0 + y);
+                    let sampler = &mut samplers[k];
+                    sampler.start_pixel_sample(px, py, s);
+                    let j = sampler.get_pixel_2d();
+                    let wl =
+                        SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
+                    let dir = cam.direction(px as f32 + j.x, py as f32 + j.y);
+                    lanes[k] = Some(Lane {
+                        pixel: (x, y, s),
+                        state: (fns.start)(cam.eye),
+                        ray: Ray::new(cam.eye, dir, 0.0, f32::INFINITY),
+                        wl,
+                    });
+                }
+            }
+            if let Some(lane) = &lanes[k] {
+                queries[k] = lane.ray.query();
+                active |= 1 << k;
+            }
+        }
+        if active == 0 {
+            break;
+        }
+        counters.rays += active.count_ones() as u64;
+        // Camera rays are coherent; once the lanes hold later rays of different paths,
+        // Embree's incoherent traversal is the faster.
+        let coherence = if lanes.iter().flatten().all(|l| l.state.depth == 0) {
+            RayCoherence::Coherent
+        } else {
+            RayCoherence::Incoherent
+        };
+        let hits = ctx.accel.intersect8_with(&queries, active, coherence);
+        let mut going = 0u8;
+        let mut rounds = 0;
+        for k in 0..PACKET {
+            let Some(lane) = &mut lanes[k] else { continue };
+            shadows[k].clear();
+            if (fns.step)(
+                ctx,
+                &mut lane.state,
+                &mut lane.ray,
+                hits[k],
+                &lane.wl,
+                &mut samplers[k],
+                &mut counters,
+                &mut shadows[k],
+            ) {
+                going |= 1 << k;
+            }
+            rounds = rounds.max(shadows[k].tests.len());
+        }
+        // The shadow rays, the r-th of every lane's in the r-th packet.
+        for r in 0..rounds {
+            let mut mask = 0u8;
+            for k in 0..PACKET {
+                if let Some(q) = shadows[k].tests.get(r).and_then(|t| t.query) {
+                    queries[k] = q;
+                    mask |= 1 << k;
+                }
+            }
+            if mask == 0 {
+                continue;
+            }
+            counters.shadow_rays += mask.count_ones() as u64;
+            let blocked = ctx
+                .accel
+                .occluded8_with(&queries, mask, RayCoherence::Incoherent);
+            for (k, sh) in shadows.iter_mut().enumerate() {
+                if mask & (1 << k) != 0 {
+                    sh.tests[r].blocked = blocked & (1 << k) != 0;
+                }
+            }
+        }
+        for k in 0..PACKET {
+            let Some(lane) = &mut lanes[k] else { continue };
+            shadows[k].resolve(&mut lane.state.l);
+            if going & (1 << k) == 0 {
+                let l = lane.state.radiance();
+                sums.add::<N, VARIANCE>((x0, y0), lane.pixel, &l, &lane.wl);
+                lanes[k] = None;
+                shadows[k].clear();
+            }
+        }
     }
+    sums.result((x0, y0, w, h), Splats::default(), Vec::new(), counters)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::load::load_scene_from_str;
-    use crate::settings::IntegratorKind;
     use std::path::Path;
 
     /// A splatting integrator (standing in for light tracing): each sample splats the

@@ -248,6 +248,60 @@ impl KernelChoice {
     }
 }
 
+/// How rays go to Embree. Embree's packet kernels return the same hits as its single-ray
+/// kernel up to the last bits of t, u and v (tests/embree.rs), so the choices give the
+/// same image up to those bits (tests/packets.rs bounds the difference).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Packets {
+    /// `Paths` under `whitted`, `Camera` otherwise: the faster on this project's scenes
+    /// (BENCHMARKS.md, "Packets of paths"). A render resolves it before it starts, so
+    /// the provenance names what ran.
+    #[default]
+    Auto,
+    /// Every ray alone (`rtcIntersect1`, `rtcOccluded1`).
+    Off,
+    /// Camera rays as 8-wide packets, every later ray alone: the one-path-at-a-time
+    /// engine, kept as the reference of the packet engine.
+    Camera,
+    /// Packets of paths: the 8 paths of a packet advance together, their closest-hit
+    /// rays go to Embree as one `rtcIntersect8` and their shadow rays as one
+    /// `rtcOccluded8`, and a path that ends is replaced by the tile's next sample
+    /// (`whitted` and `path`; light tracing and BDPT run as with `camera`).
+    Paths,
+}
+
+impl Packets {
+    pub const NAMES: &'static [&'static str] = &["auto", "paths", "camera", "off"];
+
+    pub fn parse(name: &str) -> Result<Packets, String> {
+        match name {
+            "auto" => Ok(Packets::Auto),
+            "paths" => Ok(Packets::Paths),
+            "camera" => Ok(Packets::Camera),
+            "off" => Ok(Packets::Off),
+            other => Err(format!(
+                "expected auto, paths, camera or off, got {other:?}"
+            )),
+        }
+    }
+
+    /// The name in the provenance: `camera` and `off` keep the values the older boolean
+    /// wrote (`true`, `false`), so that their EXRs keep their bytes.
+    pub fn provenance(self) -> &'static str {
+        match self {
+            Packets::Off => "false",
+            Packets::Camera => "true",
+            Packets::Paths => "paths",
+            Packets::Auto => "auto",
+        }
+    }
+
+    /// Whether camera rays go to Embree in packets.
+    pub fn camera(self) -> bool {
+        !matches!(self, Packets::Off)
+    }
+}
+
 /// Everything that decides a render's pixels: the scene file's `[render]` table (the
 /// first eight fields) and the choices only flags or keyword arguments make, with their
 /// defaults. A scene holds the file's; a render holds the scene's with
@@ -271,8 +325,8 @@ pub struct RenderSettings {
     pub offset: OffsetMode,
     /// Wavelength lanes per path: 1, 4 or 8.
     pub lanes: usize,
-    /// Trace camera rays as 8-wide packets (otherwise one by one).
-    pub packets: bool,
+    /// How rays go to Embree.
+    pub packets: Packets,
     /// How hero wavelengths are drawn.
     pub wavelengths: WavelengthSampler,
     /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
@@ -298,7 +352,7 @@ impl Default for RenderSettings {
             // The defaults with the lowest RMSE·√t over the course scenes, the Cornell
             // box and a rainbow (scripts/bench_defaults.py, BENCHMARKS.md "Defaults").
             lanes: 8,
-            packets: true,
+            packets: Packets::Auto,
             wavelengths: WavelengthSampler::Visible,
             spectral_bins: 0,
             sampler: SamplerKind::Sobol,
@@ -323,7 +377,9 @@ pub struct SettingsArgs<'a> {
     pub max_depth: Option<i64>,
     pub offset: Option<&'a str>,
     pub kernel: Option<&'a str>,
-    /// `--no-packets` (CLI only).
+    /// `--packets` (CLI only).
+    pub packets: Option<&'a str>,
+    /// `--no-packets` (CLI only): `--packets off`.
     pub no_packets: bool,
 }
 
@@ -392,8 +448,11 @@ impl RenderSettings {
         if let Some(v) = a.seed {
             s.seed = v;
         }
+        if let Some(p) = a.packets {
+            s.packets = Packets::parse(p).map_err(|e| format!("--packets: {e}"))?;
+        }
         if a.no_packets {
-            s.packets = false;
+            s.packets = Packets::Off;
         }
         *self = s;
         Ok(())
@@ -420,7 +479,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             (s.spp, s.lanes, s.integrator, s.max_depth, s.packets),
-            (3, 4, IntegratorKind::Bdpt, 2, false)
+            (3, 4, IntegratorKind::Bdpt, 2, Packets::Off)
         );
         assert_eq!(s.wavelengths, WavelengthSampler::Uniform);
         assert!(!s.offset.is_epsilon(s.integrator));

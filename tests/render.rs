@@ -275,7 +275,7 @@ fn image_is_identical_for_any_thread_count() {
     let c = run(&s, 7);
     assert!(a == b && b == c, "films differ between thread counts");
     let mut o = RenderOptions::from_scene(&s);
-    o.settings.packets = false;
+    o.settings.packets = heron::settings::Packets::Off;
     let (d, _) = render(&s, &o).unwrap();
     // Embree's packet and single-ray kernels may round t differently in the last bits,
     // so the two images agree closely but not bit for bit.

@@ -203,6 +203,7 @@ impl Scene {
                     max_depth,
                     offset,
                     kernel: None,
+                    packets: None,
                     no_packets: false,
                 })
                 .map_err(|e| lib_err(e, RENAMES))?;

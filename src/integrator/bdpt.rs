@@ -30,9 +30,9 @@
 //! bounce), then per camera bounce lobe 1D and direction 2D, then for each (s = 1, t)
 //! connection the light choice 1D and point 2D. Subpaths are at most [`MAX_VERTICES`]
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
-use super::toolkit::{next_hit, occluded, pixel_of, LightPathStart};
+use super::toolkit::{next_hit, pixel_of, Connection, Connections, LightPathStart};
 use super::{Context, TraceCounters};
-use crate::accel::embree::Hit;
+use crate::accel::embree::{Hit, RayQuery};
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
@@ -40,6 +40,7 @@ use crate::light::Light;
 use crate::math::Frame;
 use crate::sampler::Sampler;
 use crate::scene::{Scene, NO_LIGHT};
+use crate::settings::Packets;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 
@@ -470,12 +471,20 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         n + 1
     }
 
-    /// Geometry term with visibility between two vertices.
-    fn g(&self, a: &Vertex<N>, b: &Vertex<N>, counters: &mut TraceCounters) -> f32 {
+    /// Geometry term between two vertices with their visibility: 0 when blocked (or
+    /// degenerate), else the term and the shadow ray still to trace (deferred by
+    /// `conns`).
+    fn g(
+        &self,
+        a: &Vertex<N>,
+        b: &Vertex<N>,
+        conns: &Connections<N>,
+        counters: &mut TraceCounters,
+    ) -> (f32, Option<RayQuery>) {
         let w = b.p - a.p;
         let d2 = w.length_squared();
         if d2 == 0.0 {
-            return 0.0;
+            return (0.0, None);
         }
         let d = d2.sqrt();
         let w = w / d;
@@ -486,22 +495,33 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         if b.on_surface() {
             g *= b.n.dot(w).abs();
         }
-        if g == 0.0 || self.blocked(&a.spawn_point(), w, d, &b.spawn_point(), counters) {
-            return 0.0;
+        if g == 0.0 {
+            return (0.0, None);
         }
-        g
+        match self.shadow(&a.spawn_point(), w, d, &b.spawn_point(), conns, counters) {
+            Err(()) => (0.0, None),
+            Ok(q) => (g, q),
+        }
     }
 
-    /// The shadow ray between two vertices ([`occluded`]).
-    fn blocked(
+    /// The shadow ray between two points, with the render's `RayOffset` cutoffs (points
+    /// too close to tell apart count as blocked): `Err` when it is known to be blocked,
+    /// else the query still to trace (`None`: traced and clear).
+    fn shadow(
         &self,
         from: &SpawnPoint,
         w: Vec3,
         dist: f32,
         to: &SpawnPoint,
+        conns: &Connections<N>,
         counters: &mut TraceCounters,
-    ) -> bool {
-        occluded(self.ctx, from, w, dist, to, counters)
+    ) -> Result<Option<RayQuery>, ()> {
+        let q = self.ctx.offset.shadow(from, w, dist, to);
+        match conns.visible(self.ctx, q, counters) {
+            Some(true) => Ok(None),
+            Some(false) => Err(()),
+            None => Ok(q),
+        }
     }
 
     /// The power-heuristic weight of strategy (s, t); `sampled` replaces the
@@ -606,7 +626,8 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     }
 
     /// Strategy (s, t): its MIS-weighted contribution to the camera's pixel, or (for
-    /// t = 1) a splat.
+    /// t = 1) a splat; None when it adds nothing. Its shadow ray is traced now or
+    /// deferred, as `conns` does.
     #[allow(clippy::too_many_arguments)]
     fn connect(
         &self,
@@ -615,31 +636,28 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         s: usize,
         t: usize,
         sampler: &mut Sampler,
+        conns: &Connections<N>,
         counters: &mut TraceCounters,
-        splats: &mut Splats,
-    ) -> SampledSpectrum<N> {
+    ) -> Option<Connection<N>> {
         let scene = self.scene();
-        let zero = SampledSpectrum::zero();
         // A camera path that reached a light is only used as such (s = 0).
         if t > 1 && s != 0 && camera[t - 1].kind == Kind::Light {
-            return zero;
+            return None;
         }
         let mut sampled = None;
-        let l = if s == 0 {
+        let (l, shadow) = if s == 0 {
             let pt = camera[t - 1];
             if !pt.is_light() {
-                return zero;
+                return None;
             }
-            self.le(&pt, &camera[t - 2]) * pt.beta
+            (self.le(&pt, &camera[t - 2]) * pt.beta, None)
         } else if t == 1 {
             let qs = light[s - 1];
             if !qs.connectible(scene) || qs.infinite {
-                return zero;
+                return None;
             }
             let cam = &scene.camera;
-            let Some(cs) = cam.sample_wi(qs.p) else {
-                return zero;
-            };
+            let cs = cam.sample_wi(qs.p)?;
             let mut cv = Vertex::EMPTY;
             cv.kind = Kind::Camera;
             cv.p = cam.eye;
@@ -652,29 +670,31 @@ impl<'a, const N: usize> Bdpt<'a, N> {
                 c *= qs.n.dot(cs.wi).abs();
             }
             let eye = SpawnPoint::free(cam.eye);
-            if c.is_zero() || self.blocked(&qs.spawn_point(), cs.wi, cs.dist, &eye, counters) {
-                return zero;
+            if c.is_zero() {
+                return None;
             }
+            let shadow = self
+                .shadow(&qs.spawn_point(), cs.wi, cs.dist, &eye, conns, counters)
+                .ok()?;
             sampled = Some(cv);
             let w = self.mis_weight(light, camera, sampled, s, t);
-            splats.add(pixel_of(cam, cs.raster), &(c * w), self.wl);
-            return zero;
+            return Some(Connection {
+                c: c * w,
+                splat: Some(pixel_of(cam, cs.raster)),
+                shadow,
+            });
         } else if s == 1 {
             let pt = camera[t - 1];
             let u_light = sampler.get_1d();
             let u_point = sampler.get_2d();
             if !pt.connectible(scene) {
-                return zero;
+                return None;
             }
-            let Some((li, pmf)) = scene.light_sampler.sample(u_light) else {
-                return zero;
-            };
+            let (li, pmf) = scene.light_sampler.sample(u_light)?;
             let lt = &scene.lights[li];
-            let Some(ls) = lt.sample_li(pt.p, u_point, self.wl) else {
-                return zero;
-            };
+            let ls = lt.sample_li(pt.p, u_point, self.wl)?;
             if !(ls.pdf > 0.0) || ls.l.is_zero() {
-                return zero;
+                return None;
             }
             let mut lv = Vertex::EMPTY;
             lv.kind = Kind::Light;
@@ -694,17 +714,25 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if pt.on_surface() {
                 c *= pt.n.dot(ls.wi).abs();
             }
-            if c.is_zero()
-                || self.blocked(&pt.spawn_point(), ls.wi, ls.dist, &ls.target(), counters)
-            {
-                return zero;
+            if c.is_zero() {
+                return None;
             }
+            let shadow = self
+                .shadow(
+                    &pt.spawn_point(),
+                    ls.wi,
+                    ls.dist,
+                    &ls.target(),
+                    conns,
+                    counters,
+                )
+                .ok()?;
             sampled = Some(lv);
-            c
+            (c, shadow)
         } else {
             let (qs, pt) = (light[s - 1], camera[t - 1]);
             if !qs.connectible(scene) || !pt.connectible(scene) || qs.infinite {
-                return zero;
+                return None;
             }
             let alive = N > 1 && !qs.ended && !pt.ended;
             let (fq, ended_q) = self.f(&qs, &pt, TransportMode::Importance, alive);
@@ -715,15 +743,19 @@ impl<'a, const N: usize> Bdpt<'a, N> {
                 c *= 1.0 / N as f32;
             }
             if c.is_zero() {
-                return zero;
+                return None;
             }
-            let g = self.g(&qs, &pt, counters);
-            c * g
+            let (g, shadow) = self.g(&qs, &pt, conns, counters);
+            (c * g, shadow)
         };
         if l.is_zero() {
-            return zero;
+            return None;
         }
-        l * self.mis_weight(light, camera, sampled, s, t)
+        Some(Connection {
+            c: l * self.mis_weight(light, camera, sampled, s, t),
+            splat: None,
+            shadow,
+        })
     }
 }
 
@@ -757,17 +789,18 @@ pub fn radiance<const N: usize>(
         counters,
     );
     let mut l = SampledSpectrum::<N>::zero();
+    let mut conns = Connections::new(ctx.settings.packets == Packets::Paths);
     for t in 1..=n_camera {
         for s in 0..=n_light {
             let depth = s as isize + t as isize - 2;
             if (s == 1 && t == 1) || depth < 0 || depth > max_depth as isize {
                 continue;
             }
-            let c = b.connect(&mut light, &mut camera, s, t, sampler, counters, splats);
-            if c.is_finite() {
-                l += c;
+            if let Some(c) = b.connect(&mut light, &mut camera, s, t, sampler, &conns, counters) {
+                conns.push(ctx, c, (&mut l, splats), wl, counters);
             }
         }
     }
+    conns.flush(ctx, (&mut l, splats), wl, counters);
     l
 }

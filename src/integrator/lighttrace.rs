@@ -19,12 +19,14 @@
 //!
 //! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
 //! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
-use super::toolkit::{next_hit, occluded, pixel_of, roulette, LightPathStart};
+use super::toolkit::{next_hit, pixel_of, roulette, Connection, Connections, LightPathStart};
 use super::{Context, TraceCounters};
 use crate::bsdf::{BsdfContext, TransportMode};
+use crate::camera::CameraWiSample;
 use crate::film::Splats;
 use crate::geometry::SpawnPoint;
 use crate::sampler::Sampler;
+use crate::settings::Packets;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Traces one light path and splats its connections to the camera; returns nothing for
@@ -49,13 +51,38 @@ pub fn radiance<const N: usize>(
     let light_point = le.spawn_point();
     let eye = SpawnPoint::free(cam.eye);
 
+    // The connections to the camera, their shadow rays traced one by one or, with
+    // `--packets paths`, 8 at a time.
+    let mut conns = Connections::new(settings.packets == Packets::Paths);
+    let mut own = zero;
+    // The splat of a connection from `from` along `cs`, unless its shadow ray is blocked.
+    let connect = |conns: &Connections<N>,
+                   from: &SpawnPoint,
+                   cs: &CameraWiSample,
+                   c: SampledSpectrum<N>,
+                   counters: &mut TraceCounters| {
+        let q = ctx.offset.shadow(from, cs.wi, cs.dist, &eye);
+        let shadow = match conns.visible(ctx, q, counters) {
+            Some(false) => return None,
+            Some(true) => None,
+            None => q,
+        };
+        Some(Connection {
+            c,
+            splat: Some(pixel_of(cam, cs.raster)),
+            shadow,
+        })
+    };
+
     // An emitting surface seen by the camera: the light's own vertex.
     if let Some(n) = le.normal {
         if let Some(cs) = cam.sample_wi(le.origin) {
             let emitted = scene.lights[start.index].l(n, cs.wi, wl);
-            if !emitted.is_zero() && !occluded(ctx, &light_point, cs.wi, cs.dist, &eye, counters) {
+            if !emitted.is_zero() {
                 let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
-                splats.add(pixel_of(cam, cs.raster), &(emitted * k), wl);
+                if let Some(c) = connect(&conns, &light_point, &cs, emitted * k, counters) {
+                    conns.push(ctx, c, (&mut own, splats), wl, counters);
+                }
             }
         }
     }
@@ -87,10 +114,11 @@ pub fn radiance<const N: usize>(
             if let Some(cs) = cam.sample_wi(it.position) {
                 let wi = frame.to_local(cs.wi);
                 let f = material.eval(wo, wi, wl, &bsdf_ctx).f;
-                if !f.is_zero() && !occluded(ctx, &it.spawn_point(), cs.wi, cs.dist, &eye, counters)
-                {
+                if !f.is_zero() {
                     let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
-                    splats.add(pixel_of(cam, cs.raster), &c, wl);
+                    if let Some(c) = connect(&conns, &it.spawn_point(), &cs, c, counters) {
+                        conns.push(ctx, c, (&mut own, splats), wl, counters);
+                    }
                 }
             }
         }
@@ -114,5 +142,6 @@ pub fn radiance<const N: usize>(
             break;
         }
     }
+    conns.flush(ctx, (&mut own, splats), wl, counters);
     zero
 }

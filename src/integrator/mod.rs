@@ -28,6 +28,8 @@ use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
 use crate::settings::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::Vec3;
+pub use toolkit::{Deferred, PathState};
 
 /// What an integrator needs to trace: the scene, its committed Embree scene and the
 /// render's settings (the scene's, with flags applied).
@@ -112,12 +114,68 @@ fn bdpt_any<const N: usize>(
     bdpt::radiance(ctx, ray, first_hit, wl, sampler, counters, splats)
 }
 
+/// One step of a path whose ray has the closest hit given, for the packet engine (see
+/// `whitted::step`, `path::step`): shadow rays are deferred to `Deferred`, which the
+/// engine traces with the packet's and resolves before the next step.
+pub type StepFn<const N: usize> = fn(
+    &Context,
+    &mut PathState<N>,
+    &mut Ray,
+    Option<Hit>,
+    &SampledWavelengths<N>,
+    &mut Sampler,
+    &mut TraceCounters,
+    &mut Deferred<N>,
+) -> bool;
+
+/// A path at the camera, ready for its first step.
+pub type StartFn<const N: usize> = fn(Vec3) -> PathState<N>;
+
+/// What the packet engine needs of an integrator: its start and its step, specialised
+/// to the kernel flags as [`RadianceFn`]s are.
+#[derive(Clone, Copy)]
+pub struct PathFns<const N: usize> {
+    pub start: StartFn<N>,
+    pub step: StepFn<N>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn whitted_step<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: Option<Hit>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    shadows: &mut Deferred<N>,
+) -> bool {
+    whitted::step::<N, K, _>(ctx, s, ray, hit, wl, sampler, counters, shadows)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn path_step<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: Option<Hit>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    shadows: &mut Deferred<N>,
+) -> bool {
+    path::step::<N, K, _>(ctx, s, ray, hit, wl, sampler, counters, shadows)
+}
+
 /// Every kernel of one integrator, indexed by its flags (`ALL` is 31). The path tracer
 /// has no `SPECULAR` flag, so its entries with that bit are the ones without it; the
 /// Whitted tracer has no `MEDIA` flag (scenes with media are refused under it).
 macro_rules! kernels {
     ($f:ident, $n:ident, $drop:expr; $($k:literal)*) => {
-        [$($f::<$n, { $k & !$drop }> as RadianceFn<$n>),*]
+        kernels!($f, $n, $drop, RadianceFn; $($k)*)
+    };
+    ($f:ident, $n:ident, $drop:expr, $t:ident; $($k:literal)*) => {
+        [$($f::<$n, { $k & !$drop }> as $t<$n>),*]
     };
 }
 
@@ -135,5 +193,24 @@ pub fn kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> RadianceF
                 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
         IntegratorKind::LightTrace => lighttrace_any::<N>,
         IntegratorKind::Bdpt => bdpt_any::<N>,
+    }
+}
+
+/// The start and step of integrator `kind` with `N` lanes and kernel flags `k`, for the
+/// packet engine; `None` for light tracing and BDPT, which run one path at a time.
+pub fn path_fns<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> Option<PathFns<N>> {
+    let k = (k & ALL) as usize;
+    match kind {
+        IntegratorKind::Whitted => Some(PathFns {
+            start: whitted::start::<N>,
+            step: kernels!(whitted_step, N, MEDIA, StepFn; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
+                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
+        }),
+        IntegratorKind::Path => Some(PathFns {
+            start: path::start::<N>,
+            step: kernels!(path_step, N, SPECULAR, StepFn; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
+                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
+        }),
+        IntegratorKind::LightTrace | IntegratorKind::Bdpt => None,
     }
 }

@@ -40,11 +40,12 @@
 //! where T_λ is the phase sample's chance of flying to the light unscattered. When a
 //! dispersive refraction has ended the companions, the hero's own densities are used.
 use super::toolkit::{
-    light_pdf, next_hit, occluded, roulette, sample_light, transmittance, MAX_CROSSINGS,
+    light_pdf, next_hit, roulette, sample_light, transmittance, Immediate, PathState, ShadowSink,
+    MAX_CROSSINGS,
 };
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
-use crate::bsdf::{BsdfContext, Material};
+use crate::bsdf::Material;
 use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::SurfacePoint;
 use crate::math::warp::power_heuristic;
@@ -70,114 +71,101 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
-    let scene = ctx.scene;
     let mut s = PathState::<N>::start(ray.origin);
     let mut pending = first_hit;
     loop {
         let hit = next_hit(ctx, &ray, &mut pending, counters);
-        if on(K, MEDIA) && s.medium != NO_MEDIUM {
-            // A closed boundary always stops a ray inside; a ray that escapes it leaked.
-            let Some(h) = &hit else { break };
-            match medium_segment::<N, K>(ctx, &mut s, &mut ray, h, wl, sampler, counters) {
-                Segment::Scattered => continue,
-                Segment::Ended => break,
-                Segment::Crossed => {}
-            }
-        }
-        if on(K, MEDIA) {
-            if let Some(h) = &hit {
-                if scene.shapes[h.geom_id as usize].interface {
-                    // An index-matched boundary: cross it, switching media, no bounce.
-                    let (it, _) = scene.interaction(&ray, h, ctx.offset.is_robust());
-                    s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
-                        scene.shapes[h.geom_id as usize].medium
-                    } else {
-                        NO_MEDIUM
-                    };
-                    s.crossings += 1;
-                    if s.crossings > MAX_CROSSINGS {
-                        break;
-                    }
-                    ray = ctx.offset.spawn(&it.spawn_point(), ray.dir);
-                    continue;
-                }
-            }
-        }
-        // The lanes' mean of r_u (1 without media) divides every contribution found.
-        let mis = if on(K, MEDIA) {
-            lane_mean(s.r_u, s.bsdf_ctx.companions_alive)
-        } else {
-            1.0
-        };
-        let Some(hit) = hit else {
-            if on(K, ESCAPE) {
-                for &i in &scene.infinite_lights {
-                    let le = scene.lights[i as usize].le(ray.dir, wl);
-                    if !le.is_zero() {
-                        let (prev_p, dir) = (s.prev_p, ray.dir);
-                        s.add_found_light::<K>(le, mis, || {
-                            light_pdf(ctx, i as usize, prev_p, dir, None)
-                        });
-                    }
-                }
-            }
-            break;
-        };
-        if !surface_vertex::<N, K>(ctx, &mut s, &mut ray, &hit, mis, wl, sampler, counters) {
+        if !step::<N, K, _>(
+            ctx,
+            &mut s,
+            &mut ray,
+            hit,
+            wl,
+            sampler,
+            counters,
+            &mut Immediate,
+        ) {
             break;
         }
     }
     s.l
 }
 
-/// What a path carries from one vertex to the next.
-struct PathState<const N: usize> {
-    /// Radiance found so far.
-    l: SampledSpectrum<N>,
-    /// Throughput.
-    beta: SampledSpectrum<N>,
-    bsdf_ctx: BsdfContext,
-    /// For MIS when a BSDF or phase sample reaches a light: whether the last vertex
-    /// scattered by a delta lobe, where it was, the density of its direction, and
-    /// whether it was in a medium.
-    specular_bounce: bool,
-    prev_p: Vec3,
-    prev_pdf: f32,
-    prev_medium: bool,
-    /// The product of the refractions' η², undone by the roulette.
-    eta_scale: f32,
-    /// Scattering events so far.
-    depth: u32,
-    /// The medium the path is in, the rescaled path probabilities (unidirectional r_u;
-    /// r_l for a light reached from the last medium vertex, before its light pdf), and
-    /// the boundaries crossed without a bounce (bounded, against a ray caught between
-    /// coincident boundaries).
-    medium: u32,
-    r_u: SampledSpectrum<N>,
-    r_l: SampledSpectrum<N>,
-    crossings: u32,
+/// The path's state at the camera: what [`step`] starts from.
+#[inline]
+pub fn start<const N: usize>(origin: Vec3) -> PathState<N> {
+    PathState::start(origin)
+}
+
+/// One step of the path whose ray `ray` has the closest hit `hit`: the segment through a
+/// medium, a boundary crossed, the light found along an escaping ray, or a surface
+/// vertex; `ray` becomes the next ray. Returns false when the path has ended. Shadow
+/// rays go to `shadows` (the packet engine traces them after the step, before the next).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: Option<Hit>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    shadows: &mut S,
+) -> bool {
+    let scene = ctx.scene;
+    if on(K, MEDIA) && s.medium != NO_MEDIUM {
+        // A closed boundary always stops a ray inside; a ray that escapes it leaked.
+        let Some(h) = &hit else { return false };
+        match medium_segment::<N, K>(ctx, s, ray, h, wl, sampler, counters) {
+            Segment::Scattered => return true,
+            Segment::Ended => return false,
+            Segment::Crossed => {}
+        }
+    }
+    if on(K, MEDIA) {
+        if let Some(h) = &hit {
+            if scene.shapes[h.geom_id as usize].interface {
+                // An index-matched boundary: cross it, switching media, no bounce.
+                let (it, _) = scene.interaction(ray, h, ctx.offset.is_robust());
+                s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
+                    scene.shapes[h.geom_id as usize].medium
+                } else {
+                    NO_MEDIUM
+                };
+                s.crossings += 1;
+                if s.crossings > MAX_CROSSINGS {
+                    return false;
+                }
+                *ray = ctx.offset.spawn(&it.spawn_point(), ray.dir);
+                return true;
+            }
+        }
+    }
+    // The lanes' mean of r_u (1 without media) divides every contribution found.
+    let mis = if on(K, MEDIA) {
+        lane_mean(s.r_u, s.bsdf_ctx.companions_alive)
+    } else {
+        1.0
+    };
+    let Some(hit) = hit else {
+        if on(K, ESCAPE) {
+            for &i in &scene.infinite_lights {
+                let le = scene.lights[i as usize].le(ray.dir, wl);
+                if !le.is_zero() {
+                    let (prev_p, dir) = (s.prev_p, ray.dir);
+                    s.add_found_light::<K>(le, mis, || {
+                        light_pdf(ctx, i as usize, prev_p, dir, None)
+                    });
+                }
+            }
+        }
+        return false;
+    };
+    surface_vertex::<N, K, S>(ctx, s, ray, &hit, mis, wl, sampler, counters, shadows)
 }
 
 impl<const N: usize> PathState<N> {
-    #[inline(always)]
-    fn start(origin: Vec3) -> Self {
-        PathState {
-            l: SampledSpectrum::zero(),
-            beta: SampledSpectrum::splat(1.0),
-            bsdf_ctx: BsdfContext::radiance::<N>(),
-            specular_bounce: true,
-            prev_p: origin,
-            prev_pdf: 0.0,
-            prev_medium: false,
-            eta_scale: 1.0,
-            depth: 0,
-            medium: NO_MEDIUM,
-            r_u: SampledSpectrum::splat(1.0),
-            r_l: SampledSpectrum::splat(1.0),
-            crossings: 0,
-        }
-    }
-
     /// Adds radiance `le` from a light the path reached by BSDF or phase sampling:
     /// whole after a delta lobe, else weighted against light sampling, whose density
     /// `p_light` gives (the power heuristic after a surface, the balance heuristic over
@@ -341,7 +329,7 @@ fn medium_direct_light<const N: usize>(
 /// continuation with Russian roulette. Returns false when the path ends.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn surface_vertex<const N: usize, const K: KernelFlags>(
+fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     ctx: &Context,
     s: &mut PathState<N>,
     ray: &mut Ray,
@@ -350,6 +338,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags>(
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
+    shadows: &mut S,
 ) -> bool {
     let scene = ctx.scene;
     let (it, material) = scene.interaction(ray, hit, ctx.offset.is_robust());
@@ -395,9 +384,17 @@ fn surface_vertex<const N: usize, const K: KernelFlags>(
             frame: &frame,
             wo_local,
         };
-        if let Some(ld) =
-            surface_direct_light::<N, K>(ctx, s, &v, mis, u_light, u_light_point, wl, counters)
-        {
+        if let Some(ld) = surface_direct_light::<N, K, S>(
+            ctx,
+            s,
+            &v,
+            mis,
+            u_light,
+            u_light_point,
+            wl,
+            counters,
+            shadows,
+        ) {
             s.l += ld;
         }
     }
@@ -450,7 +447,7 @@ struct SurfaceVertex<'a> {
 /// the way (kernels with `MEDIA`) or past occluders.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn surface_direct_light<const N: usize, const K: KernelFlags>(
+fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     ctx: &Context,
     s: &PathState<N>,
     v: &SurfaceVertex,
@@ -459,6 +456,7 @@ fn surface_direct_light<const N: usize, const K: KernelFlags>(
     u_light_point: Vec2,
     wl: &SampledWavelengths<N>,
     counters: &mut TraceCounters,
+    shadows: &mut S,
 ) -> Option<SampledSpectrum<N>> {
     let it = v.it;
     let cl = sample_light(ctx, it.position, u_light, u_light_point, wl)?;
@@ -468,44 +466,43 @@ fn surface_direct_light<const N: usize, const K: KernelFlags>(
     if f.is_zero() {
         return None;
     }
-    // Through media: the transmittance of the shadow ray (None: blocked).
-    let tr_l = if on(K, MEDIA) {
-        let from = if ls.wi.dot(it.n_outward) < 0.0 {
-            ctx.scene.shapes[v.geom as usize].medium
+    let weight = |cl_pdf: f32| {
+        if ls.delta {
+            1.0
         } else {
-            medium_outside(s.medium, ctx.scene, v.geom)
-        };
-        transmittance(
-            ctx,
-            &it.spawn_point(),
-            ls.wi,
-            ls.dist,
-            &ls.target(),
-            from,
-            wl,
-            counters,
-        )?
-    } else if occluded(
+            power_heuristic(
+                cl_pdf,
+                v.material.pdf(v.wo_local, wi_local, wl, &s.bsdf_ctx),
+            )
+        }
+    };
+    if !on(K, MEDIA) {
+        // Past occluders: the shadow ray, traced now or with the packet's.
+        let q = ctx
+            .offset
+            .shadow(&it.spawn_point(), ls.wi, ls.dist, &ls.target());
+        return shadows.test(ctx, q, counters, || {
+            s.beta * f * ls.l * (weight(cl.pdf) / (cl.pdf * mis))
+        });
+    }
+    // Through media: the transmittance of the shadow ray (None: blocked).
+    let from = if ls.wi.dot(it.n_outward) < 0.0 {
+        ctx.scene.shapes[v.geom as usize].medium
+    } else {
+        medium_outside(s.medium, ctx.scene, v.geom)
+    };
+    let tr_l = transmittance(
         ctx,
         &it.spawn_point(),
         ls.wi,
         ls.dist,
         &ls.target(),
+        from,
+        wl,
         counters,
-    ) {
-        return None;
-    } else {
-        SampledSpectrum::splat(1.0)
-    };
-    let w = if ls.delta {
-        1.0
-    } else {
-        power_heuristic(
-            cl.pdf,
-            v.material.pdf(v.wo_local, wi_local, wl, &s.bsdf_ctx),
-        )
-    };
-    let f = if on(K, MEDIA) { f * tr_l } else { f };
+    )?;
+    let w = weight(cl.pdf);
+    let f = f * tr_l;
     Some(s.beta * f * ls.l * (w / (cl.pdf * mis)))
 }
 

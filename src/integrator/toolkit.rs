@@ -10,8 +10,10 @@
 //! material's (`Material::eval`, `BsdfSample::ended_companions`): no integrator holds
 //! either rule.
 use super::{Context, TraceCounters};
-use crate::accel::embree::Hit;
+use crate::accel::embree::{Hit, RayQuery};
+use crate::bsdf::BsdfContext;
 use crate::camera::Camera;
+use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
 use crate::medium::NO_MEDIUM;
@@ -154,26 +156,6 @@ pub(crate) fn pixel_of(cam: &Camera, raster: (f32, f32)) -> u32 {
     y * cam.width + x
 }
 
-/// Whether the shadow ray from `from` toward `to`, which lies along unit `wi` at
-/// distance `dist` (infinite: a light at infinity), is blocked, with the cutoffs of the
-/// render's `RayOffset` (the seed's: t_min = ε, t_max = dist − ε). Points too close to
-/// tell apart count as blocked.
-#[inline]
-pub(crate) fn occluded(
-    ctx: &Context,
-    from: &SpawnPoint,
-    wi: Vec3,
-    dist: f32,
-    to: &SpawnPoint,
-    counters: &mut TraceCounters,
-) -> bool {
-    let Some(q) = ctx.offset.shadow(from, wi, dist, to) else {
-        return true;
-    };
-    counters.shadow_rays += 1;
-    ctx.accel.occluded1(&q)
-}
-
 /// The most boundaries a path or shadow ray crosses between two bounces.
 pub(crate) const MAX_CROSSINGS: u32 = 256;
 
@@ -233,4 +215,343 @@ pub(crate) fn transmittance<const N: usize>(
         q = ctx.offset.shadow(&it.spawn_point(), wi, rest, to)?;
     }
     None
+}
+
+/// What a path carries from one vertex to the next (`whitted` uses the radiance, the
+/// throughput, the BSDF context and the depth).
+pub struct PathState<const N: usize> {
+    /// Radiance found so far.
+    pub(crate) l: SampledSpectrum<N>,
+    /// Throughput.
+    pub(crate) beta: SampledSpectrum<N>,
+    pub(crate) bsdf_ctx: BsdfContext,
+    /// For MIS when a BSDF or phase sample reaches a light: whether the last vertex
+    /// scattered by a delta lobe, where it was, the density of its direction, and
+    /// whether it was in a medium.
+    pub(crate) specular_bounce: bool,
+    pub(crate) prev_p: Vec3,
+    pub(crate) prev_pdf: f32,
+    pub(crate) prev_medium: bool,
+    /// The product of the refractions' η², undone by the roulette.
+    pub(crate) eta_scale: f32,
+    /// Scattering events so far.
+    pub(crate) depth: u32,
+    /// The medium the path is in, the rescaled path probabilities (unidirectional r_u;
+    /// r_l for a light reached from the last medium vertex, before its light pdf), and
+    /// the boundaries crossed without a bounce (bounded, against a ray caught between
+    /// coincident boundaries).
+    pub(crate) medium: u32,
+    pub(crate) r_u: SampledSpectrum<N>,
+    pub(crate) r_l: SampledSpectrum<N>,
+    pub(crate) crossings: u32,
+}
+
+impl<const N: usize> PathState<N> {
+    #[inline(always)]
+    pub(crate) fn start(origin: Vec3) -> Self {
+        PathState {
+            l: SampledSpectrum::zero(),
+            beta: SampledSpectrum::splat(1.0),
+            bsdf_ctx: BsdfContext::radiance::<N>(),
+            specular_bounce: true,
+            prev_p: origin,
+            prev_pdf: 0.0,
+            prev_medium: false,
+            eta_scale: 1.0,
+            depth: 0,
+            medium: NO_MEDIUM,
+            r_u: SampledSpectrum::splat(1.0),
+            r_l: SampledSpectrum::splat(1.0),
+            crossings: 0,
+        }
+    }
+}
+
+impl<const N: usize> PathState<N> {
+    /// The radiance the path has found.
+    #[inline]
+    pub fn radiance(&self) -> SampledSpectrum<N> {
+        self.l
+    }
+}
+
+/// Where a vertex's shadow rays go. The one-path-at-a-time engine traces each at once
+/// ([`Immediate`]); the packet engine defers them ([`Deferred`]) so that the shadow rays
+/// of a packet's paths go to Embree together, and adds what they carry once it knows
+/// which are blocked. A contribution is computed from values the vertex has before the
+/// path moves on, and added to the radiance before anything the next vertex finds, so
+/// both give the same sums in the same order.
+pub(crate) trait ShadowSink<const N: usize> {
+    /// The contribution `c()` of the shadow ray `q` (`None`: blocked without a query,
+    /// the points too close to tell apart): `Some` when it is known now to be
+    /// unblocked, `None` when blocked or deferred.
+    fn test(
+        &mut self,
+        ctx: &Context,
+        q: Option<RayQuery>,
+        counters: &mut TraceCounters,
+        c: impl FnOnce() -> SampledSpectrum<N>,
+    ) -> Option<SampledSpectrum<N>>;
+
+    /// `l += scale · sum`, where `sum` is the sum of the unblocked contributions of this
+    /// vertex's tests, as known now (the seed's direct lighting, summed over the lights
+    /// and then weighted by the throughput).
+    fn add_scaled(
+        &mut self,
+        l: &mut SampledSpectrum<N>,
+        scale: SampledSpectrum<N>,
+        sum: SampledSpectrum<N>,
+    );
+}
+
+/// Shadow rays traced as they come (`rtcOccluded1`).
+pub(crate) struct Immediate;
+
+impl<const N: usize> ShadowSink<N> for Immediate {
+    #[inline(always)]
+    fn test(
+        &mut self,
+        ctx: &Context,
+        q: Option<RayQuery>,
+        counters: &mut TraceCounters,
+        c: impl FnOnce() -> SampledSpectrum<N>,
+    ) -> Option<SampledSpectrum<N>> {
+        let q = q?;
+        counters.shadow_rays += 1;
+        (!ctx.accel.occluded1(&q)).then(c)
+    }
+
+    #[inline(always)]
+    fn add_scaled(
+        &mut self,
+        l: &mut SampledSpectrum<N>,
+        scale: SampledSpectrum<N>,
+        sum: SampledSpectrum<N>,
+    ) {
+        *l += scale * sum;
+    }
+}
+
+/// Shadow rays kept for the packet engine: one vertex's tests in order, each with its
+/// contribution and, once traced, whether it is blocked.
+pub struct Deferred<const N: usize> {
+    pub(crate) tests: Vec<DeferredTest<N>>,
+    /// `Some(scale)`: the unblocked contributions are summed and then added times
+    /// `scale` ([`ShadowSink::add_scaled`]); `None`: each is added as it is.
+    scale: Option<SampledSpectrum<N>>,
+}
+
+/// One deferred shadow ray: its query (`None`: blocked without one), whether it is
+/// blocked (set by the engine once traced) and what it adds when not.
+pub(crate) struct DeferredTest<const N: usize> {
+    pub(crate) query: Option<RayQuery>,
+    pub(crate) blocked: bool,
+    c: SampledSpectrum<N>,
+}
+
+impl<const N: usize> Default for Deferred<N> {
+    fn default() -> Self {
+        Deferred {
+            tests: Vec::new(),
+            scale: None,
+        }
+    }
+}
+
+impl<const N: usize> Deferred<N> {
+    /// Forgets the last vertex's tests (keeping the memory).
+    #[inline]
+    pub fn clear(&mut self) {
+        self.tests.clear();
+        self.scale = None;
+    }
+
+    /// Adds the unblocked contributions to `l`, as [`Immediate`] would have.
+    #[inline]
+    pub fn resolve(&self, l: &mut SampledSpectrum<N>) {
+        match self.scale {
+            None => {
+                for t in &self.tests {
+                    if !t.blocked {
+                        *l += t.c;
+                    }
+                }
+            }
+            Some(scale) => {
+                let mut sum = SampledSpectrum::<N>::zero();
+                for t in &self.tests {
+                    if !t.blocked {
+                        sum += t.c;
+                    }
+                }
+                *l += scale * sum;
+            }
+        }
+    }
+}
+
+impl<const N: usize> ShadowSink<N> for Deferred<N> {
+    #[inline(always)]
+    fn test(
+        &mut self,
+        _: &Context,
+        q: Option<RayQuery>,
+        _: &mut TraceCounters,
+        c: impl FnOnce() -> SampledSpectrum<N>,
+    ) -> Option<SampledSpectrum<N>> {
+        self.tests.push(DeferredTest {
+            query: q,
+            blocked: q.is_none(),
+            c: c(),
+        });
+        None
+    }
+
+    #[inline(always)]
+    fn add_scaled(
+        &mut self,
+        _: &mut SampledSpectrum<N>,
+        scale: SampledSpectrum<N>,
+        _: SampledSpectrum<N>,
+    ) {
+        self.scale = Some(scale);
+    }
+}
+
+/// What a connection adds once its shadow ray (if any) is known to be clear: to the
+/// pixel sample's own radiance (BDPT's s ≥ 0, t ≥ 2 strategies), or splatted into a
+/// pixel (a light path's vertex seen by the camera).
+#[derive(Clone, Copy)]
+pub(crate) struct Connection<const N: usize> {
+    pub c: SampledSpectrum<N>,
+    pub splat: Option<u32>,
+    /// The shadow ray still to trace (`None`: none, or already traced and clear).
+    pub shadow: Option<RayQuery>,
+}
+
+/// The connections of one pixel sample (light tracing's to the camera, BDPT's
+/// strategies), added in the order they were made. With `--packets paths` their shadow
+/// rays are deferred and go to Embree 8 at a time (`rtcOccluded8`) before the
+/// connections are added; otherwise each is traced when made (`rtcOccluded1`), and a
+/// connection found blocked costs nothing more.
+pub(crate) struct Connections<const N: usize> {
+    batched: bool,
+    pending: [Option<Connection<N>>; CONNECTIONS_CAP],
+    len: usize,
+    queries: usize,
+}
+
+/// Connections kept before they are added (up to 8 of them with shadow rays: a packet).
+const CONNECTIONS_CAP: usize = 16;
+
+impl<const N: usize> Connections<N> {
+    pub fn new(batched: bool) -> Self {
+        Connections {
+            batched,
+            pending: [None; CONNECTIONS_CAP],
+            len: 0,
+            queries: 0,
+        }
+    }
+
+    /// Whether the shadow ray `q` (`None`: blocked without one) is clear: known now when
+    /// rays are traced one by one, `None` when it is deferred (the connection then
+    /// carries `q` in [`Connection::shadow`]).
+    #[inline]
+    pub fn visible(
+        &self,
+        ctx: &Context,
+        q: Option<RayQuery>,
+        counters: &mut TraceCounters,
+    ) -> Option<bool> {
+        let Some(q) = q else { return Some(false) };
+        if self.batched {
+            return None;
+        }
+        counters.shadow_rays += 1;
+        Some(!ctx.accel.occluded1(&q))
+    }
+
+    /// Adds `c` now (one by one) or once its packet has been traced.
+    #[inline]
+    pub fn push(
+        &mut self,
+        ctx: &Context,
+        c: Connection<N>,
+        out: (&mut SampledSpectrum<N>, &mut Splats),
+        wl: &SampledWavelengths<N>,
+        counters: &mut TraceCounters,
+    ) {
+        if !self.batched {
+            Self::add(&c, out, wl);
+            return;
+        }
+        self.pending[self.len] = Some(c);
+        self.len += 1;
+        self.queries += c.shadow.is_some() as usize;
+        if self.queries == 8 || self.len == CONNECTIONS_CAP {
+            self.flush(ctx, out, wl, counters);
+        }
+    }
+
+    /// Traces the deferred shadow rays as one packet and adds the clear connections, in
+    /// order.
+    pub fn flush(
+        &mut self,
+        ctx: &Context,
+        (l, splats): (&mut SampledSpectrum<N>, &mut Splats),
+        wl: &SampledWavelengths<N>,
+        counters: &mut TraceCounters,
+    ) {
+        let mut rays = [RayQuery {
+            origin: Vec3::ZERO,
+            dir: Vec3::Z,
+            tnear: 0.0,
+            tfar: 0.0,
+        }; 8];
+        let mut lane = [usize::MAX; CONNECTIONS_CAP];
+        let mut mask = 0u8;
+        let mut k = 0;
+        for (i, c) in self.pending[..self.len].iter().enumerate() {
+            if let Some(q) = c.and_then(|c| c.shadow) {
+                rays[k] = q;
+                lane[i] = k;
+                mask |= 1 << k;
+                k += 1;
+            }
+        }
+        let blocked = if mask != 0 {
+            counters.shadow_rays += k as u64;
+            ctx.accel
+                .occluded8_with(&rays, mask, crate::accel::embree::RayCoherence::Incoherent)
+        } else {
+            0
+        };
+        for (p, &k) in self.pending[..self.len].iter_mut().zip(&lane) {
+            let Some(c) = p.take() else {
+                continue;
+            };
+            if k == usize::MAX || blocked & (1 << k) == 0 {
+                Self::add(&c, (&mut *l, &mut *splats), wl);
+            }
+        }
+        self.len = 0;
+        self.queries = 0;
+    }
+
+    #[inline]
+    fn add(
+        c: &Connection<N>,
+        (l, splats): (&mut SampledSpectrum<N>, &mut Splats),
+        wl: &SampledWavelengths<N>,
+    ) {
+        match c.splat {
+            Some(p) => splats.add(p, &c.c, wl),
+            None => {
+                if c.c.is_finite() {
+                    *l += c.c;
+                }
+            }
+        }
+    }
 }

@@ -14,10 +14,10 @@
 //! surface with both (the course's glossy over glass) does both, each at full weight.
 //! Light reaching a diffuse surface through glass or off other diffuse surfaces is
 //! missing: that is the `path` integrator's job.
-use super::toolkit::{next_hit, occluded};
+use super::toolkit::{next_hit, Immediate, PathState, ShadowSink};
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
-use crate::bsdf::{BsdfContext, LobeFlags};
+use crate::bsdf::LobeFlags;
 use crate::geometry::{Interaction, Ray};
 use crate::light::Light;
 use crate::sampler::Sampler;
@@ -48,74 +48,115 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
-    let scene = ctx.scene;
-    let mut beta = SampledSpectrum::<N>::splat(1.0);
-    let mut l = SampledSpectrum::<N>::zero();
+    let mut s = start::<N>(ray.origin);
     let mut pending = first_hit;
-    let mut depth = 0u32;
-    let mut bsdf_ctx = BsdfContext::radiance::<N>().with_lobes(DELTA);
     loop {
-        let Some(hit) = next_hit(ctx, &ray, &mut pending, counters) else {
-            if on(K, ESCAPE) {
-                l += beta * scene.escaped_radiance(ray.dir, wl);
-            }
-            break;
-        };
-        let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
-        let wo = -ray.dir;
-        if on(K, EMITTERS) {
-            let emitter = scene.shapes[hit.geom_id as usize].light;
-            if emitter != NO_LIGHT {
-                l += beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
-            }
-        }
-        let flags = material.flags();
-        let frame = it.frame();
-        let wo_local = frame.to_local(wo);
-        if on(K, SHADOWS) && flags.has_non_specular() {
-            let mut lr = SampledSpectrum::<N>::zero();
-            direct_lighting(ctx, &it, wl, sampler, counters, |wi, li_cos| {
-                lr += material.eval(wo_local, frame.to_local(wi), wl, &bsdf_ctx).f * li_cos;
-            });
-            l += beta * lr;
-        }
-        if !on(K, SPECULAR) || !flags.is_specular() {
+        let hit = next_hit(ctx, &ray, &mut pending, counters);
+        if !step::<N, K, _>(
+            ctx,
+            &mut s,
+            &mut ray,
+            hit,
+            wl,
+            sampler,
+            counters,
+            &mut Immediate,
+        ) {
             break;
         }
-        // Delta lobes choose among themselves with one number, drawn only when there is
-        // a choice (reflection and transmission); a delta's direction needs none.
-        let choice = flags.contains(LobeFlags::REFLECTION | LobeFlags::TRANSMISSION);
-        let uc = if choice { sampler.get_1d() } else { 0.5 };
-        let Some(bs) = material.sample(wo_local, uc, Vec2::ZERO, wl, &bsdf_ctx) else {
-            break;
-        };
-        beta *= bs.weight();
-        if bs.ended_companions {
-            bsdf_ctx.companions_alive = false;
-        }
-        // The lecture's continuation: overwrite the ray, clear has_hit (the next
-        // iteration's `pending` is None), increment depth.
-        depth += 1;
-        if depth > ctx.settings.max_depth {
-            break;
-        }
-        ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
     }
-    l
+    s.l
 }
 
-/// Calls `visit(ωi, L_i cos θi / pdf)` for every light but the environment that reaches
-/// the shading point unoccluded, ωi being the unit direction toward the light. Lights
-/// with extent (the sun's disk, area lights) are sampled at one point.
+/// The path's state at the camera: what [`step`] starts from (the seed's tracer samples
+/// delta lobes only).
 #[inline]
-fn direct_lighting<const N: usize>(
+pub fn start<const N: usize>(origin: Vec3) -> PathState<N> {
+    let mut s = PathState::start(origin);
+    s.bsdf_ctx = s.bsdf_ctx.with_lobes(DELTA);
+    s
+}
+
+/// One shader call of the seed's loop for the ray `ray` with closest hit `hit`: the
+/// radiance along an escaping ray, or the emission, direct lighting and specular
+/// continuation at a hit; `ray` becomes the next ray. Returns false when the path ends.
+/// Shadow rays go to `shadows`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: Option<Hit>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    shadows: &mut S,
+) -> bool {
+    let scene = ctx.scene;
+    let Some(hit) = hit else {
+        if on(K, ESCAPE) {
+            s.l += s.beta * scene.escaped_radiance(ray.dir, wl);
+        }
+        return false;
+    };
+    let (it, material) = scene.interaction(ray, &hit, ctx.offset.is_robust());
+    let wo = -ray.dir;
+    if on(K, EMITTERS) {
+        let emitter = scene.shapes[hit.geom_id as usize].light;
+        if emitter != NO_LIGHT {
+            s.l += s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
+        }
+    }
+    let flags = material.flags();
+    let frame = it.frame();
+    let wo_local = frame.to_local(wo);
+    if on(K, SHADOWS) && flags.has_non_specular() {
+        let bsdf_ctx = &s.bsdf_ctx;
+        let lr = direct_lighting(ctx, &it, wl, sampler, counters, shadows, |wi| {
+            material.eval(wo_local, frame.to_local(wi), wl, bsdf_ctx).f
+        });
+        shadows.add_scaled(&mut s.l, s.beta, lr);
+    }
+    if !on(K, SPECULAR) || !flags.is_specular() {
+        return false;
+    }
+    // Delta lobes choose among themselves with one number, drawn only when there is
+    // a choice (reflection and transmission); a delta's direction needs none.
+    let choice = flags.contains(LobeFlags::REFLECTION | LobeFlags::TRANSMISSION);
+    let uc = if choice { sampler.get_1d() } else { 0.5 };
+    let Some(bs) = material.sample(wo_local, uc, Vec2::ZERO, wl, &s.bsdf_ctx) else {
+        return false;
+    };
+    s.beta *= bs.weight();
+    if bs.ended_companions {
+        s.bsdf_ctx.companions_alive = false;
+    }
+    // The lecture's continuation: overwrite the ray, clear has_hit (the next
+    // iteration's hit is traced anew), increment depth.
+    s.depth += 1;
+    if s.depth > ctx.settings.max_depth {
+        return false;
+    }
+    *ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
+    true
+}
+
+/// The sum of f(ωi) L_i cos θi / pdf over every light but the environment that reaches
+/// the shading point unoccluded (as far as `shadows` knows now; the packet engine adds
+/// the rest later), ωi being the unit direction toward the light and `f` the BSDF
+/// there. Lights with extent (the sun's disk, area lights) are sampled at one point.
+#[inline]
+fn direct_lighting<const N: usize, S: ShadowSink<N>>(
     ctx: &Context,
     it: &Interaction,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
-    mut visit: impl FnMut(Vec3, SampledSpectrum<N>),
-) {
+    shadows: &mut S,
+    f: impl Fn(Vec3) -> SampledSpectrum<N>,
+) -> SampledSpectrum<N> {
+    let mut lr = SampledSpectrum::<N>::zero();
     let x = it.position;
     let from = it.spawn_point();
     let n = it.normal;
@@ -135,8 +176,10 @@ fn direct_lighting<const N: usize>(
         if cos <= 0.0 || !(ls.pdf > 0.0) {
             continue;
         }
-        if !occluded(ctx, &from, ls.wi, ls.dist, &ls.target(), counters) {
-            visit(ls.wi, ls.l * (cos / ls.pdf));
+        let q = ctx.offset.shadow(&from, ls.wi, ls.dist, &ls.target());
+        if let Some(c) = shadows.test(ctx, q, counters, || f(ls.wi) * (ls.l * (cos / ls.pdf))) {
+            lr += c;
         }
     }
+    lr
 }
