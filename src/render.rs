@@ -997,6 +997,30 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
                 }
             }
         }
+        // Shadow rays through media walk boundary by boundary: one closest-hit packet
+        // per crossing, until every lane's walk has ended.
+        loop {
+            let mut mask = 0u8;
+            for (k, sh) in shadows.iter().enumerate() {
+                if let Some((w, _)) = &sh.walk {
+                    queries[k] = w.q;
+                    mask |= 1 << k;
+                }
+            }
+            if mask == 0 {
+                break;
+            }
+            counters.shadow_rays += mask.count_ones() as u64;
+            let hits = ctx
+                .accel
+                .intersect8_with(&queries, mask, RayCoherence::Incoherent);
+            for (k, sh) in shadows.iter_mut().enumerate() {
+                if mask & (1 << k) != 0 {
+                    let wl = &lanes[k].as_ref().expect("a walking lane is live").wl;
+                    sh.advance_walk(ctx, hits[k], wl);
+                }
+            }
+        }
         for k in 0..PACKET {
             let Some(lane) = &mut lanes[k] else { continue };
             shadows[k].resolve(&mut lane.state.l);

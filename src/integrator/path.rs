@@ -40,8 +40,8 @@
 //! where T_λ is the phase sample's chance of flying to the light unscattered. When a
 //! dispersive refraction has ended the companions, the hero's own densities are used.
 use super::toolkit::{
-    light_pdf, next_hit, roulette, sample_light, transmittance, Immediate, PathState, ShadowSink,
-    MAX_CROSSINGS,
+    lane_mean, light_pdf, next_hit, roulette, sample_light, Finish, Immediate, PathState,
+    ShadowSink, TransmittanceWalk, MAX_CROSSINGS,
 };
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
@@ -117,7 +117,7 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     if on(K, MEDIA) && s.medium != NO_MEDIUM {
         // A closed boundary always stops a ray inside; a ray that escapes it leaked.
         let Some(h) = &hit else { return false };
-        match medium_segment::<N, K>(ctx, s, ray, h, wl, sampler, counters) {
+        match medium_segment::<N, K, S>(ctx, s, ray, h, wl, sampler, counters, shadows) {
             Segment::Scattered => return true,
             Segment::Ended => return false,
             Segment::Crossed => {}
@@ -206,7 +206,7 @@ enum Segment {
 /// the surface, with the lanes' weights and rescaled probabilities updated.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn medium_segment<const N: usize, const K: KernelFlags>(
+fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     ctx: &Context,
     s: &mut PathState<N>,
     ray: &mut Ray,
@@ -214,6 +214,7 @@ fn medium_segment<const N: usize, const K: KernelFlags>(
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
+    shadows: &mut S,
 ) -> Segment {
     let m = &ctx.scene.media[s.medium as usize];
     let sigma_t = m.sigma_t(wl);
@@ -253,9 +254,18 @@ fn medium_segment<const N: usize, const K: KernelFlags>(
     let u_rr = sampler.get_1d();
     let alive = s.bsdf_ctx.companions_alive;
     if on(K, SHADOWS) {
-        if let Some(ld) =
-            medium_direct_light(ctx, s, m, ray.dir, p, u_light, u_light_point, wl, counters)
-        {
+        if let Some(ld) = medium_direct_light(
+            ctx,
+            s,
+            m,
+            ray.dir,
+            p,
+            u_light,
+            u_light_point,
+            wl,
+            counters,
+            shadows,
+        ) {
             s.l += ld;
         }
     }
@@ -288,7 +298,7 @@ fn medium_segment<const N: usize, const K: KernelFlags>(
 /// toward the light is p_λ(ω) T_λ (the chance of flying there unscattered).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn medium_direct_light<const N: usize>(
+fn medium_direct_light<const N: usize, S: ShadowSink<N>>(
     ctx: &Context,
     s: &PathState<N>,
     m: &Medium,
@@ -298,6 +308,7 @@ fn medium_direct_light<const N: usize>(
     u_light_point: Vec2,
     wl: &SampledWavelengths<N>,
     counters: &mut TraceCounters,
+    shadows: &mut S,
 ) -> Option<SampledSpectrum<N>> {
     let cl = sample_light(ctx, p, u_light, u_light_point, wl)?;
     let ls = &cl.sample;
@@ -306,23 +317,17 @@ fn medium_direct_light<const N: usize>(
         return None;
     }
     let from = SpawnPoint::free(p);
-    let tr_l = transmittance(
-        ctx,
-        &from,
-        ls.wi,
-        ls.dist,
-        &ls.target(),
-        s.medium,
-        wl,
-        counters,
-    )?;
-    let alive = s.bsdf_ctx.companions_alive;
-    let denom = if ls.delta {
-        lane_mean(s.r_u * cl.pdf, alive)
-    } else {
-        lane_mean(s.r_u * (SampledSpectrum::splat(cl.pdf) + f * tr_l), alive)
+    let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium);
+    let finish = Finish::Medium {
+        beta: s.beta,
+        f,
+        l: ls.l,
+        r_u: s.r_u,
+        pdf: cl.pdf,
+        delta: ls.delta,
+        alive: s.bsdf_ctx.companions_alive,
     };
-    (denom > 0.0).then(|| s.beta * f * tr_l * ls.l / denom)
+    shadows.transmit(ctx, walk, finish, wl, counters)
 }
 
 /// A surface vertex: the emission found there, next-event estimation, and the BSDF's
@@ -491,36 +496,20 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     } else {
         medium_outside(s.medium, ctx.scene, v.geom)
     };
-    let tr_l = transmittance(
-        ctx,
-        &it.spawn_point(),
-        ls.wi,
-        ls.dist,
-        &ls.target(),
-        from,
-        wl,
-        counters,
-    )?;
-    let w = weight(cl.pdf);
-    let f = f * tr_l;
-    Some(s.beta * f * ls.l * (w / (cl.pdf * mis)))
+    let walk = TransmittanceWalk::start(ctx, &it.spawn_point(), ls.wi, ls.dist, &ls.target(), from);
+    let finish = Finish::Surface {
+        beta: s.beta,
+        f,
+        l: ls.l,
+        scale: weight(cl.pdf) / (cl.pdf * mis),
+    };
+    shadows.transmit(ctx, walk, finish, wl, counters)
 }
 
 /// exp(−σ_t d) per lane.
 #[inline]
 fn exp_neg<const N: usize>(sigma_t: SampledSpectrum<N>, d: f32) -> SampledSpectrum<N> {
     SampledSpectrum(std::array::from_fn(|i| (-sigma_t.0[i] * d).exp()))
-}
-
-/// The mean over the lanes, or the hero's value once the companions have ended (the
-/// balance heuristic over heroes needs every lane alive).
-#[inline]
-fn lane_mean<const N: usize>(s: SampledSpectrum<N>, companions_alive: bool) -> f32 {
-    if companions_alive {
-        s.0.iter().sum::<f32>() / N as f32
-    } else {
-        s.0[0]
-    }
 }
 
 /// The medium on the outer side of shape `geom`'s surface for a path now in `current`:

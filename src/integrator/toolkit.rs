@@ -159,62 +159,177 @@ pub(crate) fn pixel_of(cam: &Camera, raster: (f32, f32)) -> u32 {
 /// The most boundaries a path or shadow ray crosses between two bounces.
 pub(crate) const MAX_CROSSINGS: u32 = 256;
 
-/// The transmittance of the shadow ray from `from` (in `medium`) toward `to` along unit
-/// `wi` at distance `dist`: exp(−σ_t ℓ) for each stretch ℓ inside a medium, continuing
-/// through index-matched medium boundaries; `None` when any other surface blocks it.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn transmittance<const N: usize>(
-    ctx: &Context,
-    from: &SpawnPoint,
+/// The transmittance of a shadow ray from a point in a medium toward a target: exp(−σ_t ℓ)
+/// for each stretch ℓ inside a medium, continuing through index-matched medium
+/// boundaries, blocked by any other surface. Walked one closest-hit query at a time (an
+/// any-hit query could not tell an occluder from a boundary to cross), so that the
+/// packet engine can send the queries of several paths' walks together; each query
+/// counts as a shadow ray.
+#[derive(Clone, Copy)]
+pub(crate) struct TransmittanceWalk<const N: usize> {
+    /// The next query.
+    pub q: RayQuery,
+    tr: SampledSpectrum<N>,
+    medium: u32,
     wi: Vec3,
     dist: f32,
-    to: &SpawnPoint,
-    mut medium: u32,
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-) -> Option<SampledSpectrum<N>> {
-    let scene = ctx.scene;
-    let mut tr = SampledSpectrum::<N>::splat(1.0);
-    let mut q = ctx.offset.shadow(from, wi, dist, to)?;
-    for _ in 0..MAX_CROSSINGS {
+    to: SpawnPoint,
+    queries: u32,
+}
+
+/// What one query of a walk found.
+pub(crate) enum WalkStep<const N: usize> {
+    /// A boundary crossed: the walk goes on with its next query.
+    Next,
+    /// The target reached, with the transmittance along the way.
+    Done(SampledSpectrum<N>),
+    /// Another surface, too many boundaries, or points too close to tell apart.
+    Blocked,
+}
+
+impl<const N: usize> TransmittanceWalk<N> {
+    /// The walk from `from` (in `medium`) toward `to`; `None` when blocked at once.
+    #[inline]
+    pub fn start(
+        ctx: &Context,
+        from: &SpawnPoint,
+        wi: Vec3,
+        dist: f32,
+        to: &SpawnPoint,
+        medium: u32,
+    ) -> Option<Self> {
+        Some(TransmittanceWalk {
+            q: ctx.offset.shadow(from, wi, dist, to)?,
+            tr: SampledSpectrum::splat(1.0),
+            medium,
+            wi,
+            dist,
+            to: *to,
+            queries: 0,
+        })
+    }
+
+    /// Takes the closest hit `hit` of the walk's query `q`.
+    #[inline]
+    pub fn advance(
+        &mut self,
+        ctx: &Context,
+        hit: Option<Hit>,
+        wl: &SampledWavelengths<N>,
+    ) -> WalkStep<N> {
+        let scene = ctx.scene;
+        let q = self.q;
         // Robust shadow rays to a point have an unnormalised direction (t in its units).
         let scale = q.dir.length();
-        // A closest-hit query: the nearest surface is either an occluder or a boundary
-        // to cross (an any-hit query could not tell which). Counted as a shadow ray.
-        counters.shadow_rays += 1;
-        let hit = ctx.accel.intersect1(&q);
+        self.queries += 1;
         let Some(h) = hit else {
-            if medium != NO_MEDIUM {
+            if self.medium != NO_MEDIUM {
                 let len = q.tfar * scale;
                 if !len.is_finite() {
-                    return None;
+                    return WalkStep::Blocked;
                 }
-                tr *= scene.media[medium as usize].transmittance(len, wl);
+                self.tr *= scene.media[self.medium as usize].transmittance(len, wl);
             }
-            return Some(tr);
+            return WalkStep::Done(self.tr);
         };
         let g = h.geom_id as usize;
         if !scene.shapes[g].interface {
-            return None;
+            return WalkStep::Blocked;
         }
-        if medium != NO_MEDIUM {
-            tr *= scene.media[medium as usize].transmittance(h.t * scale, wl);
+        if self.medium != NO_MEDIUM {
+            self.tr *= scene.media[self.medium as usize].transmittance(h.t * scale, wl);
         }
         let ray = Ray::new(q.origin, q.dir, q.tnear, q.tfar);
         let (it, _) = scene.interaction(&ray, &h, ctx.offset.is_robust());
-        medium = if wi.dot(it.n_outward) < 0.0 {
+        self.medium = if self.wi.dot(it.n_outward) < 0.0 {
             scene.shapes[g].medium
         } else {
             NO_MEDIUM
         };
-        let rest = if dist.is_finite() {
-            (to.p - it.position).length()
+        let rest = if self.dist.is_finite() {
+            (self.to.p - it.position).length()
         } else {
             f32::INFINITY
         };
-        q = ctx.offset.shadow(&it.spawn_point(), wi, rest, to)?;
+        if self.queries >= MAX_CROSSINGS {
+            return WalkStep::Blocked;
+        }
+        match ctx
+            .offset
+            .shadow(&it.spawn_point(), self.wi, rest, &self.to)
+        {
+            Some(q) => {
+                self.q = q;
+                WalkStep::Next
+            }
+            None => WalkStep::Blocked,
+        }
     }
-    None
+}
+
+/// How a next-event contribution through media follows from the shadow ray's
+/// transmittance `tr`, kept while the packet engine walks the ray (the same arithmetic
+/// as the one-path-at-a-time code, in the same order).
+#[derive(Clone, Copy)]
+pub(crate) enum Finish<const N: usize> {
+    /// At a surface: β (f tr) L · scale.
+    Surface {
+        beta: SampledSpectrum<N>,
+        f: SampledSpectrum<N>,
+        l: SampledSpectrum<N>,
+        scale: f32,
+    },
+    /// At a medium vertex: β f tr L / d, where d is the balance heuristic's denominator
+    /// over (technique, hero) pairs: mean_λ r_u p_light for a delta light, else
+    /// mean_λ r_u (p_light + f tr); nothing when d ≤ 0.
+    Medium {
+        beta: SampledSpectrum<N>,
+        f: SampledSpectrum<N>,
+        l: SampledSpectrum<N>,
+        r_u: SampledSpectrum<N>,
+        pdf: f32,
+        delta: bool,
+        alive: bool,
+    },
+}
+
+impl<const N: usize> Finish<N> {
+    #[inline]
+    pub fn apply(&self, tr: SampledSpectrum<N>) -> Option<SampledSpectrum<N>> {
+        match *self {
+            Finish::Surface { beta, f, l, scale } => {
+                let f = f * tr;
+                Some(beta * f * l * scale)
+            }
+            Finish::Medium {
+                beta,
+                f,
+                l,
+                r_u,
+                pdf,
+                delta,
+                alive,
+            } => {
+                let denom = if delta {
+                    lane_mean(r_u * pdf, alive)
+                } else {
+                    lane_mean(r_u * (SampledSpectrum::splat(pdf) + f * tr), alive)
+                };
+                (denom > 0.0).then(|| beta * f * tr * l / denom)
+            }
+        }
+    }
+}
+
+/// The mean over the lanes, or the hero's value once the companions have ended (the
+/// balance heuristic over heroes needs every lane alive).
+#[inline]
+pub(crate) fn lane_mean<const N: usize>(s: SampledSpectrum<N>, companions_alive: bool) -> f32 {
+    if companions_alive {
+        s.0.iter().sum::<f32>() / N as f32
+    } else {
+        s.0[0]
+    }
 }
 
 /// What a path carries from one vertex to the next (`whitted` uses the radiance, the
@@ -293,6 +408,18 @@ pub(crate) trait ShadowSink<const N: usize> {
         c: impl FnOnce() -> SampledSpectrum<N>,
     ) -> Option<SampledSpectrum<N>>;
 
+    /// The contribution `finish` gives for the transmittance of `walk` (`None`: blocked
+    /// at once): `Some` when known now (walked with `rtcIntersect1`), `None` when
+    /// blocked or deferred.
+    fn transmit(
+        &mut self,
+        ctx: &Context,
+        walk: Option<TransmittanceWalk<N>>,
+        finish: Finish<N>,
+        wl: &SampledWavelengths<N>,
+        counters: &mut TraceCounters,
+    ) -> Option<SampledSpectrum<N>>;
+
     /// `l += scale · sum`, where `sum` is the sum of the unblocked contributions of this
     /// vertex's tests, as known now (the seed's direct lighting, summed over the lights
     /// and then weighted by the throughput).
@@ -322,6 +449,27 @@ impl<const N: usize> ShadowSink<N> for Immediate {
     }
 
     #[inline(always)]
+    fn transmit(
+        &mut self,
+        ctx: &Context,
+        walk: Option<TransmittanceWalk<N>>,
+        finish: Finish<N>,
+        wl: &SampledWavelengths<N>,
+        counters: &mut TraceCounters,
+    ) -> Option<SampledSpectrum<N>> {
+        let mut walk = walk?;
+        loop {
+            counters.shadow_rays += 1;
+            let hit = ctx.accel.intersect1(&walk.q);
+            match walk.advance(ctx, hit, wl) {
+                WalkStep::Next => {}
+                WalkStep::Done(tr) => return finish.apply(tr),
+                WalkStep::Blocked => return None,
+            }
+        }
+    }
+
+    #[inline(always)]
     fn add_scaled(
         &mut self,
         l: &mut SampledSpectrum<N>,
@@ -336,6 +484,9 @@ impl<const N: usize> ShadowSink<N> for Immediate {
 /// contribution and, once traced, whether it is blocked.
 pub struct Deferred<const N: usize> {
     pub(crate) tests: Vec<DeferredTest<N>>,
+    /// A shadow ray through media still walking (at most one per vertex: the path
+    /// tracer's next-event estimation), and what its transmittance becomes.
+    pub(crate) walk: Option<(TransmittanceWalk<N>, Finish<N>)>,
     /// `Some(scale)`: the unblocked contributions are summed and then added times
     /// `scale` ([`ShadowSink::add_scaled`]); `None`: each is added as it is.
     scale: Option<SampledSpectrum<N>>,
@@ -353,6 +504,7 @@ impl<const N: usize> Default for Deferred<N> {
     fn default() -> Self {
         Deferred {
             tests: Vec::new(),
+            walk: None,
             scale: None,
         }
     }
@@ -363,7 +515,36 @@ impl<const N: usize> Deferred<N> {
     #[inline]
     pub fn clear(&mut self) {
         self.tests.clear();
+        self.walk = None;
         self.scale = None;
+    }
+
+    /// Takes the closest hit of the walk's query; once the walk ends, its contribution
+    /// (if any) joins the tests, unblocked. Returns whether it walks on.
+    #[inline]
+    pub fn advance_walk(
+        &mut self,
+        ctx: &Context,
+        hit: Option<Hit>,
+        wl: &SampledWavelengths<N>,
+    ) -> bool {
+        let Some((walk, finish)) = &mut self.walk else {
+            return false;
+        };
+        let c = match walk.advance(ctx, hit, wl) {
+            WalkStep::Next => return true,
+            WalkStep::Done(tr) => finish.apply(tr),
+            WalkStep::Blocked => None,
+        };
+        if let Some(c) = c {
+            self.tests.push(DeferredTest {
+                query: None,
+                blocked: false,
+                c,
+            });
+        }
+        self.walk = None;
+        false
     }
 
     /// Adds the unblocked contributions to `l`, as [`Immediate`] would have.
@@ -404,6 +585,19 @@ impl<const N: usize> ShadowSink<N> for Deferred<N> {
             blocked: q.is_none(),
             c: c(),
         });
+        None
+    }
+
+    #[inline(always)]
+    fn transmit(
+        &mut self,
+        _: &Context,
+        walk: Option<TransmittanceWalk<N>>,
+        finish: Finish<N>,
+        _: &SampledWavelengths<N>,
+        _: &mut TraceCounters,
+    ) -> Option<SampledSpectrum<N>> {
+        self.walk = walk.map(|w| (w, finish));
         None
     }
 
