@@ -4,6 +4,7 @@
     .venv/bin/python scripts/bench_mitsuba.py [--scene scenes/cornell-box.toml]
         [--ref-spp 4096] [--spp 16,32,64,128,256] [--rounds 3] [--threads 2]
         [--heron-args "--lanes 8"]... [--mitsuba-integrator direct] [--black-background]
+        [--mitsuba-sampler ldsampler]
 
 The course's default scene (a point light, Lambertian shapes: heron's Whitted tracer
 is direct lighting there) is compared with Mitsuba's `direct` integrator, one emitter
@@ -115,9 +116,11 @@ def main():
     ap.add_argument("--heron-args", action="append", default=[],
                     help="extra heron settings measured as further rows, e.g. '--lanes 8'")
     ap.add_argument("--mitsuba-integrator", choices=["path", "direct"], default="path")
-    ap.add_argument("--mitsuba-sampler", default="independent",
-                    help="Mitsuba's sampler for its two runs: independent (its default), "
-                         "stratified, multijitter, orthogonal or ldsampler")
+    ap.add_argument("--mitsuba-sampler", default="ldsampler",
+                    help="Mitsuba's sampler for its two runs: ldsampler (the default here: "
+                         "low-discrepancy points, the like-for-like peer of heron's Sobol' "
+                         "sampler), independent (Mitsuba's own default), stratified, "
+                         "multijitter or orthogonal")
     ap.add_argument("--black-background", action="store_true",
                     help="render a copy of the scene with its background set to 0")
     a = ap.parse_args()
