@@ -3,26 +3,20 @@
 //! renderer picks gives the same image, bit for bit, as the general kernel with every
 //! feature compiled in; a kernel missing a feature the scene uses does not; and the
 //! course's scenes get the kernels their contents imply.
-use heron::camera::Camera;
+mod common;
+
 use heron::render::{render, RenderOptions};
-use heron::scene::{load_scene, Features, Scene};
+use heron::scene::{Features, Scene};
 use heron::settings::IntegratorKind;
 use heron::settings::{
     flag_names, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS, SPECULAR,
 };
 use std::collections::BTreeSet;
-use std::path::Path;
 
 fn scene(name: &str) -> Scene {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name);
-    let mut s = load_scene(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
     // Small enough to render every scene twice per integrator in a second or two, large
     // enough that every feature is hit (each scene's camera sees its lights' effects).
-    let c = &s.camera;
-    s.camera = Camera::new(c.eye, c.look_at, c.up, c.d, 40, 30).unwrap();
-    s
+    common::scenes::load_small(name, 40, 30)
 }
 
 fn image(s: &Scene, kind: IntegratorKind, kernel: KernelChoice) -> (Vec<u32>, KernelFlags) {
@@ -39,14 +33,7 @@ fn image(s: &Scene, kind: IntegratorKind, kernel: KernelChoice) -> (Vec<u32>, Ke
 
 #[test]
 fn specialised_kernels_give_the_general_kernels_image() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n.ends_with(".toml"))
-        .collect();
-    names.sort();
-    assert!(names.len() >= 10, "{names:?}");
+    let names = common::scenes::names();
     let mut kernels = BTreeSet::new();
     for name in &names {
         let s = scene(name);

@@ -15,21 +15,12 @@
 //! points inside the fog and rain, to 5e-3, in about 0.1% of their pixels. The bound
 //! below allows that and no more: a lost shadow ray, a sample added twice or a random
 //! number read out of turn changes most pixels.
-use heron::camera::Camera;
-use heron::render::{render, render_state, RenderOptions};
-use heron::scene::{load_scene, Features, Scene};
-use heron::settings::{IntegratorKind, Packets};
-use std::path::Path;
+mod common;
 
-fn scene(name: &str, width: u32, height: u32) -> Scene {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name);
-    let mut s = load_scene(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let c = &s.camera;
-    s.camera = Camera::new(c.eye, c.look_at, c.up, c.d, width, height).unwrap();
-    s
-}
+use common::scenes::{load_small as scene, names as scene_names};
+use heron::render::{render, render_state, RenderOptions};
+use heron::scene::{Features, Scene};
+use heron::settings::{IntegratorKind, Packets};
 
 struct Image {
     xyz: Vec<[f32; 3]>,
@@ -68,14 +59,7 @@ fn differing(a: &[[f32; 3]], b: &[[f32; 3]]) -> usize {
 
 #[test]
 fn packets_of_paths_give_the_one_path_at_a_time_image() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n.ends_with(".toml"))
-        .collect();
-    names.sort();
-    assert!(names.len() >= 10, "{names:?}");
+    let names = scene_names();
     let (mut pairs, mut exact) = (0, 0);
     for name in &names {
         // 37x29: tiles narrower than a packet at the right and bottom edges.

@@ -4,3 +4,4 @@
 
 pub mod chi2;
 pub mod render;
+pub mod scenes;

@@ -1,0 +1,28 @@
+//! The scenes in `scenes/`, for the tests that hold every one of them to a rule.
+use heron::camera::Camera;
+use heron::scene::{load_scene, Scene};
+use std::path::Path;
+
+/// The file names of the scenes in `scenes/`, sorted (at least ten of them).
+pub fn names() -> Vec<String> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 10, "{names:?}");
+    names
+}
+
+/// The scene `name` of `scenes/`, its camera's image resized to `width` × `height`.
+pub fn load_small(name: &str, width: u32, height: u32) -> Scene {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    let mut s = load_scene(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let c = &s.camera;
+    s.camera = Camera::new(c.eye, c.look_at, c.up, c.d, width, height).unwrap();
+    s
+}
