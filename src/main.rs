@@ -593,7 +593,9 @@ struct RenderArgs {
     /// closest-hit and shadow rays sent as 8-wide packets; whitted and path), camera
     /// (camera rays in packets, every later ray alone: the one-path-at-a-time engine) or
     /// off (every ray alone). They agree up to the last bits of Embree's hits. Default
-    /// auto: paths under whitted, camera otherwise (the faster here; BENCHMARKS.md).
+    /// auto: paths under whitted, camera otherwise (off under lighttrace, which traces
+    /// no camera rays): the faster here (BENCHMARKS.md). Under lighttrace and bdpt,
+    /// paths sends each sample's connection shadow rays 8 at a time.
     #[arg(long, value_name = "HOW")]
     packets: Option<String>,
     /// Every ray alone: the same as --packets off.

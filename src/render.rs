@@ -855,6 +855,8 @@ struct Lane<const N: usize> {
     state: PathState<N>,
     ray: Ray,
     wl: SampledWavelengths<N>,
+    /// Whether `ray` is the camera ray (not yet traced).
+    camera: bool,
 }
 
 /// One tile's samples of one pass with packets of paths (`Packets::Paths`): PACKET
@@ -936,6 +938,7 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
                         state: (fns.start)(cam.eye),
                         ray: Ray::new(cam.eye, dir, 0.0, f32::INFINITY),
                         wl,
+                        camera: true,
                     });
                 }
             }
@@ -948,14 +951,33 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
             break;
         }
         counters.rays += active.count_ones() as u64;
-        // Camera rays are coherent; once the lanes hold later rays of different paths,
-        // Embree's incoherent traversal is the faster.
-        let coherence = if lanes.iter().flatten().all(|l| l.state.depth == 0) {
-            RayCoherence::Coherent
-        } else {
-            RayCoherence::Incoherent
-        };
-        let hits = ctx.accel.intersect8_with(&queries, active, coherence);
+        // Camera rays go as one coherent packet, later rays as one incoherent packet:
+        // each ray's hint follows from the ray alone. (A hint chosen by what a packet
+        // holds would make a ray's traversal, and so the last bits of its hit, depend on
+        // its partners, which differ between a whole render and its shards.) Under
+        // `whitted` most paths end at their first hit, so most rounds are all camera
+        // rays.
+        let mut fresh = 0u8;
+        for (k, lane) in lanes.iter_mut().enumerate() {
+            if let Some(lane) = lane {
+                fresh |= (lane.camera as u8) << k;
+                lane.camera = false;
+            }
+        }
+        let mut hits = [None; PACKET];
+        for (mask, hint) in [
+            (fresh, RayCoherence::Coherent),
+            (active & !fresh, RayCoherence::Incoherent),
+        ] {
+            if mask != 0 {
+                let h = ctx.accel.intersect8_with(&queries, mask, hint);
+                for (k, h) in h.into_iter().enumerate() {
+                    if mask & (1 << k) != 0 {
+                        hits[k] = h;
+                    }
+                }
+            }
+        }
         let mut going = 0u8;
         let mut rounds = 0;
         for k in 0..PACKET {

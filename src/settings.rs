@@ -264,9 +264,10 @@ pub enum Packets {
     /// engine, kept as the reference of the packet engine.
     Camera,
     /// Packets of paths: the 8 paths of a packet advance together, their closest-hit
-    /// rays go to Embree as one `rtcIntersect8` and their shadow rays as one
-    /// `rtcOccluded8`, and a path that ends is replaced by the tile's next sample
-    /// (`whitted` and `path`; light tracing and BDPT run as with `camera`).
+    /// rays go to Embree as 8-wide packets (camera rays in one, later rays in another)
+    /// and their shadow rays as `rtcOccluded8` rounds, and a path that ends is replaced
+    /// by the tile's next sample (`whitted` and `path`). Light tracing and BDPT run one
+    /// path at a time and send each pixel sample's connection shadow rays 8 at a time.
     Paths,
 }
 

@@ -9,15 +9,16 @@
 //! and `rtcOccluded1` only up to the last bits of t, u and v (tests/embree.rs checks
 //! 1e-5), and a ray that grazes an edge, or meets two coincident surfaces (the fog
 //! bank's floor on the ground), can find a different surface. Such a path goes its own
-//! way from there. Measured at 4 spp over the scenes at their own size: 13 of 19 scene
-//! and integrator pairs agree to relative RMSE 1e-7 or better (7 of them exactly), the
-//! rest but two to 1e-6, and the two media scenes, whose scattered rays leave from
-//! points inside the fog and rain, to 5e-3, in about 0.1% of their pixels. The bound
-//! below allows that and no more: a lost shadow ray, a sample added twice or a random
+//! way from there. Measured at 4 spp over the scenes at their own size under `whitted`
+//! and `path` (BENCHMARKS.md, "Packets of paths"): 16 of 36 pairs give the same pixels,
+//! the other non-media pairs agree to relative RMSE 1e-6, and the two media scenes, whose
+//! scattered rays leave from points inside the fog and rain, to 5e-3, in about 0.1% of
+//! their pixels. The bound below allows that and no more: a lost shadow ray, a sample added twice or a random
 //! number read out of turn changes most pixels.
 mod common;
 
 use common::scenes::{load_small as scene, names as scene_names};
+use heron::checkpoint::Shard;
 use heron::render::{render, render_state, RenderOptions};
 use heron::scene::{Features, Scene};
 use heron::settings::{IntegratorKind, Packets};
@@ -106,8 +107,8 @@ fn packets_of_paths_give_the_one_path_at_a_time_image() {
     );
 }
 
-/// The packet engine's image does not depend on the thread count, nor on how many of a
-/// tile's samples one pass holds (its lanes refill across samples and pixels).
+/// The packet engine's image does not depend on the thread count (the passes' sample
+/// ranges, which decide the packets' partners, are the next test's).
 #[test]
 fn packets_of_paths_are_deterministic() {
     let s = scene("default-glass.toml", 45, 35);
@@ -122,6 +123,33 @@ fn packets_of_paths_are_deterministic() {
         assert!(one.xyz == two.xyz, "{}", kind.name());
         assert_eq!((one.rays, one.shadow_rays), (two.rays, two.shadow_rays));
     }
+}
+
+/// The shards of a render with packets of paths add up to the one render exactly, in a
+/// scene where a ray's hit is most sensitive to how Embree traverses it (the fog bank's
+/// floor on the ground): each shard's passes start at other samples, so its packets hold
+/// other partners, and a hint chosen by what a packet holds made the two differ.
+#[test]
+fn shards_of_packets_of_paths_add_up_to_the_one_render() {
+    let s = scene("fogbow.toml", 96, 54);
+    let mut o = RenderOptions::from_scene(&s);
+    o.settings.integrator = IntegratorKind::Path;
+    o.settings.packets = Packets::Paths;
+    o.settings.spp = 7;
+    o.threads = 2;
+    let (one, _) = render_state(&s, &o).unwrap();
+    let mut sum = vec![[0i128; 3]; one.sum_xyz.len()];
+    for k in 0..3 {
+        o.shard = Some(Shard::parse(&format!("{k}/3")).unwrap());
+        let (part, _) = render_state(&s, &o).unwrap();
+        for (a, b) in sum.iter_mut().zip(&part.sum_xyz) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.wrapping_add(*y);
+            }
+        }
+    }
+    let differ = sum.iter().zip(&one.sum_xyz).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "{differ} of {} pixels differ", sum.len());
 }
 
 /// `auto` runs packets of paths under `whitted` and one path at a time otherwise, and

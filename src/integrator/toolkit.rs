@@ -597,6 +597,8 @@ impl<const N: usize> ShadowSink<N> for Deferred<N> {
         _: &SampledWavelengths<N>,
         _: &mut TraceCounters,
     ) -> Option<SampledSpectrum<N>> {
+        // One walk per vertex, and no tests beside it: `resolve` adds them in that order.
+        debug_assert!(self.walk.is_none() && self.tests.is_empty());
         self.walk = walk.map(|w| (w, finish));
         None
     }
