@@ -515,6 +515,13 @@ mod tests {
                 },
                 "--integrator: expected one of whitted, path, lighttrace, bdpt, got \"nope\"",
             ),
+            (
+                SettingsArgs {
+                    packets: Some("sideways"),
+                    ..SettingsArgs::default()
+                },
+                "--packets: expected auto, paths, camera or off, got \"sideways\"",
+            ),
         ] {
             assert_eq!(s.apply(&args), Err(message.to_string()));
             assert_eq!(args.check(), Err(message.to_string()));
