@@ -221,7 +221,7 @@ def test_exr_carries_provenance_readable_by_openexr(render, tmp_path):
         "heron.wavelengths": "visible",
         "heron.maxDepth": got.get("heron.maxDepth"),
         "heron.offset": "epsilon 0.0001",
-        "heron.packets": "true",
+        "heron.packets": "paths",  # whitted under --packets auto: packets of paths
         "heron.spectralBins": "0",
     }, got
     assert got["heron.version"] and got["heron.maxDepth"].isdigit()
