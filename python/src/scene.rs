@@ -23,6 +23,7 @@ const RENAMES: &[(&str, &str)] = &[
     ("--spectral-bins", "spectral_bins"),
     ("--max-depth", "max_depth"),
     ("--offset", "offset"),
+    ("--packets", "packets"),
 ];
 
 /// How often the thread that called `render` wakes to let Python run its signal
@@ -156,7 +157,10 @@ impl Scene {
     /// one per core (the image does not depend on it); spectral_bins 0 for none, else
     /// 1–470 equal bins over 360–830 nm; sampler "sobol" or "independent" (default
     /// sobol); max_depth overrides `[render] max_depth`; offset "auto", "epsilon" or
-    /// "robust" overrides `[render] offset`; variance=True also estimates each pixel's
+    /// "robust" overrides `[render] offset`; packets "auto", "paths", "camera" or "off"
+    /// chooses how rays go to Embree (`heron render --packets`; default auto: packets
+    /// of paths under whitted, one path at a time otherwise; the choices agree up to the
+    /// last bits of Embree's hits); variance=True also estimates each pixel's
     /// variance (`heron render --variance`, at least 2 spp), as
     /// `RenderResult.variance`. The numbers equal bit for bit the EXR channels `heron
     /// render` writes with the same settings (R, G, B; X, Y, Z with `--xyz`; S0.* with
@@ -165,7 +169,7 @@ impl Scene {
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false, packets=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
@@ -181,6 +185,7 @@ impl Scene {
         max_depth: Option<i64>,
         offset: Option<&str>,
         variance: bool,
+        packets: Option<&str>,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -203,7 +208,7 @@ impl Scene {
                     max_depth,
                     offset,
                     kernel: None,
-                    packets: None,
+                    packets,
                     no_packets: false,
                 })
                 .map_err(|e| lib_err(e, RENAMES))?;

@@ -274,12 +274,33 @@ def test_render_argument_errors(tmp_path):
     assert py_error(scene.render, offset="big") == 'offset: expected auto, epsilon or robust, got "big"'
     assert py_error(scene.render, spectral_bins=471).startswith("spectral_bins: expected 0 (none) or 1 to 470")
     assert py_error(scene.render, max_depth=0) == "max_depth: expected at least 1, got 0"
+    assert py_error(scene.render, packets="sideways") == (
+        'packets: expected auto, paths, camera or off, got "sideways"')
     assert py_error(scene.render, threads=-1).startswith("threads: expected 0")
     # The scene file's own messages for the same values.
     g = tmp_path / "t.toml"
     g.write_text(SMALL_SCENE.replace('"bdpt"', '"photon"'))
     assert cli_error("render", g, "-o", tmp_path / "o.exr").endswith(
         'render.integrator: expected one of whitted, path, lighttrace, bdpt, got "photon"')
+
+
+def test_render_packets_choose_the_engine_and_agree():
+    """`packets` is `heron render --packets`: every choice renders the same image up to the
+    last bits of Embree's hits (tests/packets.rs holds that over every scene), and what ran
+    is recorded as the CLI records it."""
+    scene = heron.Scene.from_dict(tomllib.loads(SMALL_SCENE))
+    images = {}
+    for integrator in ("whitted", "path", "bdpt"):
+        for packets in ("auto", "paths", "camera", "off"):
+            r = scene.render(spp=2, integrator=integrator, packets=packets, threads=2)
+            images[integrator, packets] = r.rgb
+        ref = images[integrator, "camera"]
+        for packets in ("auto", "paths", "off"):
+            close = np.isclose(images[integrator, packets], ref, rtol=1e-4, atol=1e-6)
+            assert close.mean() > 0.99, (integrator, packets, close.mean())
+    # auto: packets of paths under whitted, one path at a time under path.
+    assert np.array_equal(images["whitted", "auto"], images["whitted", "paths"])
+    assert np.array_equal(images["path", "auto"], images["path", "camera"])
 
 
 # --------------------------------------------------------------------------- trace
