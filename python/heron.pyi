@@ -73,13 +73,19 @@ class Scene:
         max_depth: Optional[int] = None,
         offset: Optional[Literal["auto", "epsilon", "robust"]] = None,
         variance: bool = False,
+        packets: Optional[Literal["auto", "paths", "camera", "off"]] = None,
+        medium_nee: Optional[Literal["forced", "collision"]] = None,
+        sun_guide: Optional[float] = None,
     ) -> "RenderResult":
         """Renders the scene with ``heron render``'s options and defaults.
 
         spp and seed default to the scene's ``[render]`` values; threads 0 is one per
         core (the image does not depend on it); spectral_bins 0 is none, else 1-470
         equal bins over 360-830 nm; variance=True also estimates each pixel's variance
-        (``heron render --variance``, at least 2 spp). The GIL is released while
+        (``heron render --variance``, at least 2 spp); packets chooses how rays go to
+        Embree (``--packets``); medium_nee ("forced" or "collision") and sun_guide (a
+        fraction in [0, 1)) choose the path tracer's estimators in media
+        (``--medium-nee``, ``--sun-guide``). The GIL is released while
         rendering; Ctrl-C stops the render within a row of a tile and raises
         KeyboardInterrupt.
         """

@@ -474,6 +474,13 @@ struct ConvergeArgs {
     /// uses independent numbers.
     #[arg(long, value_parser = ["sobol", "independent"])]
     sampler: Option<String>,
+    /// forced or collision (as heron render --medium-nee), for the reference and the
+    /// measured runs; default: the scene's.
+    #[arg(long, value_name = "HOW")]
+    medium_nee: Option<String>,
+    /// As heron render --sun-guide, for the reference and the measured runs.
+    #[arg(long, value_name = "FRACTION")]
+    sun_guide: Option<f64>,
 }
 
 #[derive(clap::Args)]
@@ -601,6 +608,17 @@ struct RenderArgs {
     /// Every ray alone: the same as --packets off.
     #[arg(long, conflicts_with = "packets")]
     no_packets: bool,
+    /// Where the path tracer samples lights from a segment through a medium: forced
+    /// (default: one light sample per segment, at a point drawn within it, collided or
+    /// not) or collision (at free-flight collisions only, the estimator before 0.21).
+    /// Overrides the scene's render.medium_nee.
+    #[arg(long, value_name = "HOW")]
+    medium_nee: Option<String>,
+    /// The fraction of phase samples at medium vertices drawn about the direction
+    /// toward the sun, in [0, 1) (default 0.5; 0: phase sampling alone). Overrides the
+    /// scene's render.sun_guide.
+    #[arg(long, value_name = "FRACTION")]
+    sun_guide: Option<f64>,
     /// Do not write the PNG preview.
     #[arg(long)]
     no_png: bool,
@@ -941,6 +959,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         kernel: Some(&args.kernel),
         packets: args.packets.as_deref(),
         no_packets: args.no_packets,
+        medium_nee: args.medium_nee.as_deref(),
+        sun_guide: args.sun_guide,
     };
     // Before the scene loads, which may take seconds (sky and medium tables).
     settings_args.check().map_err(anyhow::Error::msg)?;
@@ -1187,6 +1207,8 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
             integrator: a.integrator.as_deref(),
             sampler: a.sampler.as_deref(),
             wavelengths: Some(&a.wavelengths),
+            medium_nee: a.medium_nee.as_deref(),
+            sun_guide: a.sun_guide,
             ..SettingsArgs::default()
         })
         .map_err(anyhow::Error::msg)?;

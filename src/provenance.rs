@@ -85,6 +85,10 @@ pub const KEYS: [&str; 15] = [
     "spectralBins",
 ];
 
+/// Keys written after [`KEYS`] only when the scene has a participating medium (the
+/// path tracer's estimators there), so that other scenes' EXRs keep their bytes.
+pub const MEDIA_KEYS: [&str; 2] = ["mediumNee", "sunGuide"];
+
 impl Provenance {
     /// The provenance a film's settings key holds (the key of `render.rs` contains every
     /// provenance entry), with `spp` samples per pixel: what `heron merge` writes, the
@@ -94,6 +98,7 @@ impl Provenance {
         spp: u32,
     ) -> Option<Provenance> {
         KEYS.iter()
+            .chain(MEDIA_KEYS.iter().filter(|k| key.contains_key(**k)))
             .map(|&k| {
                 let v = key.get(k)?.as_str()?;
                 Some((
@@ -126,7 +131,7 @@ impl Provenance {
             WavelengthSampler::Uniform => "uniform",
             WavelengthSampler::Visible => "visible",
         };
-        Provenance(vec![
+        let mut p = Provenance(vec![
             ("version", VERSION.to_string()),
             ("commit", COMMIT.to_string()),
             ("scene", name),
@@ -145,7 +150,12 @@ impl Provenance {
             ),
             ("packets", settings.packets.provenance().to_string()),
             ("spectralBins", settings.spectral_bins.to_string()),
-        ])
+        ]);
+        if !scene.media.is_empty() {
+            p.0.push(("mediumNee", settings.medium_nee.name().to_string()));
+            p.0.push(("sunGuide", settings.sun_guide.to_string()));
+        }
+        p
     }
 }
 

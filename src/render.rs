@@ -15,7 +15,7 @@ use crate::film::{
     add_splat_squares, add_to_bins, rgb_squares, xyz_of_sample, Film, SpectralBins, Splats,
 };
 use crate::geometry::{Ray, ShapeKind};
-use crate::integrator::{self, Context, Deferred, PathState, TraceCounters};
+use crate::integrator::{self, Context, Deferred, PathState, TraceCounters, WALKS};
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene};
 use crate::settings::{IntegratorKind, KernelFlags, Packets, RenderSettings};
@@ -1020,26 +1020,29 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
             }
         }
         // Shadow rays through media walk boundary by boundary: one closest-hit packet
-        // per crossing, until every lane's walk has ended.
-        loop {
-            let mut mask = 0u8;
-            for (k, sh) in shadows.iter().enumerate() {
-                if let Some((w, _)) = &sh.walk {
-                    queries[k] = w.q;
-                    mask |= 1 << k;
+        // per crossing, until every lane's walk has ended; a lane's first walk before
+        // its second, so contributions add in the order they were made.
+        for slot in 0..WALKS {
+            loop {
+                let mut mask = 0u8;
+                for (k, sh) in shadows.iter().enumerate() {
+                    if let Some((w, _)) = &sh.walks[slot] {
+                        queries[k] = w.q;
+                        mask |= 1 << k;
+                    }
                 }
-            }
-            if mask == 0 {
-                break;
-            }
-            counters.shadow_rays += mask.count_ones() as u64;
-            let hits = ctx
-                .accel
-                .intersect8_with(&queries, mask, RayCoherence::Incoherent);
-            for (k, sh) in shadows.iter_mut().enumerate() {
-                if mask & (1 << k) != 0 {
-                    let wl = &lanes[k].as_ref().expect("a walking lane is live").wl;
-                    sh.advance_walk(ctx, hits[k], wl);
+                if mask == 0 {
+                    break;
+                }
+                counters.shadow_rays += mask.count_ones() as u64;
+                let hits = ctx
+                    .accel
+                    .intersect8_with(&queries, mask, RayCoherence::Incoherent);
+                for (k, sh) in shadows.iter_mut().enumerate() {
+                    if mask & (1 << k) != 0 {
+                        let wl = &lanes[k].as_ref().expect("a walking lane is live").wl;
+                        sh.advance_walk(ctx, slot, hits[k], wl);
+                    }
                 }
             }
         }

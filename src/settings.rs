@@ -248,6 +248,54 @@ impl KernelChoice {
     }
 }
 
+/// Where the path tracer samples the lights from a segment of a path through a medium
+/// (issue 21; `integrator::path`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum MediumNee {
+    /// One light sample per segment, from a point drawn within the segment (free
+    /// flight truncated to it: a forced collision), weighted by the balance heuristic
+    /// against phase sampling from the free-flight collision that continues the path.
+    /// Every segment through a medium contributes, collided or not.
+    #[default]
+    Forced,
+    /// One light sample at each free-flight collision (a segment the path flies through
+    /// unscattered contributes nothing): the estimator before issue 21.
+    Collision,
+}
+
+impl MediumNee {
+    pub fn parse(name: &str) -> Result<MediumNee, String> {
+        match name {
+            "forced" => Ok(MediumNee::Forced),
+            "collision" => Ok(MediumNee::Collision),
+            other => Err(format!("expected forced or collision, got {other:?}")),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MediumNee::Forced => "forced",
+            MediumNee::Collision => "collision",
+        }
+    }
+}
+
+/// The default fraction of phase samples drawn about the sun's direction at medium
+/// vertices (`RenderSettings::sun_guide`), chosen by measurement (BENCHMARKS.md,
+/// "Rain and fog that converge").
+pub const DEFAULT_SUN_GUIDE: f32 = 0.5;
+
+/// The sun guide from a flag or key: a probability below 1.
+pub fn parse_sun_guide(v: f64) -> Result<f32, String> {
+    if (0.0..1.0).contains(&v) {
+        Ok(v as f32)
+    } else {
+        Err(format!(
+            "expected a fraction in [0, 1) (0: phase sampling alone), got {v}"
+        ))
+    }
+}
+
 /// How rays go to Embree. Embree's packet kernels return the same hits as its single-ray
 /// kernel up to the last bits of t, u and v (tests/embree.rs), so the choices give the
 /// same image up to those bits (tests/packets.rs bounds the difference).
@@ -337,6 +385,13 @@ pub struct RenderSettings {
     pub sampler: SamplerKind,
     /// The kernel specialised to the scene's features, or the general one.
     pub kernel: KernelChoice,
+    /// Where light is sampled along segments through media.
+    pub medium_nee: MediumNee,
+    /// The fraction of phase samples at medium vertices drawn from the phase function
+    /// about the direction toward the sun (the rest about the path's direction), so that
+    /// the next vertex's light sample is seldom made where the phase function is far
+    /// larger than where the path came from (0: off; ignored without a sun).
+    pub sun_guide: f32,
 }
 
 impl Default for RenderSettings {
@@ -358,6 +413,8 @@ impl Default for RenderSettings {
             spectral_bins: 0,
             sampler: SamplerKind::Sobol,
             kernel: KernelChoice::Auto,
+            medium_nee: MediumNee::Forced,
+            sun_guide: DEFAULT_SUN_GUIDE,
         }
     }
 }
@@ -382,6 +439,8 @@ pub struct SettingsArgs<'a> {
     pub packets: Option<&'a str>,
     /// `--no-packets` (CLI only): `--packets off`.
     pub no_packets: bool,
+    pub medium_nee: Option<&'a str>,
+    pub sun_guide: Option<f64>,
 }
 
 impl SettingsArgs<'_> {
@@ -454,6 +513,12 @@ impl RenderSettings {
         }
         if a.no_packets {
             s.packets = Packets::Off;
+        }
+        if let Some(m) = a.medium_nee {
+            s.medium_nee = MediumNee::parse(m).map_err(|e| format!("--medium-nee: {e}"))?;
+        }
+        if let Some(g) = a.sun_guide {
+            s.sun_guide = parse_sun_guide(g).map_err(|e| format!("--sun-guide: {e}"))?;
         }
         *self = s;
         Ok(())

@@ -606,7 +606,13 @@ fn colour_and_luminance_noise_fall_as_one_over_n() {
     // side, is 2.5% for Y and 4–4.5% for colour. Over seven pairs of seeds the ratios
     // were 0.96–1.11 (mean 1.02–1.03: a variance of heavy-tailed values is more often
     // under than over its mean, more so at 16 spp). Both renders: 3.4·10⁶ paths, about
-    // 8 s in release on 2 cores.
+    // 8 s in release on 2 cores. (Those figures are the estimator before issue 21's.
+    // With its forced light samples and sun guide, the defaults now, N·var is 10×
+    // smaller for δx (1.4·10⁻³) and Y's is 4.5·10⁻⁴, but what remains of the tail is
+    // rarer: κ at 16 spp measured 55–69 for Y and 150–370 for δx, δy, growing with the
+    // pixel count as a heavy tail's sample kurtosis does. So the 16-spp image is 384²
+    // pixels and the ratio's error must be below 8% (≥ 2.75σ from either bound);
+    // measured 2.9% for Y, 5.2–6.7% for colour, ratios 0.95–0.99.)
     //
     // It fails when it should: with the d = 1000 field above, the fixed colour pattern
     // gave 1.26 for y in single scattering; samples all alike would give 16. (The
@@ -655,7 +661,7 @@ medium = {{ type = "mie", radius_mm = 0.01, number_density = {n}, forward_cutoff
         })
         .xyz
     };
-    let low = independent(&fog(256), 16, 1);
+    let low = independent(&fog(384), 16, 1);
     let high = independent(&fog(96), 256, 2);
     let mean = |k: usize| high.iter().map(|c| c[k] as f64).sum::<f64>() / high.len() as f64;
     let s = mean(0) + mean(1) + mean(2);
@@ -682,7 +688,7 @@ medium = {{ type = "mie", radius_mm = 0.01, number_density = {n}, forward_cutoff
             v16 * 16.0,
             v256 * 256.0
         );
-        if !(0.8..=1.25).contains(&ratio) || se >= 0.06 {
+        if !(0.8..=1.25).contains(&ratio) || se >= 0.08 {
             failures.push(format!("{name}: ratio {ratio} (ln ± {se})"));
         }
     }

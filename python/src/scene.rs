@@ -24,6 +24,8 @@ const RENAMES: &[(&str, &str)] = &[
     ("--max-depth", "max_depth"),
     ("--offset", "offset"),
     ("--packets", "packets"),
+    ("--medium-nee", "medium_nee"),
+    ("--sun-guide", "sun_guide"),
 ];
 
 /// How often the thread that called `render` wakes to let Python run its signal
@@ -164,12 +166,15 @@ impl Scene {
     /// variance (`heron render --variance`, at least 2 spp), as
     /// `RenderResult.variance`. The numbers equal bit for bit the EXR channels `heron
     /// render` writes with the same settings (R, G, B; X, Y, Z with `--xyz`; S0.* with
-    /// `--spectral-bins`; variance.R, .G, .B with `--variance`).
+    /// `--spectral-bins`; variance.R, .G, .B with `--variance`). medium_nee "forced" or
+    /// "collision" and sun_guide (a fraction in [0, 1)) choose the path tracer's
+    /// estimators in media (`heron render --medium-nee`, `--sun-guide`; default: the
+    /// scene's `[render]` values, else forced and 0.5).
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false, packets=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
@@ -186,6 +191,8 @@ impl Scene {
         offset: Option<&str>,
         variance: bool,
         packets: Option<&str>,
+        medium_nee: Option<&str>,
+        sun_guide: Option<f64>,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -210,6 +217,8 @@ impl Scene {
                     kernel: None,
                     packets,
                     no_packets: false,
+                    medium_nee,
+                    sun_guide,
                 })
                 .map_err(|e| lib_err(e, RENAMES))?;
             opts.threads = threads as usize;

@@ -29,6 +29,7 @@ use crate::settings::{IntegratorKind, RenderSettings};
 use crate::settings::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
+pub(crate) use toolkit::WALKS;
 pub use toolkit::{Deferred, PathState};
 
 /// What an integrator needs to trace: the scene, its committed Embree scene and the

@@ -281,10 +281,13 @@ pub(crate) enum Finish<const N: usize> {
     },
     /// At a medium vertex: β f tr L / d, where d is the balance heuristic's denominator
     /// over (technique, hero) pairs: mean_λ r_u p_light for a delta light, else
-    /// mean_λ r_u (p_light + f tr); nothing when d ≤ 0.
+    /// mean_λ r_u (p_light + q tr), q_λ the density with which the phase-sampling
+    /// technique reaches the vertex and leaves toward the light, relative to the light
+    /// technique's density of the vertex (`integrator::path`); nothing when d ≤ 0.
     Medium {
         beta: SampledSpectrum<N>,
         f: SampledSpectrum<N>,
+        q: SampledSpectrum<N>,
         l: SampledSpectrum<N>,
         r_u: SampledSpectrum<N>,
         pdf: f32,
@@ -304,6 +307,7 @@ impl<const N: usize> Finish<N> {
             Finish::Medium {
                 beta,
                 f,
+                q,
                 l,
                 r_u,
                 pdf,
@@ -313,7 +317,7 @@ impl<const N: usize> Finish<N> {
                 let denom = if delta {
                     lane_mean(r_u * pdf, alive)
                 } else {
-                    lane_mean(r_u * (SampledSpectrum::splat(pdf) + f * tr), alive)
+                    lane_mean(r_u * (SampledSpectrum::splat(pdf) + q * tr), alive)
                 };
                 (denom > 0.0).then(|| beta * f * tr * l / denom)
             }
@@ -482,11 +486,15 @@ impl<const N: usize> ShadowSink<N> for Immediate {
 
 /// Shadow rays kept for the packet engine: one vertex's tests in order, each with its
 /// contribution and, once traced, whether it is blocked.
+/// The most shadow walks a step makes ([`Deferred::walks`]).
+pub(crate) const WALKS: usize = 2;
+
 pub struct Deferred<const N: usize> {
     pub(crate) tests: Vec<DeferredTest<N>>,
-    /// A shadow ray through media still walking (at most one per vertex: the path
-    /// tracer's next-event estimation), and what its transmittance becomes.
-    pub(crate) walk: Option<(TransmittanceWalk<N>, Finish<N>)>,
+    /// Shadow rays through media still walking, and what their transmittances become:
+    /// at most two per step (the path tracer's light sample from a segment through a
+    /// medium, and the one at the surface that ends it), walked in this order.
+    pub(crate) walks: [Option<(TransmittanceWalk<N>, Finish<N>)>; WALKS],
     /// `Some(scale)`: the unblocked contributions are summed and then added times
     /// `scale` ([`ShadowSink::add_scaled`]); `None`: each is added as it is.
     scale: Option<SampledSpectrum<N>>,
@@ -504,7 +512,7 @@ impl<const N: usize> Default for Deferred<N> {
     fn default() -> Self {
         Deferred {
             tests: Vec::new(),
-            walk: None,
+            walks: [None; WALKS],
             scale: None,
         }
     }
@@ -515,20 +523,21 @@ impl<const N: usize> Deferred<N> {
     #[inline]
     pub fn clear(&mut self) {
         self.tests.clear();
-        self.walk = None;
+        self.walks = [None; WALKS];
         self.scale = None;
     }
 
-    /// Takes the closest hit of the walk's query; once the walk ends, its contribution
-    /// (if any) joins the tests, unblocked. Returns whether it walks on.
+    /// Takes the closest hit of the query of walk `slot`; once the walk ends, its
+    /// contribution (if any) joins the tests, unblocked. Returns whether it walks on.
     #[inline]
     pub fn advance_walk(
         &mut self,
         ctx: &Context,
+        slot: usize,
         hit: Option<Hit>,
         wl: &SampledWavelengths<N>,
     ) -> bool {
-        let Some((walk, finish)) = &mut self.walk else {
+        let Some((walk, finish)) = &mut self.walks[slot] else {
             return false;
         };
         let c = match walk.advance(ctx, hit, wl) {
@@ -543,7 +552,7 @@ impl<const N: usize> Deferred<N> {
                 c,
             });
         }
-        self.walk = None;
+        self.walks[slot] = None;
         false
     }
 
@@ -597,9 +606,15 @@ impl<const N: usize> ShadowSink<N> for Deferred<N> {
         _: &SampledWavelengths<N>,
         _: &mut TraceCounters,
     ) -> Option<SampledSpectrum<N>> {
-        // One walk per vertex, and no tests beside it: `resolve` adds them in that order.
-        debug_assert!(self.walk.is_none() && self.tests.is_empty());
-        self.walk = walk.map(|w| (w, finish));
+        // Walks and no tests beside them: `resolve` adds them in the order they were
+        // made, as the engine walks slot 0 to its end before slot 1.
+        debug_assert!(self.tests.is_empty());
+        let slot = self
+            .walks
+            .iter()
+            .position(|w| w.is_none())
+            .expect("at most WALKS shadow walks per step");
+        self.walks[slot] = walk.map(|w| (w, finish));
         None
     }
 

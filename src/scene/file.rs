@@ -150,6 +150,13 @@ pub struct RenderFile {
     /// epsilon or robust.
     #[serde(default)]
     pub offset: Option<String>,
+    /// Where the path tracer samples lights from a segment through a medium: forced
+    /// (default) or collision.
+    #[serde(default)]
+    pub medium_nee: Option<String>,
+    /// The fraction of phase samples drawn about the sun at medium vertices, in [0, 1).
+    #[serde(default)]
+    pub sun_guide: Option<f64>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.

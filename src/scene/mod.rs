@@ -53,6 +53,9 @@ pub struct Scene {
     pub light_sampler: LightSampler,
     /// Participating media (`Shape::medium` indexes them); empty for most scenes.
     pub media: std::sync::Arc<Vec<crate::medium::Medium>>,
+    /// The direction toward the most powerful sun, if the scene has one (the guide of
+    /// phase sampling in media, `RenderSettings::sun_guide`).
+    pub sun_toward: Option<glam::Vec3>,
 }
 
 /// What a scene is made of before its derived parts (the environment light, the list of
@@ -103,6 +106,17 @@ impl Scene {
         );
         let bounds = load::scene_bounds(&p.shapes);
         let light_sampler = LightSampler::new(p.settings.light_sampler, &lights, &bounds);
+        let sun_toward = lights
+            .iter()
+            .filter_map(|l| match l {
+                Light::Sun(s) => Some((l.phi(&bounds), -s.direction)),
+                _ => None,
+            })
+            .fold(None, |best: Option<(f32, glam::Vec3)>, c| match best {
+                Some(b) if b.0 >= c.0 => Some(b),
+                _ => Some(c),
+            })
+            .map(|(_, d)| d);
         Scene {
             source: p.source,
             source_sha256: p.source_sha256,
@@ -120,6 +134,7 @@ impl Scene {
             bounds,
             light_sampler,
             media: std::sync::Arc::new(p.media),
+            sun_toward,
         }
     }
 

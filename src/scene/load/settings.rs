@@ -1,7 +1,9 @@
 //! The `[render]` table to [`RenderSettings`]: every key optional, defaults from
 //! `RenderSettings::default()`.
 use crate::scene::file::RenderFile;
-use crate::settings::{IntegratorKind, LightSamplerKind, OffsetMode, RenderSettings};
+use crate::settings::{
+    parse_sun_guide, IntegratorKind, LightSamplerKind, MediumNee, OffsetMode, RenderSettings,
+};
 
 /// The settings of the `[render]` table `r` (defaults without one).
 pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, String> {
@@ -34,6 +36,13 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
     if let Some(name) = &r.light_sampler {
         settings.light_sampler =
             LightSamplerKind::parse(name).map_err(|e| format!("render.light_sampler: {e}"))?;
+    }
+    if let Some(name) = &r.medium_nee {
+        settings.medium_nee =
+            MediumNee::parse(name).map_err(|e| format!("render.medium_nee: {e}"))?;
+    }
+    if let Some(g) = r.sun_guide {
+        settings.sun_guide = parse_sun_guide(g).map_err(|e| format!("render.sun_guide: {e}"))?;
     }
     Ok(settings)
 }
