@@ -257,6 +257,13 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     let sigma_t = m.sigma_t(wl);
     let u_dist = sampler.get_1d();
     let forced = on(K, SHADOWS) && ctx.settings.medium_nee == MediumNee::Forced;
+    // Forced: each lane's chance 1 − e^{−σ_λ d} that a free flight collides within the
+    // segment, the normalisation of its truncated distance density.
+    let collide = if forced {
+        SampledSpectrum(std::array::from_fn(|i| -(-sigma_t.0[i] * h.t).exp_m1()))
+    } else {
+        SampledSpectrum::splat(1.0)
+    };
     if forced {
         let u_forced = sampler.get_1d();
         let u_light = sampler.get_1d();
@@ -267,6 +274,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
                 origin: ray.origin,
                 d: h.t,
                 sigma_t,
+                collide,
                 u: u_forced,
             };
             if let Some(ld) =
@@ -301,7 +309,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     // free-flight density that drew it (r_l's distance part: p_forced,λ / p_free,hero).
     let r_light = if forced {
         SampledSpectrum(std::array::from_fn(|i| {
-            forced_pdf(sigma_t.0[i], t, h.t) / pdf
+            forced_pdf(sigma_t.0[i], tr.0[i], collide.0[i], h.t) / pdf
         }))
     } else {
         SampledSpectrum::splat(1.0)
@@ -367,12 +375,13 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
 }
 
 /// The density of a free flight with extinction `sigma` truncated to [0, d] (a forced
-/// collision), at t: σ e^{−σt} / (1 − e^{−σd}); 1/d in the limit σd → 0.
+/// collision) at the distance t where its transmittance is `tr` = e^{−σt}, given its
+/// chance of colliding within the segment `collide` = 1 − e^{−σd}: σ e^{−σt} / (1 −
+/// e^{−σd}); 1/d, its limit, when σ = 0.
 #[inline]
-fn forced_pdf(sigma: f32, t: f32, d: f32) -> f32 {
-    let c = -(-sigma * d).exp_m1();
-    if sigma * d > 1e-6 && c > 0.0 {
-        sigma * (-sigma * t).exp() / c
+fn forced_pdf(sigma: f32, tr: f32, collide: f32, d: f32) -> f32 {
+    if collide > 0.0 {
+        sigma * tr / collide
     } else {
         1.0 / d
     }
@@ -385,6 +394,8 @@ struct ForcedSample<const N: usize> {
     /// The segment's length.
     d: f32,
     sigma_t: SampledSpectrum<N>,
+    /// 1 − e^{−σ_λ d} per lane.
+    collide: SampledSpectrum<N>,
     u: f32,
 }
 
@@ -411,24 +422,24 @@ fn forced_direct_light<const N: usize, S: ShadowSink<N>>(
     shadows: &mut S,
 ) -> Option<SampledSpectrum<N>> {
     let s0 = f.sigma_t.0[0];
-    let c0 = -(-s0 * f.d).exp_m1();
+    let c0 = f.collide.0[0];
     if !(s0 > 0.0 && c0 > 0.0) {
         return None;
     }
     // The inverse of the truncated exponential's distribution function.
     let t = (-(-f.u * c0).ln_1p() / s0).min(f.d);
-    let p_hero = forced_pdf(s0, t, f.d);
+    let tr = exp_neg(f.sigma_t, t);
+    let p_hero = forced_pdf(s0, tr.0[0], c0, f.d);
     if !(p_hero > 0.0) {
         return None;
     }
-    let tr = exp_neg(f.sigma_t, t);
     let beta = s.beta * m.sigma_s(wl) * tr / p_hero;
     if beta.is_zero() {
         return None;
     }
     let r_u = s.r_u
         * SampledSpectrum(std::array::from_fn(|i| {
-            forced_pdf(f.sigma_t.0[i], t, f.d) / p_hero
+            forced_pdf(f.sigma_t.0[i], tr.0[i], f.collide.0[i], f.d) / p_hero
         }));
     let p = f.origin + f.dir * t;
     let cl = sample_light(ctx, p, u_light, u_light_point, wl)?;
@@ -437,8 +448,7 @@ fn forced_direct_light<const N: usize, S: ShadowSink<N>>(
     if phase.is_zero() {
         return None;
     }
-    let collide = SampledSpectrum(std::array::from_fn(|i| -(-f.sigma_t.0[i] * f.d).exp_m1()));
-    let q = collide * direction_density(ctx, s.depth + 1, m, ls.wi, phase, wl);
+    let q = f.collide * direction_density(ctx, s.depth + 1, m, ls.wi, phase, wl);
     let from = SpawnPoint::free(p);
     let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium);
     let finish = Finish::Medium {

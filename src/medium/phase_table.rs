@@ -60,6 +60,37 @@ pub fn v_between(a: Vec3, b: Vec3) -> f32 {
     0.5 * (a - b).length_squared()
 }
 
+/// Cells of the bin search in v: uniform in √(v/2) = sin(θ/2), which spreads the
+/// table's bins (dense near θ = 0) over the cells better than v itself.
+const V_CELLS: usize = 4096;
+/// Cells of the CDF's inversion, uniform in u.
+const U_CELLS: usize = 1024;
+
+/// The cell of v in [`PhaseTable::v_cells`] (monotonic in v).
+#[inline]
+fn v_cell(v: f32) -> usize {
+    (((0.5 * v).max(0.0).sqrt() * V_CELLS as f32) as usize).min(V_CELLS - 1)
+}
+
+/// The cell of u in a node's `PhaseTable::u_cells` (monotonic in u).
+#[inline]
+fn u_cell(u: f64) -> usize {
+    ((u.max(0.0) * U_CELLS as f64) as usize).min(U_CELLS - 1)
+}
+
+/// For sorted values whose cells (monotonic, < `cells`) are `of`: per k in 0 ..= cells,
+/// how many have a cell below k.
+fn cell_starts(of: impl Iterator<Item = usize>, cells: usize) -> Vec<u32> {
+    let mut counts = vec![0u32; cells + 1];
+    for c in of {
+        counts[c + 1] += 1;
+    }
+    for k in 1..=cells {
+        counts[k] += counts[k - 1];
+    }
+    counts
+}
+
 /// The tabulated phase function of one medium.
 #[derive(Clone, Debug)]
 pub struct PhaseTable {
@@ -68,11 +99,20 @@ pub struct PhaseTable {
     pub dlambda: f32,
     /// Bin edges in v = 1 − cos θ, increasing from 0 to 2 (f32 for lookup).
     v: Vec<f32>,
-    /// Per node, per bin: the phase function (sr⁻¹).
-    density: Vec<Vec<f32>>,
+    /// The phase function (sr⁻¹) per bin and node, bin-major (`density[j * nodes + i]`):
+    /// the lanes of a path look up one bin at nearby wavelengths, so their values share cache lines.
+    density: Vec<f32>,
+    nodes: usize,
     /// Per node: the CDF at the bin edges (f64, so a bin of the far tail of a peaked
     /// function keeps its probability); cdf[0] = 0, cdf[M] = 1.
     cdf: Vec<Vec<f64>>,
+    /// Where the bin search looks: `v_cells[k]` is the number of edges whose cell
+    /// ([`v_cell`]) is below k. The cell is monotonic in v, so for a v in cell k the
+    /// edges ≤ v are the first `v_cells[k]` and some of the next `v_cells[k + 1]`: the
+    /// search covers a few edges instead of the whole table, with the same result.
+    v_cells: Vec<u32>,
+    /// Per node, the same for the CDF's inversion ([`u_cell`]).
+    u_cells: Vec<Vec<u32>>,
     /// Per node: the integral of the untruncated values before normalisation (1 when the
     /// grid resolves the function), for checks.
     pub raw_integral: Vec<f64>,
@@ -110,11 +150,22 @@ impl PhaseTable {
             density.push(d);
             cdf.push(c);
         }
+        let v: Vec<f32> = vd.iter().map(|&x| x as f32).collect();
+        let v_cells = cell_starts(v.iter().map(|&e| v_cell(e)), V_CELLS);
+        let u_cells = cdf
+            .iter()
+            .map(|c: &Vec<f64>| cell_starts(c.iter().map(|&x| u_cell(x)), U_CELLS))
+            .collect();
         PhaseTable {
             lambda0,
             dlambda,
-            v: vd.iter().map(|&x| x as f32).collect(),
-            density,
+            v,
+            v_cells,
+            u_cells,
+            density: (0..m)
+                .flat_map(|j| density.iter().map(move |d: &Vec<f32>| d[j]))
+                .collect(),
+            nodes: values.len(),
             cdf,
             raw_integral,
         }
@@ -122,14 +173,14 @@ impl PhaseTable {
 
     /// The number of wavelength nodes.
     pub fn nodes(&self) -> usize {
-        self.density.len()
+        self.nodes
     }
 
     /// Node index i and fraction t of `lambda` between nodes i and i + 1 (held at the
     /// ends).
     #[inline]
     fn node(&self, lambda: f32) -> (usize, f32) {
-        let n = self.density.len();
+        let n = self.nodes;
         let s = ((lambda - self.lambda0) / self.dlambda).max(0.0);
         let i = (s as usize).min(n - 1);
         if i + 1 >= n {
@@ -138,20 +189,25 @@ impl PhaseTable {
         (i, s - i as f32)
     }
 
+    /// The bin of v: the last edge ≤ v (bins 0 … M − 1), searched between the bins
+    /// its cell bounds.
     #[inline]
     fn bin(&self, v: f32) -> usize {
         let m = self.v.len() - 1;
-        self.v.partition_point(|&e| e <= v).clamp(1, m) - 1
+        let k = v_cell(v);
+        let (lo, hi) = (self.v_cells[k] as usize, self.v_cells[k + 1] as usize);
+        (lo + self.v[lo..hi].partition_point(|&e| e <= v)).clamp(1, m) - 1
     }
 
     #[inline]
     fn value_in_bin(&self, lambda: f32, j: usize) -> f32 {
         let (i, t) = self.node(lambda);
-        let a = self.density[i][j];
+        let row = &self.density[j * self.nodes..(j + 1) * self.nodes];
+        let a = row[i];
         if t == 0.0 {
             a
         } else {
-            a + t * (self.density[i + 1][j] - a)
+            a + t * (row[i + 1] - a)
         }
     }
 
@@ -177,7 +233,12 @@ impl PhaseTable {
         let c = &self.cdf[node];
         let uu = u as f64;
         let m = c.len() - 1;
-        let j = (c.partition_point(|&x| x <= uu).clamp(1, m) - 1).min(m - 1);
+        let k = u_cell(uu);
+        let (lo, hi) = (
+            self.u_cells[node][k] as usize,
+            self.u_cells[node][k + 1] as usize,
+        );
+        let j = ((lo + c[lo..hi].partition_point(|&x| x <= uu)).clamp(1, m) - 1).min(m - 1);
         let span = c[j + 1] - c[j];
         let f = if span > 0.0 {
             ((uu - c[j]) / span).clamp(0.0, 1.0) as f32
@@ -201,4 +262,54 @@ pub fn direction_at(axis: Vec3, v: f32, u_phi: f32) -> Vec3 {
     crate::math::frame::Frame::from_z(axis)
         .to_world(local)
         .normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cell-bounded searches find what a search of the whole table finds: at every
+    /// edge, between edges, near θ = π (where bins are narrowest in v) and for u at and
+    /// between the CDF's values.
+    #[test]
+    fn cell_bounded_searches_equal_whole_table_searches() {
+        let theta = angle_grid(8727.0);
+        let values: Vec<Vec<f64>> = (0..3)
+            .map(|i| {
+                theta
+                    .iter()
+                    .map(|&t| 1.0 / (1e-4 + t * t) + i as f64 * (10.0 * t).cos().abs())
+                    .collect()
+            })
+            .collect();
+        let table = PhaseTable::from_values(400.0, 10.0, &theta, &values);
+        let m = table.v.len() - 1;
+        let whole = |v: f32| table.v.partition_point(|&e| e <= v).clamp(1, m) - 1;
+        let mut probes: Vec<f32> = table.v.clone();
+        probes.extend(table.v.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+        probes.extend(
+            table
+                .v
+                .iter()
+                .map(|&e| f32::from_bits(e.to_bits().saturating_sub(1))),
+        );
+        probes.extend([0.0, 2.0, 2.5, -0.0, f32::NAN]);
+        for v in probes {
+            assert_eq!(table.bin(v), whole(v), "v = {v:e}");
+        }
+        for (node, c) in table.cdf.iter().enumerate() {
+            let whole = |u: f64| (c.partition_point(|&x| x <= u).clamp(1, m) - 1).min(m - 1);
+            let mut us: Vec<f64> = c.clone();
+            us.extend(c.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+            us.extend((0..4096).map(|k| k as f64 / 4096.0));
+            for u in us.into_iter().filter(|&u| u < 1.0) {
+                let (v, _) = table.sample(0.0, u as f32, &[400.0 + 10.0 * node as f32]);
+                let j = whole(u as f32 as f64);
+                assert!(
+                    v >= table.v[j] && v <= table.v[j + 1],
+                    "node {node}, u = {u}"
+                );
+            }
+        }
+    }
 }
