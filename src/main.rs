@@ -615,7 +615,7 @@ struct RenderArgs {
     #[arg(long, value_name = "HOW")]
     medium_nee: Option<String>,
     /// The fraction of phase samples at medium vertices drawn about the direction
-    /// toward the sun, in [0, 1) (default 0.5; 0: phase sampling alone). Overrides the
+    /// toward the sun, in [0, 1) (default 0.25; 0: phase sampling alone). Overrides the
     /// scene's render.sun_guide.
     #[arg(long, value_name = "FRACTION")]
     sun_guide: Option<f64>,

@@ -283,7 +283,7 @@ impl MediumNee {
 /// The default fraction of phase samples drawn about the sun's direction at medium
 /// vertices (`RenderSettings::sun_guide`), chosen by measurement (BENCHMARKS.md,
 /// "Rain and fog that converge").
-pub const DEFAULT_SUN_GUIDE: f32 = 0.5;
+pub const DEFAULT_SUN_GUIDE: f32 = 0.25;
 
 /// The sun guide from a flag or key: a probability below 1.
 pub fn parse_sun_guide(v: f64) -> Result<f32, String> {

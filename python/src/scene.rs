@@ -169,7 +169,7 @@ impl Scene {
     /// `--spectral-bins`; variance.R, .G, .B with `--variance`). medium_nee "forced" or
     /// "collision" and sun_guide (a fraction in [0, 1)) choose the path tracer's
     /// estimators in media (`heron render --medium-nee`, `--sun-guide`; default: the
-    /// scene's `[render]` values, else forced and 0.5).
+    /// scene's `[render]` values, else forced and 0.25).
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
