@@ -609,10 +609,10 @@ fn colour_and_luminance_noise_fall_as_one_over_n() {
     // 8 s in release on 2 cores. (Those figures are the estimator before issue 21's.
     // With its forced light samples and sun guide, the defaults now, N·var is 10×
     // smaller for δx (1.4·10⁻³) and Y's is 4.5·10⁻⁴, but what remains of the tail is
-    // rarer: κ at 16 spp measured 55–69 for Y and 150–370 for δx, δy, growing with the
-    // pixel count as a heavy tail's sample kurtosis does. So the 16-spp image is 384²
-    // pixels and the ratio's error must be below 8% (≥ 2.75σ from either bound);
-    // measured 2.9% for Y, 5.2–6.7% for colour, ratios 0.95–0.99.)
+    // rarer: κ at 16 spp measured 15–69 for Y and 85–370 for δx, δy, growing with the
+    // pixel count as a heavy tail's sample kurtosis does, and up to 54 at 256 spp. So
+    // the images are 384² pixels (16 spp) and 128² (256 spp), and the ratio's error
+    // must be below 8% (≥ 2.75σ from either bound).)
     //
     // It fails when it should: with the d = 1000 field above, the fixed colour pattern
     // gave 1.26 for y in single scattering; samples all alike would give 16. (The
@@ -662,7 +662,7 @@ medium = {{ type = "mie", radius_mm = 0.01, number_density = {n}, forward_cutoff
         .xyz
     };
     let low = independent(&fog(384), 16, 1);
-    let high = independent(&fog(96), 256, 2);
+    let high = independent(&fog(128), 256, 2);
     let mean = |k: usize| high.iter().map(|c| c[k] as f64).sum::<f64>() / high.len() as f64;
     let s = mean(0) + mean(1) + mean(2);
     let (x, y) = (mean(0) / s, mean(1) / s);
