@@ -303,6 +303,62 @@ def test_render_packets_choose_the_engine_and_agree():
     assert np.array_equal(images["path", "auto"], images["path", "camera"])
 
 
+FOG_SCENE = """
+background = 0.05
+[camera]
+eye = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+d = 2.0
+resolution = [24, 24]
+[render]
+integrator = "path"
+max_depth = 4
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+medium = { type = "henyey-greenstein", sigma_a = 0.05, sigma_s = 0.6, g = 0.7 }
+[[lights]]
+type = "sun"
+direction = [0.0, -0.4, -0.9]
+irradiance = 2.0
+"""
+
+
+def test_render_medium_estimators_are_arguments_and_agree(tmp_path):
+    """`medium_nee` and `sun_guide` are `heron render --medium-nee` and `--sun-guide`:
+    each choice takes effect (the images differ in their bits), all agree in the mean
+    (unbiased estimators of one image; tests/media_estimators.rs holds them to region
+    z-tests), and bad values are the CLI's errors under the arguments' names."""
+    scene = heron.Scene.from_dict(tomllib.loads(FOG_SCENE))
+    means = {}
+    images = {}
+    for nee in ("forced", "collision"):
+        for guide in (0.0, 0.25):
+            r = scene.render(spp=64, seed=3, sampler="independent", threads=2,
+                             medium_nee=nee, sun_guide=guide)
+            images[nee, guide] = r.rgb
+            means[nee, guide] = float(r.rgb.mean())
+    default = scene.render(spp=64, seed=3, sampler="independent", threads=2)
+    assert np.array_equal(bits(default.rgb), bits(images["forced", 0.25]))
+    keys = list(images)
+    for i, a in enumerate(keys):
+        for b in keys[i + 1:]:
+            assert not np.array_equal(bits(images[a]), bits(images[b])), (a, b)
+    m = np.mean(list(means.values()))
+    for k, v in means.items():
+        # 576 pixels x 64 spp: each image mean's standard error is below 1% here.
+        assert abs(v / m - 1.0) < 0.03, (k, v, m)
+    assert py_error(scene.render, sun_guide=1.0) == (
+        "sun_guide: expected a fraction in [0, 1) (0: phase sampling alone), got 1")
+    assert py_error(scene.render, medium_nee="often") == (
+        'medium_nee: expected forced or collision, got "often"')
+    f = tmp_path / "fog.toml"
+    f.write_text(FOG_SCENE)
+    assert cli_error("render", f, "--sun-guide", "1", "-o", tmp_path / "o.exr") == (
+        "--sun-guide: expected a fraction in [0, 1) (0: phase sampling alone), got 1")
+
+
 # --------------------------------------------------------------------------- trace
 
 DROP = REPO / "scenes" / "droplet.toml"
