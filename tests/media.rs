@@ -239,25 +239,7 @@ fn white_furnace_non_absorbing_media_stay_at_one() {
     // radius 2: most paths scatter several times. 32² pixels × 64 spp give a standard
     // error below 0.3% (the test requires < 0.005 and 4 σ).
     let dir = temp_dir("furnace");
-    let sphere = |medium: &str| {
-        format!(
-            r#"
-background = 1.0
-[camera]
-eye = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-d = 2.5
-resolution = [32, 32]
-[render]
-max_depth = 1000
-[[shapes]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-medium = {medium}
-"#
-        )
-    };
+    let sphere = |medium: &str| common::scenes::furnace_sphere(medium, "");
     let hg = load_in(
         &dir,
         &sphere(r#"{ type = "henyey-greenstein", sigma_a = 0.0, sigma_s = 2.0, g = 0.6 }"#),

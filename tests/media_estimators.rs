@@ -174,29 +174,8 @@ fn white_furnace_stays_at_one_with_the_sun_guide() {
     // α = 0.5), so 32² pixels × 512 spp: standard errors 0.05% (forced) to 0.2%
     // (guided), measured; the test requires < 0.3% and 4 σ.
     let dir = temp_dir("furnace");
-    let scene_text = |medium: &str| {
-        format!(
-            r#"
-background = 1.0
-[camera]
-eye = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-d = 2.5
-resolution = [32, 32]
-[render]
-max_depth = 1000
-[[shapes]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-medium = {medium}
-[[lights]]
-type = "sun"
-direction = [0.3, -0.5, -0.8]
-irradiance = 1e-9
-"#
-        )
-    };
+    let sun = "[[lights]]\ntype = \"sun\"\ndirection = [0.3, -0.5, -0.8]\nirradiance = 1e-9";
+    let scene_text = |medium: &str| common::scenes::furnace_sphere(medium, sun);
     let hg = load_in(
         &dir,
         &scene_text(r#"{ type = "henyey-greenstein", sigma_a = 0.0, sigma_s = 2.0, g = 0.6 }"#),

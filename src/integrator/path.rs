@@ -332,18 +332,17 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     let u_rr = sampler.get_1d();
     let alive = s.bsdf_ctx.companions_alive;
     if on(K, SHADOWS) && !forced {
-        if let Some(ld) = medium_direct_light(
-            ctx,
-            s,
-            m,
-            ray.dir,
+        let v = MediumVertex {
             p,
-            u_light,
-            u_light_point,
-            wl,
-            counters,
-            shadows,
-        ) {
+            dir: ray.dir,
+            depth: s.depth,
+            beta: s.beta,
+            r_u: s.r_u,
+            q_scale: SampledSpectrum::splat(1.0),
+        };
+        if let Some(ld) =
+            light_from_medium(ctx, s, m, &v, u_light, u_light_point, wl, counters, shadows)
+        {
             s.l += ld;
         }
     }
@@ -441,27 +440,15 @@ fn forced_direct_light<const N: usize, S: ShadowSink<N>>(
         * SampledSpectrum(std::array::from_fn(|i| {
             forced_pdf(f.sigma_t.0[i], tr.0[i], f.collide.0[i], f.d) / p_hero
         }));
-    let p = f.origin + f.dir * t;
-    let cl = sample_light(ctx, p, u_light, u_light_point, wl)?;
-    let ls = &cl.sample;
-    let phase = m.phase(f.dir, ls.wi, wl);
-    if phase.is_zero() {
-        return None;
-    }
-    let q = f.collide * direction_density(ctx, s.depth + 1, m, ls.wi, phase, wl);
-    let from = SpawnPoint::free(p);
-    let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium);
-    let finish = Finish::Medium {
+    let v = MediumVertex {
+        p: f.origin + f.dir * t,
+        dir: f.dir,
+        depth: s.depth + 1,
         beta,
-        f: phase,
-        q,
-        l: ls.l,
         r_u,
-        pdf: cl.pdf,
-        delta: ls.delta,
-        alive: s.bsdf_ctx.companions_alive,
+        q_scale: f.collide,
     };
-    shadows.transmit(ctx, walk, finish, wl, counters)
+    light_from_medium(ctx, s, m, &v, u_light, u_light_point, wl, counters, shadows)
 }
 
 /// The medium vertices of a path, from its first, whose direction is drawn with the
@@ -538,40 +525,53 @@ fn sample_direction<const N: usize>(
     (wi, pv, pv * (1.0 - a) + pg * a)
 }
 
-/// Next-event estimation at a scattering event in medium `m` at `p` (the ray arrived
-/// along `dir`) under [`MediumNee::Collision`]: a light sample, its transmittance
-/// through the media on the way, and the balance heuristic over (technique, hero) pairs
-/// against direction sampling, whose density toward the light is q_λ(ω) T_λ (the chance
-/// of flying there unscattered).
+/// A point in a medium where light is sampled: where it is, the direction the path
+/// arrived along, its depth (for the sun guide), the path's throughput and rescaled
+/// probabilities with the point's distance density in them, and the factor by which the
+/// direction-sampling technique's density of the point differs from the light
+/// technique's, per lane (1 at a free-flight collision, 1 − e^{−σ_λ d} at a forced one).
+struct MediumVertex<const N: usize> {
+    p: Vec3,
+    dir: Vec3,
+    depth: u32,
+    beta: SampledSpectrum<N>,
+    r_u: SampledSpectrum<N>,
+    q_scale: SampledSpectrum<N>,
+}
+
+/// Next-event estimation at a medium point `v` (a free-flight collision under
+/// [`MediumNee::Collision`], a forced one under [`MediumNee::Forced`]): a light sample,
+/// its transmittance through the media on the way, and the balance heuristic over
+/// (technique, hero) pairs against direction sampling, whose density toward the light
+/// is q_λ(ω) T_λ (T_λ: the chance of flying there unscattered) times `q_scale`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn medium_direct_light<const N: usize, S: ShadowSink<N>>(
+fn light_from_medium<const N: usize, S: ShadowSink<N>>(
     ctx: &Context,
     s: &PathState<N>,
     m: &Medium,
-    dir: Vec3,
-    p: Vec3,
+    v: &MediumVertex<N>,
     u_light: f32,
     u_light_point: Vec2,
     wl: &SampledWavelengths<N>,
     counters: &mut TraceCounters,
     shadows: &mut S,
 ) -> Option<SampledSpectrum<N>> {
-    let cl = sample_light(ctx, p, u_light, u_light_point, wl)?;
+    let cl = sample_light(ctx, v.p, u_light, u_light_point, wl)?;
     let ls = &cl.sample;
-    let f = m.phase(dir, ls.wi, wl);
+    let f = m.phase(v.dir, ls.wi, wl);
     if f.is_zero() {
         return None;
     }
-    let q = direction_density(ctx, s.depth, m, ls.wi, f, wl);
-    let from = SpawnPoint::free(p);
+    let q = v.q_scale * direction_density(ctx, v.depth, m, ls.wi, f, wl);
+    let from = SpawnPoint::free(v.p);
     let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium);
     let finish = Finish::Medium {
-        beta: s.beta,
+        beta: v.beta,
         f,
         q,
         l: ls.l,
-        r_u: s.r_u,
+        r_u: v.r_u,
         pdf: cl.pdf,
         delta: ls.delta,
         alive: s.bsdf_ctx.companions_alive,

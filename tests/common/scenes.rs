@@ -26,3 +26,28 @@ pub fn load_small(name: &str, width: u32, height: u32) -> Scene {
     s.camera = Camera::new(c.eye, c.look_at, c.up, c.d, width, height).unwrap();
     s
 }
+
+/// A white furnace around a medium: an environment of radiance 1, the sphere of radius 1
+/// at the origin holding `medium` (a TOML inline table) behind an index-matched boundary,
+/// seen whole by a 32×32 camera, paths up to 1000 events long; `extra` is appended (TOML:
+/// a material for the sphere, lights).
+pub fn furnace_sphere(medium: &str, extra: &str) -> String {
+    format!(
+        r#"
+background = 1.0
+[camera]
+eye = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+d = 2.5
+resolution = [32, 32]
+[render]
+max_depth = 1000
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+medium = {medium}
+{extra}
+"#
+    )
+}
