@@ -387,10 +387,11 @@ pub struct RenderSettings {
     pub kernel: KernelChoice,
     /// Where light is sampled along segments through media.
     pub medium_nee: MediumNee,
-    /// The fraction of phase samples at medium vertices drawn from the phase function
-    /// about the direction toward the sun (the rest about the path's direction), so that
-    /// the next vertex's light sample is seldom made where the phase function is far
-    /// larger than where the path came from (0: off; ignored without a sun).
+    /// The fraction of phase samples at a path's first two medium vertices drawn from
+    /// the phase function about the direction toward the sun (the rest about the path's
+    /// direction), so that the directions from which the next vertex's light sample
+    /// toward the sun is bright (near the phase function's forward peak) are drawn as
+    /// often as they matter (0: off; ignored without a sun; `integrator::path`).
     pub sun_guide: f32,
 }
 
