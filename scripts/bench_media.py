@@ -33,6 +33,7 @@ CONFIGS = {
     "collision, no guide (before)": ("collision", 0.0),
     "forced, no guide": ("forced", 0.0),
     "collision, guide 0.5": ("collision", 0.5),
+    "forced, guide 0.125": ("forced", 0.125),
     "forced, guide 0.25 (default)": ("forced", 0.25),
     "forced, guide 0.5": ("forced", 0.5),
     "forced, guide 0.75": ("forced", 0.75),

@@ -284,7 +284,8 @@ fn spectral_samples(lambdas: &[f64], values: &[f64]) -> PyResult<Vec<(f32, f32)>
 /// returns a float32 array, one n per wavelength.
 ///
 /// model: a catalogue name ("water", "N-BK7", "fused-silica", "N-SF11", "F2",
-/// "diamond"; spectra/ior_catalogue.toml), a positive number (no dispersion), or a dict:
+/// "diamond", Schott lens glasses such as "N-SK16" or "N-LASF9";
+/// spectra/ior_catalogue.toml), a positive number (no dispersion), or a dict:
 /// {"sellmeier": {"b": [...], "c": [...]}} (λ in µm, C in µm²), {"cauchy": [A, B]} or
 /// [A, B, C] (λ in µm), {"table": "file.csv"} (rows wavelength_nm,n; relative to the
 /// current directory). Checked as the scene loader checks it (n ≥ 1 and finite over
