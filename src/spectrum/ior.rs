@@ -182,7 +182,11 @@ mod tests {
             let Some(v_d) = m.v_d else { continue };
             let n = |l: f32| m.ior.eval(l) as f64;
             let v = (n(587.56) - 1.0) / (n(486.13) - n(656.27));
-            assert!((v - v_d as f64).abs() < 0.015, "{}: V_d {v} vs {v_d}", m.name);
+            assert!(
+                (v - v_d as f64).abs() < 0.015,
+                "{}: V_d {v} vs {v_d}",
+                m.name
+            );
             checked += 1;
         }
         assert!(checked >= 11, "{checked} Abbe numbers");
