@@ -96,9 +96,10 @@ SPOT_COLUMNS = ("field_deg", "wavelength_nm", "rays", "rms_radius_mm", "geo_radi
 class HeronIor(BaseMaterial):
     """An Optiland material that evaluates one of heron's refractive-index models.
 
-    kind: "constant" (coeffs = (n,)), "sellmeier" (coeffs = (B..., C...), λ in µm, C in
-    µm²: n² = 1 + Σ B λ²/(λ² − C)) or "cauchy" (coeffs = (A, B, C): n = A + B/λ² + C/λ⁴,
-    λ in µm). Optiland passes wavelengths in µm, as these formulas take them.
+    kind: "constant" (coeffs = (n,)), "sellmeier" (coeffs = (B..., C...), λ in µm, C
+    in µm²: n² = 1 + Σ B λ²/(λ² − C)) or "cauchy" (coeffs = (A, B, C):
+    n = A + B/λ² + C/λ⁴, λ in µm). Optiland passes wavelengths in µm, as these formulas
+    take them.
     """
 
     def __init__(self, label: str, kind: str, coeffs: tuple[float, ...]):
@@ -167,7 +168,8 @@ def material(spec, catalogue: dict, where: str) -> HeronIor:
     if spec is None or (isinstance(spec, str) and spec.lower() == "air"):
         return HeronIor("air", "constant", (1.0,))
     if isinstance(spec, bool):
-        raise ValueError(f"{where}: medium must be a name, a number or a table, got {spec!r}")
+        raise ValueError(f"{where}: medium must be a name, a number or a table, "
+                         f"got {spec!r}")
     if isinstance(spec, (int, float)):
         if not spec > 0:
             raise ValueError(f"{where}: medium must be positive, got {spec!r}")
@@ -407,8 +409,8 @@ def write_csv(path, columns, rows) -> None:
 
 
 class Float32Ior(HeronIor):
-    """HeronIor evaluated as heron's Ior::eval does, in float32 (λ nm → µm, the formula),
-    for `--f32`: how much a renderer's float32 indices alone move the numbers."""
+    """HeronIor evaluated as heron's Ior::eval does, in float32 (λ nm → µm, the
+    formula), for `--f32`: how much a renderer's float32 indices alone move the numbers."""
 
     def _calculate_n(self, wavelength, **kwargs):
         lam = np.asarray(be.to_numpy(wavelength), dtype=np.float64)
