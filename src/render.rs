@@ -9,6 +9,7 @@
 //! a list per tile, in the order they were made, and added to the film tile by tile in
 //! tile order, pass by pass. So the image is bit-identical whatever the thread count.
 use crate::accel::embree::{self, RayCoherence, RayQuery};
+use crate::camera::CameraRay;
 use crate::checkpoint::{Checkpoint, Shard};
 use crate::film::fixed::{to_fixed, to_fixed3, SquareSum};
 use crate::film::{
@@ -228,6 +229,12 @@ fn render_with(
     opts: &RenderOptions,
 ) -> Result<(Checkpoint, RenderStats)> {
     let kind = opts.settings.integrator;
+    if scene.camera.lens.is_some() && kind.splats() {
+        return Err(HeronError::Invalid(format!(
+            "integrator {}: the lens camera (camera.type = \"lens\") has no importance function We and no connection to the film yet, which light tracing and BDPT need to reach the camera from the lights; use integrator = \"path\" or \"whitted\"",
+            kind.name()
+        )));
+    }
     let ctx = Context {
         scene,
         accel,
@@ -792,6 +799,7 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
         tfar: f32::INFINITY,
     }; PACKET];
     let mut wls = [SampledWavelengths::<N>::sample_uniform(0.0); PACKET];
+    let mut cams: [Option<CameraRay>; PACKET] = [None; PACKET];
     for y in 0..h {
         if cancelled(opts) {
             break;
@@ -811,28 +819,52 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
                     let j = sampler.get_pixel_2d();
                     wls[k] =
                         SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
-                    rays[k].dir = cam.direction(px as f32 + j.x, py as f32 + j.y);
+                    cams[k] = cam.ray(
+                        px as f32 + j.x,
+                        py as f32 + j.y,
+                        || sampler.get_2d(),
+                        wls[k].lambda[0],
+                    );
+                    if let Some(c) = &cams[k] {
+                        rays[k].origin = c.ray.origin;
+                        rays[k].dir = c.ray.dir;
+                    }
                 }
+                // A ray the lens stopped is traced by no one.
+                let traced =
+                    (0..lanes).fold(
+                        active,
+                        |m, k| {
+                            if cams[k].is_none() {
+                                m & !(1 << k)
+                            } else {
+                                m
+                            }
+                        },
+                    );
                 let hits = if opts.settings.packets.camera()
                     && opts.settings.integrator.uses_camera_rays()
                 {
-                    counters.rays += lanes as u64;
-                    Some(ctx.accel.intersect8(&rays, active))
+                    counters.rays += traced.count_ones() as u64;
+                    Some(ctx.accel.intersect8(&rays, traced))
                 } else {
                     None
                 };
                 for k in 0..lanes {
-                    let ray = Ray::new(cam.eye, rays[k].dir, 0.0, f32::INFINITY);
                     let splats_before = if VARIANCE { splats.list.len() } else { 0 };
-                    let l = sample_fn(
-                        ctx,
-                        ray,
-                        hits.map(|h| h[k]),
-                        &wls[k],
-                        &mut samplers[k],
-                        &mut counters,
-                        &mut splats,
-                    );
+                    let l = match cams[k] {
+                        Some(ray) => sample_fn(
+                            ctx,
+                            ray,
+                            hits.map(|h| h[k]),
+                            &wls[k],
+                            &mut samplers[k],
+                            &mut counters,
+                            &mut splats,
+                        ),
+                        // Stopped by the lens: the sample adds 0.
+                        None => SampledSpectrum::zero(),
+                    };
                     if VARIANCE && splats.list.len() > splats_before {
                         add_splat_squares(
                             &splats.list[splats_before..],
@@ -924,22 +956,29 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
         // Refill: every free lane takes the next pixel sample.
         let mut active = 0u8;
         for k in 0..PACKET {
-            if lanes[k].is_none() {
-                if let Some((x, y, s)) = take(k) {
-                    let (px, py) = (x0 + x, y0 + y);
-                    let sampler = &mut samplers[k];
-                    sampler.start_pixel_sample(px, py, s);
-                    let j = sampler.get_pixel_2d();
-                    let wl =
-                        SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
-                    let dir = cam.direction(px as f32 + j.x, py as f32 + j.y);
-                    lanes[k] = Some(Lane {
-                        pixel: (x, y, s),
-                        state: (fns.start)(cam.eye),
-                        ray: Ray::new(cam.eye, dir, 0.0, f32::INFINITY),
-                        wl,
-                        camera: true,
-                    });
+            while lanes[k].is_none() {
+                let Some((x, y, s)) = take(k) else { break };
+                let (px, py) = (x0 + x, y0 + y);
+                let sampler = &mut samplers[k];
+                sampler.start_pixel_sample(px, py, s);
+                let j = sampler.get_pixel_2d();
+                let wl = SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
+                let u = || sampler.get_2d();
+                match cam.ray(px as f32 + j.x, py as f32 + j.y, u, wl.lambda[0]) {
+                    Some(c) => {
+                        lanes[k] = Some(Lane {
+                            pixel: (x, y, s),
+                            state: (fns.start)(&c),
+                            ray: c.ray,
+                            wl,
+                            camera: true,
+                        })
+                    }
+                    // Stopped by the lens: the sample adds 0, and the lane takes the
+                    // next one.
+                    None => {
+                        sums.add::<N, VARIANCE>((x0, y0), (x, y, s), &SampledSpectrum::zero(), &wl)
+                    }
                 }
             }
             if let Some(lane) = &lanes[k] {
@@ -1088,7 +1127,7 @@ mod tests {
         };
         fn splat_one(
             _: &Context,
-            _: Ray,
+            _: CameraRay,
             _: Option<Option<crate::accel::embree::Hit>>,
             wl: &SampledWavelengths<4>,
             s: &mut Sampler,
@@ -1152,7 +1191,7 @@ mod tests {
         };
         fn own(
             _: &Context,
-            _: Ray,
+            _: CameraRay,
             _: Option<Option<crate::accel::embree::Hit>>,
             _: &SampledWavelengths<4>,
             s: &mut Sampler,
@@ -1163,7 +1202,7 @@ mod tests {
         }
         fn splat(
             _: &Context,
-            _: Ray,
+            _: CameraRay,
             _: Option<Option<crate::accel::embree::Hit>>,
             wl: &SampledWavelengths<4>,
             s: &mut Sampler,

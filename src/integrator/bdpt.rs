@@ -34,6 +34,7 @@ use super::toolkit::{next_hit, pixel_of, Connection, Connections, LightPathStart
 use super::{Context, TraceCounters};
 use crate::accel::embree::{Hit, RayQuery};
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
+use crate::camera::CameraRay;
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::Light;
@@ -768,13 +769,15 @@ fn direction<const N: usize>(a: &Vertex<N>, b: &Vertex<N>) -> Vec3 {
 /// `splats`.
 pub fn radiance<const N: usize>(
     ctx: &Context,
-    ray: Ray,
+    cam: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
     splats: &mut Splats,
 ) -> SampledSpectrum<N> {
+    // The pinhole's ray (render.rs refuses BDPT with a lens camera).
+    let ray = cam.ray;
     let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
     let b = Bdpt { ctx, wl };
     let mut light = [Vertex::<N>::EMPTY; MAX_VERTICES];

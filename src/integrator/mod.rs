@@ -21,6 +21,7 @@ pub(crate) mod toolkit;
 pub mod whitted;
 
 use crate::accel::embree::{self, Hit};
+use crate::camera::CameraRay;
 use crate::film::Splats;
 use crate::geometry::{Ray, RayOffset};
 use crate::sampler::Sampler;
@@ -28,7 +29,7 @@ use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
 use crate::settings::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::Vec3;
+
 pub(crate) use toolkit::WALKS;
 pub use toolkit::{Deferred, PathState};
 
@@ -52,14 +53,15 @@ pub struct TraceCounters {
     pub shadow_rays: u64,
 }
 
-/// What one pixel sample computes: radiance along the camera ray `ray` at the
+/// What one pixel sample computes: radiance along the camera ray `ray` (times its
+/// weight; its companions ended when the lens dispersed them) at the
 /// wavelengths `wl`; contributions to other pixels go to `splats`. `first_hit` is the
 /// camera ray's closest hit when it was already traced (in an Embree packet); `None`
 /// traces it here. One function per (integrator, lanes, kernel), chosen once per render
 /// by [`kernel`] (pbrt-v4's `RayIntegrator::EvaluatePixelSample`).
 pub type RadianceFn<const N: usize> = fn(
     &Context,
-    Ray,
+    CameraRay,
     Option<Option<Hit>>,
     &SampledWavelengths<N>,
     &mut Sampler,
@@ -69,7 +71,7 @@ pub type RadianceFn<const N: usize> = fn(
 
 fn whitted_k<const N: usize, const K: KernelFlags>(
     ctx: &Context,
-    ray: Ray,
+    ray: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
@@ -81,7 +83,7 @@ fn whitted_k<const N: usize, const K: KernelFlags>(
 
 fn path_k<const N: usize, const K: KernelFlags>(
     ctx: &Context,
-    ray: Ray,
+    ray: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
@@ -93,7 +95,7 @@ fn path_k<const N: usize, const K: KernelFlags>(
 
 fn lighttrace_any<const N: usize>(
     ctx: &Context,
-    _: Ray,
+    _: CameraRay,
     _: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
@@ -105,7 +107,7 @@ fn lighttrace_any<const N: usize>(
 
 fn bdpt_any<const N: usize>(
     ctx: &Context,
-    ray: Ray,
+    ray: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
@@ -129,8 +131,8 @@ pub type StepFn<const N: usize> = fn(
     &mut Deferred<N>,
 ) -> bool;
 
-/// A path at the camera, ready for its first step.
-pub type StartFn<const N: usize> = fn(Vec3) -> PathState<N>;
+/// A path at the camera, ready for its first step along the camera ray.
+pub type StartFn<const N: usize> = fn(&CameraRay) -> PathState<N>;
 
 /// What the packet engine needs of an integrator: its start and its step, specialised
 /// to the kernel flags as [`RadianceFn`]s are.

@@ -81,6 +81,7 @@ use super::toolkit::{
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::Material;
+use crate::camera::CameraRay;
 use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::SurfacePoint;
 use crate::math::warp::power_heuristic;
@@ -100,13 +101,14 @@ use glam::{Vec2, Vec3};
 /// The random numbers read per bounce are the same in every kernel.
 pub fn radiance<const N: usize, const K: KernelFlags>(
     ctx: &Context,
-    mut ray: Ray,
+    cam: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
-    let mut s = PathState::<N>::start(ray.origin);
+    let mut s = PathState::<N>::at_camera(&cam);
+    let mut ray = cam.ray;
     let mut pending = first_hit;
     loop {
         let hit = next_hit(ctx, &ray, &mut pending, counters);
@@ -128,8 +130,8 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
 
 /// The path's state at the camera: what [`step`] starts from.
 #[inline]
-pub fn start<const N: usize>(origin: Vec3) -> PathState<N> {
-    PathState::start(origin)
+pub fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
+    PathState::at_camera(cam)
 }
 
 /// One step of the path whose ray `ray` has the closest hit `hit`: the segment through a

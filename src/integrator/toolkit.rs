@@ -12,7 +12,7 @@
 use super::{Context, TraceCounters};
 use crate::accel::embree::{Hit, RayQuery};
 use crate::bsdf::BsdfContext;
-use crate::camera::Camera;
+use crate::camera::{Camera, CameraRay};
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
@@ -387,6 +387,19 @@ impl<const N: usize> PathState<N> {
 }
 
 impl<const N: usize> PathState<N> {
+    /// The path at the camera ray `cam`: its throughput is the camera's weight, and
+    /// only the hero's when the lens ended the companions (as at a dispersive surface).
+    #[inline(always)]
+    pub(crate) fn at_camera(cam: &CameraRay) -> Self {
+        let mut s = PathState::start(cam.ray.origin);
+        s.beta = SampledSpectrum::splat(cam.weight);
+        if cam.hero_only {
+            s.beta.terminate_secondary();
+            s.bsdf_ctx.companions_alive = false;
+        }
+        s
+    }
+
     /// The radiance the path has found.
     #[inline]
     pub fn radiance(&self) -> SampledSpectrum<N> {

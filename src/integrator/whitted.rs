@@ -18,6 +18,7 @@ use super::toolkit::{next_hit, Immediate, PathState, ShadowSink};
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::LobeFlags;
+use crate::camera::CameraRay;
 use crate::geometry::{Interaction, Ray};
 use crate::light::Light;
 use crate::sampler::Sampler;
@@ -42,13 +43,14 @@ const DELTA: LobeFlags = LobeFlags::SPECULAR
 /// emission, radiance along escaping rays).
 pub fn radiance<const N: usize, const K: KernelFlags>(
     ctx: &Context,
-    mut ray: Ray,
+    cam: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
 ) -> SampledSpectrum<N> {
-    let mut s = start::<N>(ray.origin);
+    let mut s = start::<N>(&cam);
+    let mut ray = cam.ray;
     let mut pending = first_hit;
     loop {
         let hit = next_hit(ctx, &ray, &mut pending, counters);
@@ -71,8 +73,8 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
 /// The path's state at the camera: what [`step`] starts from (the seed's tracer samples
 /// delta lobes only).
 #[inline]
-pub fn start<const N: usize>(origin: Vec3) -> PathState<N> {
-    let mut s = PathState::start(origin);
+pub fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
+    let mut s = PathState::at_camera(cam);
     s.bsdf_ctx = s.bsdf_ctx.with_lobes(DELTA);
     s
 }

@@ -109,7 +109,8 @@ pub struct SkyFile {
     pub debye: Option<u32>,
 }
 
-/// `[camera]`: the seed's pinhole camera.
+/// `[camera]`: the seed's pinhole camera, or (`type = "lens"`) a film behind a lens
+/// prescription (`lens = "file"` or `[[camera.surface]]` tables).
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraFile {
@@ -118,10 +119,44 @@ pub struct CameraFile {
     /// Default `[0, 1, 0]`.
     #[serde(default)]
     pub up: Option<Direction3>,
-    /// Camera constant d (distance to an image plane of height 1); default 1.
+    /// Camera constant d (distance to an image plane of height 1); default 1. Pinhole
+    /// only.
     #[serde(default)]
     pub d: Option<PositiveNumber>,
     pub resolution: Resolution,
+    /// "pinhole" (the default) or "lens".
+    #[serde(default, rename = "type")]
+    pub kind: Option<String>,
+    /// The lens: a prescription file (heron's TOML or pbrt-v4's `.dat`), relative to
+    /// the scene file …
+    #[serde(default)]
+    pub lens: Option<String>,
+    /// … or its surfaces inline.
+    #[serde(default)]
+    pub surface: Option<Vec<toml::Value>>,
+    /// Film diagonal in mm; default 43.27 (35 mm film, 36 × 24).
+    #[serde(default)]
+    pub film_diagonal: Option<PositiveNumber>,
+    /// Film behind the last vertex (mm) …
+    #[serde(default)]
+    pub film_distance: Option<PositiveNumber>,
+    /// … or focused on a point this far in front of the film (scene units).
+    #[serde(default)]
+    pub focus_distance: Option<PositiveNumber>,
+    /// Wavelength (nm) of the focus and of the exposure's normalisation; default the
+    /// prescription's reference wavelength.
+    #[serde(default)]
+    pub focus_wavelength: Option<PositiveNumber>,
+    /// Millimetres per scene unit; default 1000 (the scene in metres).
+    #[serde(default)]
+    pub mm_per_unit: Option<PositiveNumber>,
+    /// Stop the lens down (or open it) to this f-number (paraxial, at the focus
+    /// wavelength, object at infinity).
+    #[serde(default)]
+    pub f_number: Option<PositiveNumber>,
+    /// Exit-pupil sampling: "bounds" (default) or "rear-element".
+    #[serde(default)]
+    pub pupil: Option<String>,
 }
 
 /// `[render]`: every key optional, defaults from `RenderSettings::default()`.
@@ -541,7 +576,9 @@ pub struct DirectionalLightFile {
 /// A refractive index: a positive number (no dispersion), the name of a catalogue entry
 /// (spectra/ior_catalogue.toml), or one of `{ sellmeier = { b = [..], c = [..] } }`
 /// (λ in µm, C in µm²), `{ cauchy = [A, B] }` or `{ cauchy = [A, B, C] }` (λ in µm),
-/// `{ table = "file.csv" }` (rows `wavelength_nm,n`, relative to the scene file).
+/// `{ table = "file.csv" }` (rows `wavelength_nm,n`, relative to the scene file), or
+/// `{ n_d = .., v_d = .. }` (a glass known by its index and Abbe number:
+/// [`crate::spectrum::ior::Ior::abbe`]).
 #[derive(Clone, Debug, PartialEq)]
 pub enum IorSpec {
     Constant(f32),
@@ -549,6 +586,7 @@ pub enum IorSpec {
     Sellmeier { b: Vec<f32>, c: Vec<f32> },
     Cauchy([f32; 3]),
     Table(String),
+    Abbe { n_d: f32, v_d: f32 },
 }
 
 /// `[x, y, z]`, three numbers finite in f32.
@@ -844,7 +882,7 @@ impl<'de> Deserialize<'de> for IorSpec {
         };
         let expected = || {
             format!(
-                "expected a positive number, a catalogue name ({}), {{ sellmeier = {{ b = [..], c = [..] }} }}, {{ cauchy = [A, B, C] }} or {{ table = \"file.csv\" }}, got {}",
+                "expected a positive number, a catalogue name ({}), {{ sellmeier = {{ b = [..], c = [..] }} }}, {{ cauchy = [A, B, C] }}, {{ n_d = .., v_d = .. }} or {{ table = \"file.csv\" }}, got {}",
                 names(),
                 show(&v)
             )
@@ -858,6 +896,19 @@ impl<'de> Deserialize<'de> for IorSpec {
                         "unknown refractive-index model {name:?}, expected one of {}",
                         names()
                     )))
+                }
+            }
+            toml::Value::Table(t) if t.contains_key("n_d") || t.contains_key("v_d") => {
+                let n_d = t.get("n_d").and_then(finite_f32);
+                let v_d = t.get("v_d").and_then(finite_f32);
+                match (n_d, v_d) {
+                    (Some(n_d), Some(v_d)) if t.len() == 2 && n_d >= 1.0 && v_d > 0.0 => {
+                        Ok(IorSpec::Abbe { n_d, v_d })
+                    }
+                    _ => Err(D::Error::custom(format!(
+                        "expected {{ n_d = .., v_d = .. }} with an index n_d ≥ 1 at 587.56 nm and an Abbe number v_d > 0, got {}",
+                        show(&v)
+                    ))),
                 }
             }
             toml::Value::Table(t) if t.len() == 1 => {

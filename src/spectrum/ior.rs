@@ -79,6 +79,23 @@ impl Ior {
         Ok(Ior::Sellmeier { b: bb, c: cc })
     }
 
+    /// A glass known by its index n_d (587.56 nm, the helium d line) and Abbe number
+    /// V_d = (n_d − 1)/(n_F − n_C): the two-term Cauchy model n = A + B/λ² through n_d
+    /// whose n_F − n_C (486.13 and 656.27 nm) is (n_d − 1)/V_d. It reproduces both
+    /// numbers exactly; between the lines it follows a real glass to about 1e-4, and it
+    /// has no UV or IR poles. The form design programs use for "model glasses" (e.g.
+    /// Zemax's model glass, Optiland's `AbbeMaterial`).
+    pub fn abbe(n_d: f32, v_d: f32) -> Ior {
+        let (ld, lf, lc) = (0.5875618f64, 0.4861327f64, 0.6562725f64);
+        let b = (n_d as f64 - 1.0) / v_d as f64 / (1.0 / (lf * lf) - 1.0 / (lc * lc));
+        let a = n_d as f64 - b / (ld * ld);
+        Ior::Cauchy {
+            a: a as f32,
+            b: b as f32,
+            c: 0.0,
+        }
+    }
+
     /// Checks that n is finite and at least 1 over 360–830 nm (a pole of a Sellmeier
     /// term inside the range, or a fit used far outside its range, would break this).
     pub fn validate(&self) -> Result<(), String> {
@@ -166,6 +183,19 @@ mod tests {
             assert!((n - m.n_d).abs() < tol, "{}: n_d {n} vs {}", m.name, m.n_d);
             assert!(m.ior.is_dispersive());
             m.ior.validate().unwrap();
+        }
+    }
+
+    #[test]
+    fn abbe_model_reproduces_n_d_and_v_d() {
+        for (n_d, v_d) in [(1.5168f32, 64.17f32), (1.7847, 25.76), (1.0, 50.0)] {
+            let m = Ior::abbe(n_d, v_d);
+            let (d, f, c) = (m.eval(587.5618), m.eval(486.1327), m.eval(656.2725));
+            assert!((d - n_d).abs() < 2e-6, "{d} vs {n_d}");
+            if n_d > 1.0 {
+                let v = (d - 1.0) / (f - c);
+                assert!((v - v_d).abs() < 2e-3 * v_d, "{v} vs {v_d}");
+            }
         }
     }
 

@@ -1,11 +1,22 @@
-//! The `[camera]` table to the seed's pinhole [`Camera`].
+//! The `[camera]` table to the seed's pinhole [`Camera`], or to a film behind a lens
+//! prescription ([`crate::camera::lens`]).
 use super::errors::fmt_points;
+use crate::camera::lens::{paraxial, Focus, LensCamera, LensSettings, LensSystem, PupilSampling};
 use crate::camera::{Camera, D_MAX, D_MIN};
 use crate::scene::file::{fmt_f32, CameraFile};
 use glam::Vec3;
+use std::path::Path;
 
-/// The camera of the `[camera]` table `c`.
-pub(super) fn build_camera(c: &CameraFile) -> Result<Camera, String> {
+/// The film diagonal of 35 mm film (36 × 24 mm), the default.
+pub const FILM_DIAGONAL_35MM: f64 = 43.266615305567875;
+
+/// The camera of the `[camera]` table `c`; a lens file is read relative to `base_dir`
+/// and recorded in `inputs`.
+pub(super) fn build_camera(
+    c: &CameraFile,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> Result<Camera, String> {
     if !(c.look_at.0 - c.eye.0).length().is_finite() {
         return Err(format!(
             "camera: expected eye and look_at at a distance finite in f32, got eye = {} and look_at = {}",
@@ -13,14 +24,54 @@ pub(super) fn build_camera(c: &CameraFile) -> Result<Camera, String> {
             fmt_points(&[c.look_at.0])
         ));
     }
-    let d = c.d.map_or(1.0, |d| d.0);
+    let lens = match c.kind.as_deref() {
+        None | Some("pinhole") => {
+            let lens_keys = [
+                ("lens", c.lens.is_some()),
+                ("surface", c.surface.is_some()),
+                ("film_diagonal", c.film_diagonal.is_some()),
+                ("film_distance", c.film_distance.is_some()),
+                ("focus_distance", c.focus_distance.is_some()),
+                ("focus_wavelength", c.focus_wavelength.is_some()),
+                ("mm_per_unit", c.mm_per_unit.is_some()),
+                ("f_number", c.f_number.is_some()),
+                ("pupil", c.pupil.is_some()),
+            ];
+            if let Some((k, _)) = lens_keys.iter().find(|(_, set)| *set) {
+                return Err(format!(
+                    "camera.{k}: a key of the lens camera; set camera.type = \"lens\" to use it"
+                ));
+            }
+            None
+        }
+        Some("lens") => Some(build_lens(c, base_dir, inputs)?),
+        Some(other) => {
+            return Err(format!(
+                "camera.type: expected \"pinhole\" or \"lens\", got {other:?}"
+            ))
+        }
+    };
+    let d = match (&lens, c.d) {
+        (Some(_), Some(_)) => {
+            return Err(
+                "camera.d: the pinhole's camera constant; a lens camera's field of view follows from its focal length and film_diagonal".into(),
+            )
+        }
+        // The pinhole of the same field of view, for what asks a camera for its d.
+        (Some(l), None) => {
+            let (_, fh) = l.film_size(c.resolution.width, c.resolution.height);
+            let f = paraxial::paraxial(&l.system, l.settings.focus_wavelength).efl;
+            ((f / fh) as f32).clamp(D_MIN, D_MAX)
+        }
+        (None, d) => d.map_or(1.0, |d| d.0),
+    };
     if !(D_MIN..=D_MAX).contains(&d) {
         return Err(format!(
             "camera.d: expected a camera constant in [{D_MIN:e}, {D_MAX:e}] (a vertical field of view from about 180° down to 1e-6 rad), got {}",
             fmt_f32(d)
         ));
     }
-    Camera::new(
+    let cam = Camera::new(
         c.eye.0,
         c.look_at.0,
         c.up.map_or(Vec3::Y, |u| u.unit()),
@@ -28,5 +79,81 @@ pub(super) fn build_camera(c: &CameraFile) -> Result<Camera, String> {
         c.resolution.width,
         c.resolution.height,
     )
-    .map_err(|e| format!("camera: {e}"))
+    .map_err(|e| format!("camera: {e}"))?;
+    Ok(match lens {
+        Some(l) => cam.with_lens(l),
+        None => cam,
+    })
+}
+
+/// The lens of a `type = "lens"` camera.
+fn build_lens(
+    c: &CameraFile,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> Result<LensCamera, String> {
+    let system: LensSystem = match (&c.lens, &c.surface) {
+        (Some(file), None) => {
+            let sys = super::lens::read_prescription(&base_dir.join(file))
+                .map_err(|e| format!("camera.lens: {e}"))?;
+            inputs.push(file.clone());
+            sys
+        }
+        (None, Some(values)) => {
+            super::lens::surfaces_from_values("camera.", "inline", values, base_dir)?
+        }
+        (Some(_), Some(_)) => {
+            return Err(
+                "camera.lens: give the prescription once: a file (lens = \"…\") or [[camera.surface]] tables, not both".into(),
+            )
+        }
+        (None, None) => {
+            return Err(
+                "camera.lens: a lens camera needs a prescription: lens = \"file.toml\" (or a pbrt-v4 .dat file) or [[camera.surface]] tables".into(),
+            )
+        }
+    };
+    let focus_wavelength = c
+        .focus_wavelength
+        .map_or(system.reference_wavelength, |w| w.0 as f64);
+    if !(360.0..=830.0).contains(&focus_wavelength) {
+        return Err(format!(
+            "camera.focus_wavelength: expected a wavelength in 360–830 nm, got {focus_wavelength}"
+        ));
+    }
+    let mm_per_unit = c.mm_per_unit.map_or(1000.0, |x| x.0 as f64);
+    let focus = match (c.film_distance, c.focus_distance) {
+        (Some(_), Some(_)) => {
+            return Err(
+                "camera.focus_distance: give the focus once: film_distance (mm behind the last vertex) or focus_distance (scene units in front of the film), not both".into(),
+            )
+        }
+        (Some(d), None) => Focus::FilmDistance(d.0 as f64),
+        (None, Some(d)) => Focus::ObjectDistance(d.0 as f64 * mm_per_unit),
+        (None, None) => Focus::Prescription,
+    };
+    let pupil = match c.pupil.as_deref() {
+        None => PupilSampling::Bounds,
+        Some(p) => PupilSampling::parse(p).ok_or_else(|| {
+            format!(
+                "camera.pupil: expected one of {}, got {p:?}",
+                PupilSampling::NAMES.join(", ")
+            )
+        })?,
+    };
+    let system = match c.f_number {
+        Some(n) => {
+            let p = paraxial::paraxial(&system, focus_wavelength);
+            system.with_stop_scaled(p.f_number / n.0 as f64)
+        }
+        None => system,
+    };
+    let settings = LensSettings {
+        film_diagonal: c.film_diagonal.map_or(FILM_DIAGONAL_35MM, |x| x.0 as f64),
+        focus,
+        focus_wavelength,
+        pupil,
+        mm_per_unit,
+    };
+    LensCamera::new(system, settings).map_err(|e| format!("camera.{e}"))
 }

@@ -127,6 +127,7 @@ fn build_ior(
             b: *b,
             c: *c,
         },
+        IorSpec::Abbe { n_d, v_d } => Ior::abbe(*n_d, *v_d),
         IorSpec::Table(file) => {
             let p = base_dir.join(file);
             let csv =

@@ -28,6 +28,7 @@ pub(crate) mod obj;
 
 mod camera;
 mod errors;
+pub mod lens;
 mod lights;
 mod materials;
 mod media;
@@ -131,7 +132,7 @@ pub(crate) fn build(
         }
         None => None,
     };
-    let camera = camera::build_camera(&file.camera).map_err(err)?;
+    let camera = camera::build_camera(&file.camera, &base_dir, &mut inputs).map_err(err)?;
     let inputs = crate::files::hash_inputs(&base_dir, inputs).map_err(err)?;
     Ok(Scene::from_parts(SceneParts {
         source: path.to_path_buf(),
