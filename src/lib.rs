@@ -21,6 +21,7 @@ pub mod film;
 pub mod fuzzing;
 pub mod geometry;
 pub mod integrator;
+pub mod lensdesign;
 pub mod light;
 pub mod math;
 pub mod medium;

@@ -64,6 +64,11 @@ enum Command {
     /// Rainbow skies: radiance profiles of the sky models (heron::sky).
     #[command(subcommand)]
     Sky(SkyCommand),
+    /// A lens prescription's optics from heron's own lens code: first order (EFL, BFL,
+    /// f-number, pupils) at F, d and C, the chromatic focal shift over 400–700 nm and
+    /// real-ray spot diagrams per field angle and wavelength; with --out, as CSV files
+    /// and PNG plots.
+    Lens(LensArgs),
     /// The scene's spectra (reflectances, emissions, indices) on heron's 1 nm grid as
     /// JSON, for tests/python/test_mitsuba.py.
     #[command(hide = true)]
@@ -93,6 +98,43 @@ struct StressArgs {
     /// auto, epsilon or robust (as render --offset); default: the scene's render.offset.
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::settings::OffsetMode::NAMES))]
     offset: Option<String>,
+}
+
+#[derive(clap::Args)]
+struct LensArgs {
+    /// The prescription: heron's TOML (lenses/*.toml) or a pbrt-v4 lens file (*.dat).
+    prescription: PathBuf,
+    /// Folder for paraxial.csv, focal_shift.csv, spots.csv, spot_points.csv,
+    /// focal_shift.png and spots.png.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Field angles of the spot diagrams (degrees, comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "0,14,20")]
+    fields: Vec<f64>,
+    /// Points across the pupil's diameter of the spot diagrams' square grid.
+    #[arg(long, default_value_t = 64)]
+    rays: usize,
+    /// The reference wavelength (nm) of the focus and the focal shift; default the
+    /// prescription's (587.5618, the d line, unless it says otherwise).
+    #[arg(long)]
+    reference_wavelength: Option<f64>,
+}
+
+fn cmd_lens(a: LensArgs) -> Result<()> {
+    let mut sys = heron::scene::load::lens::read_prescription(&a.prescription)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(l) = a.reference_wavelength {
+        if !(360.0..=830.0).contains(&l) {
+            bail!("--reference-wavelength: expected a wavelength in 360–830 nm, got {l}");
+        }
+        sys.reference_wavelength = l;
+    }
+    let report = heron::lensdesign::analyse(&sys, &a.fields, a.rays)?;
+    if let Some(dir) = &a.out {
+        report.write(dir)?;
+    }
+    print!("{}", report.summary());
+    Ok(())
 }
 
 #[derive(Subcommand)]
@@ -879,6 +921,7 @@ fn main() {
         Command::Info { exr } => cmd_info(&exr),
         Command::Stress(args) => cmd_stress(args),
         Command::Sky(c) => cmd_sky(c),
+        Command::Lens(args) => cmd_lens(args),
         Command::Spectra { scene } => load_scene(&scene)
             .map_err(Into::into)
             .map(|s| println!("{}", heron::scene::export::spectra_json(&s))),
@@ -1197,7 +1240,8 @@ fn cmd_converge(a: ConvergeArgs) -> Result<()> {
     let mut scene = load_scene(&a.scene)?;
     if let Some((w, h)) = a.size {
         let c = &scene.camera;
-        scene.camera = heron::camera::Camera::new(c.eye, c.look_at, c.up, c.d, w, h)
+        scene.camera = c
+            .resized(w, h)
             .map_err(|e| anyhow::anyhow!("--size: {e}"))?;
     }
     let mut base = RenderOptions::from_scene(&scene);
