@@ -339,16 +339,9 @@ fn solve_focus(sys: &LensSystem, lambda_nm: f64, object_mm: f64) -> Result<f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectrum::ior::Ior;
 
     fn singlet(sa_stop: f64) -> LensSystem {
-        let surf = |radius, thickness, n: f32, sa, stop| Surface {
-            radius,
-            thickness,
-            medium: Ior::Constant(n),
-            semi_aperture: sa,
-            stop,
-        };
+        let surf = Surface::constant;
         LensSystem::new(
             "singlet",
             vec![

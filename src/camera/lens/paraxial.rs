@@ -139,17 +139,6 @@ pub fn image_distance(sys: &LensSystem, lambda_nm: f64, object_mm: f64) -> f64 {
 mod tests {
     use super::super::system::Surface;
     use super::*;
-    use crate::spectrum::ior::Ior;
-
-    fn surf(radius: f64, thickness: f64, n: f32, sa: f64, stop: bool) -> Surface {
-        Surface {
-            radius,
-            thickness,
-            medium: Ior::Constant(n),
-            semi_aperture: sa,
-            stop,
-        }
-    }
 
     /// A thick singlet against the thick-lens formula 1/f = (n−1)(1/R₁ − 1/R₂ +
     /// (n−1)t/(n R₁R₂)) and its back focal distance f(1 − (n−1)t/(n R₁)) (Hecht,
@@ -160,9 +149,9 @@ mod tests {
         let sys = LensSystem::new(
             "singlet",
             vec![
-                surf(0.0, 0.0, 1.0, 10.0, true),
-                surf(r1, t, n, 12.0, false),
-                surf(r2, 50.0, 1.0, 12.0, false),
+                Surface::constant(0.0, 0.0, 1.0, 10.0, true),
+                Surface::constant(r1, t, n, 12.0, false),
+                Surface::constant(r2, 50.0, 1.0, 12.0, false),
             ],
         )
         .unwrap();
@@ -195,9 +184,9 @@ mod tests {
         let sys = LensSystem::new(
             "front",
             vec![
-                surf(r, 1e-4, n, 0.05, false),
-                surf(0.0, d, 1.0, 0.05, false),
-                surf(0.0, 40.0, 1.0, 4.0, true),
+                Surface::constant(r, 1e-4, n, 0.05, false),
+                Surface::constant(0.0, d, 1.0, 0.05, false),
+                Surface::constant(0.0, 40.0, 1.0, 4.0, true),
             ],
         )
         .unwrap();

@@ -26,6 +26,18 @@ pub struct Surface {
 }
 
 impl Surface {
+    /// A surface with a constant index behind it, for the lens modules' tests.
+    #[cfg(test)]
+    pub fn constant(radius: f64, thickness: f64, n: f32, semi_aperture: f64, stop: bool) -> Self {
+        Surface {
+            radius,
+            thickness,
+            medium: Ior::Constant(n),
+            semi_aperture,
+            stop,
+        }
+    }
+
     /// Curvature 1/R (0 for a flat surface).
     #[inline]
     pub fn curvature(&self) -> f64 {

@@ -152,16 +152,9 @@ mod tests {
     use super::super::paraxial::paraxial;
     use super::super::system::Surface;
     use super::*;
-    use crate::spectrum::ior::Ior;
 
     fn singlet() -> LensSystem {
-        let surf = |radius, thickness, n: f32, sa, stop| Surface {
-            radius,
-            thickness,
-            medium: Ior::Constant(n),
-            semi_aperture: sa,
-            stop,
-        };
+        let surf = Surface::constant;
         LensSystem::new(
             "singlet",
             vec![
