@@ -89,9 +89,10 @@ pub struct LensSettings {
 const RINGS: usize = 64;
 /// Film radii traced per ring, grid points per side of the rear square, and the
 /// wavelengths (nm: the range's ends and its middle) whose rays the bounds hold: the
-/// bounds are the union over them, widened by two grid cells. With a 48² grid the cell
-/// is 1/12 of the rear semi-aperture; tests/lens_camera.rs checks by a z-test that the
-/// bounds lose no light against sampling the whole square.
+/// bounds are the union over them, widened by two grid cells. With a 48² grid the first
+/// pass's cell is 1/12 of the rear semi-aperture and the second's 1/48 of the first
+/// pass's rectangle; tests/lens_camera.rs checks by a z-test that the bounds lose no
+/// light against sampling the whole square.
 const RING_RADII: usize = 6;
 const GRID: usize = 48;
 const BOUND_WAVELENGTHS: [f64; 3] = [360.0, 595.0, 830.0];
@@ -202,10 +203,25 @@ impl LensCamera {
     }
 
     /// The bounds on the rear plane of the rays from film points in ring `k` that get
-    /// through, for film points on the +x axis.
+    /// through, for film points on the +x axis: a grid over the whole rear square, then
+    /// the same grid over the rectangle it found, so a small exit pupil (a lens stopped
+    /// down) gets bounds a grid cell of its own size from its edge rather than one of
+    /// the rear element's.
     fn ring_bounds(&self, k: usize) -> [f64; 4] {
         let h = self.rear_half;
-        let cell = 2.0 * h / GRID as f64;
+        let coarse = self.grid_bounds(k, [-h, h, -h, h]);
+        if coarse == [0.0; 4] {
+            return coarse;
+        }
+        self.grid_bounds(k, coarse)
+    }
+
+    /// The rectangle within `within` [x0, x1, y0, y1] (rear plane, mm) holding every
+    /// point of a GRID² grid over it whose ray from ring `k`'s film points gets through,
+    /// widened by two cells and clipped to `within`; all zeros when none does.
+    fn grid_bounds(&self, k: usize, within: [f64; 4]) -> [f64; 4] {
+        let [wx0, wx1, wy0, wy1] = within;
+        let (cx, cy) = ((wx1 - wx0) / GRID as f64, (wy1 - wy0) / GRID as f64);
         let mut b = [
             f64::INFINITY,
             f64::NEG_INFINITY,
@@ -219,9 +235,9 @@ impl LensCamera {
             let o = DVec3::new(r, 0.0, zf);
             for &lambda in &BOUND_WAVELENGTHS {
                 for gy in 0..GRID {
-                    let y = -h + (gy as f64 + 0.5) * cell;
+                    let y = wy0 + (gy as f64 + 0.5) * cy;
                     for gx in 0..GRID {
-                        let x = -h + (gx as f64 + 0.5) * cell;
+                        let x = wx0 + (gx as f64 + 0.5) * cx;
                         let d = (DVec3::new(x, y, zr) - o).normalize();
                         if trace_backward(&self.system, LensRay { o, d }, lambda).is_ok() {
                             b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
@@ -234,12 +250,11 @@ impl LensCamera {
             // Nothing gets through from this ring: it stays black.
             return [0.0; 4];
         }
-        let m = 2.0 * cell;
         [
-            (b[0] - m).max(-h),
-            (b[1] + m).min(h),
-            (b[2] - m).max(-h),
-            (b[3] + m).min(h),
+            (b[0] - 2.0 * cx).max(wx0),
+            (b[1] + 2.0 * cx).min(wx1),
+            (b[2] - 2.0 * cy).max(wy0),
+            (b[3] + 2.0 * cy).min(wy1),
         ]
     }
 
