@@ -124,9 +124,13 @@ pub fn trace_forward(
     lambda_nm: f64,
     rims: Rims,
 ) -> Result<LensRay, Blocked> {
+    // Each medium's index is evaluated once and carried to the next surface (a
+    // Sellmeier index costs four divisions and a square root).
+    let mut n1 = 1.0;
     for i in 0..sys.surfaces.len() {
-        let (n1, n2) = (sys.n_before(i, lambda_nm), sys.n_after(i, lambda_nm));
+        let n2 = sys.n_after(i, lambda_nm);
         r = cross(sys, i, &r, n1, n2, rims)?;
+        n1 = n2;
     }
     Ok(r)
 }
@@ -140,9 +144,12 @@ pub fn trace_backward(
     mut r: LensRay,
     lambda_nm: f64,
 ) -> Result<LensRay, Blocked> {
-    for i in (0..sys.surfaces.len()).rev() {
-        let (n1, n2) = (sys.n_after(i, lambda_nm), sys.n_before(i, lambda_nm));
+    let last = sys.surfaces.len() - 1;
+    let mut n1 = sys.n_after(last, lambda_nm);
+    for i in (0..=last).rev() {
+        let n2 = sys.n_before(i, lambda_nm);
         r = cross(sys, i, &r, n1, n2, Rims::Stop)?;
+        n1 = n2;
     }
     Ok(r)
 }
