@@ -121,15 +121,9 @@ struct LensArgs {
 }
 
 fn cmd_lens(a: LensArgs) -> Result<()> {
-    let mut sys = heron::scene::load::lens::read_prescription(&a.prescription)
+    let sys = heron::scene::load::lens::read_prescription(&a.prescription)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some(l) = a.reference_wavelength {
-        if !(360.0..=830.0).contains(&l) {
-            bail!("--reference-wavelength: expected a wavelength in 360–830 nm, got {l}");
-        }
-        sys.reference_wavelength = l;
-    }
-    let report = heron::lensdesign::analyse(&sys, &a.fields, a.rays)?;
+    let report = heron::lensdesign::analyse(&sys, &a.fields, a.rays, a.reference_wavelength)?;
     if let Some(dir) = &a.out {
         report.write(dir)?;
     }
