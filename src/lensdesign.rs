@@ -28,6 +28,16 @@ use std::path::Path;
 /// The wavelengths of the first-order table and the spot diagrams: F, d, C.
 pub const LINES: [f64; 3] = [F_LINE, D_LINE, C_LINE];
 
+/// The field angles (degrees) of the spot diagrams when none are given: the Cooke
+/// triplet's design fields (`heron.lens(fields=...)`, and `heron lens --fields`, whose
+/// clap default is the text "0,14,20": tests/python/test_lens_python.py holds the two
+/// together).
+pub const DEFAULT_FIELDS: [f64; 3] = [0.0, 14.0, 20.0];
+
+/// Points across the pupil of the spot diagrams' grid when not given: 64, whose 3096
+/// points in the disc are Optiland's "uniform" pupil of the same size.
+pub const DEFAULT_RAYS: usize = 64;
+
 /// One spot: a field angle at one wavelength.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Spot {

@@ -109,10 +109,12 @@ struct LensArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Field angles of the spot diagrams (degrees, comma-separated).
+    // heron::lensdesign::DEFAULT_FIELDS, written as text so that the help shows it
+    // comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "0,14,20")]
     fields: Vec<f64>,
     /// Points across the pupil's diameter of the spot diagrams' square grid.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = heron::lensdesign::DEFAULT_RAYS)]
     rays: usize,
     /// The reference wavelength (nm) of the focus and the focal shift; default the
     /// prescription's (587.5618, the d line, unless it says otherwise).
