@@ -5,7 +5,7 @@ Scenes are heron's TOML scene files (``load_scene``) or the same schema as a dic
 spectral bins) equal bit for bit to the EXR ``heron render`` writes for the same
 settings. ``trace``, ``sky_profile``, ``color`` and ``ior`` are the CLI's ``heron trace``,
 ``heron sky profile``, ``heron color`` and the scene files' refractive indices;
-``compare`` is ``heron compare``.
+``compare`` is ``heron compare``; ``lens`` is ``heron lens``.
 
 Bad input raises ``HeronError`` (a ``ValueError``) with the CLI's one-line message; where
 the CLI names a flag (``--lanes``) the message names the argument (``lanes``).
@@ -274,4 +274,72 @@ def compare(
     variance, else from the spread within each region (Student t). "same" is the
     verdict and "status" the CLI's exit status (0 same, 1 different); errors raise
     HeronError (the CLI's status 2).
+    """
+
+class LensParaxial(TypedDict):
+    """First order at one wavelength: the columns of ``heron lens``'s paraxial.csv.
+    Lengths in mm; pupil positions from the first (entrance) and last (exit) vertex,
+    positive toward the image."""
+
+    wavelength_nm: float
+    efl_mm: float
+    bfl_mm: float
+    f_number: float
+    entrance_pupil_z_mm: float
+    entrance_pupil_diameter_mm: float
+    exit_pupil_z_mm: float
+    exit_pupil_diameter_mm: float
+
+class LensFocalShift(TypedDict):
+    """The columns of focal_shift.csv as arrays of 61 values, 400-700 nm every 5 nm."""
+
+    wavelength_nm: npt.NDArray[np.float64]
+    bfl_mm: npt.NDArray[np.float64]
+    focal_shift_mm: npt.NDArray[np.float64]
+    """BFL(lambda) - BFL(reference wavelength)."""
+
+class LensSpot(TypedDict):
+    """One field angle at one wavelength: the columns of spots.csv, and the points."""
+
+    field_deg: float
+    wavelength_nm: float
+    rays: int
+    """Rays that reached the image plane."""
+    rms_radius_mm: float
+    geo_radius_mm: float
+    centroid_x_mm: float
+    centroid_y_mm: float
+    vignetted_fraction: float
+    """Share of the traced rays a rim or the stop would stop."""
+    points_mm: npt.NDArray[np.float64]
+    """rays x 2: each ray's (x, y) in the reference wavelength's paraxial image plane
+    (spot_points.csv writes them minus the centroid)."""
+
+class LensReport(TypedDict):
+    name: str
+    reference_wavelength_nm: float
+    paraxial: list[LensParaxial]
+    """At the F, d and C lines (486.1327, 587.5618, 656.2725 nm)."""
+    focal_shift: LensFocalShift
+    spots: list[LensSpot]
+    """Per field angle, then per F, d, C line."""
+    summary: str
+    """The text ``heron lens`` prints."""
+
+def lens(
+    prescription: Union[_Path, Sequence[Mapping[str, Any]]],
+    fields: _Numbers = (0, 14, 20),
+    rays: int = 64,
+    reference_wavelength: Optional[float] = None,
+) -> LensReport:
+    """First order at F, d, C, the chromatic focal shift over 400-700 nm and real-ray
+    spot diagrams of a lens prescription, as ``heron lens`` computes them (the numbers
+    of its CSV files, exactly).
+
+    prescription: a path to heron's TOML prescription or a pbrt-v4 lens file (``*.dat``),
+    or a list of dicts like the TOML's ``[[surface]]`` tables, from the object side:
+    radius, thickness, semi_aperture (mm), optionally medium (``"air"`` or any ``ior``
+    model) and stop. fields: degrees in (-90, 90). rays: points across the pupil of the
+    spot grid (at least 2). reference_wavelength: nm, the focus of the spots and the
+    zero of the focal shift (default the prescription's, else the d line).
     """

@@ -28,6 +28,16 @@ use std::path::Path;
 /// The wavelengths of the first-order table and the spot diagrams: F, d, C.
 pub const LINES: [f64; 3] = [F_LINE, D_LINE, C_LINE];
 
+/// The field angles (degrees) of the spot diagrams when none are given: the Cooke
+/// triplet's design fields (`heron.lens(fields=...)`, and `heron lens --fields`, whose
+/// clap default is the text "0,14,20": tests/python/test_lens_python.py holds the two
+/// together).
+pub const DEFAULT_FIELDS: [f64; 3] = [0.0, 14.0, 20.0];
+
+/// Points across the pupil of the spot diagrams' grid when not given: 64, whose 3096
+/// points in the disc are Optiland's "uniform" pupil of the same size.
+pub const DEFAULT_RAYS: usize = 64;
+
 /// One spot: a field angle at one wavelength.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Spot {
@@ -56,18 +66,43 @@ pub struct LensReport {
 }
 
 /// The report for `sys` with spots at `fields` (degrees) on a grid of `rays` points
-/// across the pupil.
-pub fn analyse(sys: &LensSystem, fields: &[f64], rays: usize) -> Result<LensReport> {
+/// across the pupil, focused at `reference_wavelength` (nm; default the prescription's).
+/// The errors name the CLI's flags (`--rays`, `--fields`, `--reference-wavelength`); the
+/// Python module renames them to its arguments.
+pub fn analyse(
+    sys: &LensSystem,
+    fields: &[f64],
+    rays: usize,
+    reference_wavelength: Option<f64>,
+) -> Result<LensReport> {
     if rays < 2 {
-        return Err(HeronError::Invalid(format!(
-            "--rays: expected at least 2 points across the pupil, got {rays}"
-        )));
+        return Err(rays_error(rays));
+    }
+    if fields.is_empty() {
+        return Err(HeronError::Invalid(
+            "--fields: expected at least one field angle (degrees)".into(),
+        ));
     }
     if let Some(f) = fields.iter().find(|f| !(f.is_finite() && f.abs() < 90.0)) {
         return Err(HeronError::Invalid(format!(
             "--fields: expected field angles in (−90°, 90°), got {f}"
         )));
     }
+    let overridden;
+    let sys = match reference_wavelength {
+        None => sys,
+        Some(l) => {
+            if !(360.0..=830.0).contains(&l) {
+                return Err(HeronError::Invalid(format!(
+                    "--reference-wavelength: expected a wavelength in 360–830 nm, got {l}"
+                )));
+            }
+            let mut s = sys.clone();
+            s.reference_wavelength = l;
+            overridden = s;
+            &overridden
+        }
+    };
     let reference = sys.reference_wavelength;
     let first_order = LINES.iter().map(|&l| paraxial(sys, l)).collect();
     let bfl_ref = paraxial(sys, reference).bfl;
@@ -91,6 +126,14 @@ pub fn analyse(sys: &LensSystem, fields: &[f64], rays: usize) -> Result<LensRepo
         focal_shift,
         spots,
     })
+}
+
+/// The error for a grid of `got` points across the pupil (fewer than 2), also for
+/// front ends whose number can be negative.
+pub fn rays_error(got: impl std::fmt::Display) -> HeronError {
+    HeronError::Invalid(format!(
+        "--rays: expected at least 2 points across the pupil, got {got}"
+    ))
 }
 
 /// The spot of field `field_deg` at `lambda_nm` (see the module docs).
@@ -146,54 +189,243 @@ pub fn spot(sys: &LensSystem, field_deg: f64, lambda_nm: f64, rays: usize) -> Sp
     }
 }
 
+/// A value in one of the report's tables.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    /// A length (mm), angle (degrees), wavelength (nm), ratio or fraction.
+    Real(f64),
+    /// A number of rays.
+    Count(usize),
+}
+
+impl std::fmt::Display for Value {
+    /// As the CSV files write it: the shortest text that reads back as the same number.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Real(x) => write!(f, "{x}"),
+            Value::Count(n) => write!(f, "{n}"),
+        }
+    }
+}
+
+/// How the summary `heron lens` prints shows a column: right-aligned in `width`
+/// characters (then `suffix`), `decimals` after the point, the value times `scale`.
+#[derive(Clone, Copy, Debug)]
+pub struct Shown {
+    pub header: &'static str,
+    pub width: usize,
+    pub decimals: usize,
+    pub scale: f64,
+    pub suffix: &'static str,
+}
+
+/// One column of a table the report writes: its name (the CSV header, and the key in
+/// the Python module's records), its value in a row, and how the summary shows it (if
+/// it does). One list per table, read by the CSV writer, the summary and the Python
+/// module alike, so the three cannot disagree.
+pub struct Column<T> {
+    pub name: &'static str,
+    pub value: fn(&T) -> Value,
+    pub shown: Option<Shown>,
+}
+
+/// A summary column of a real number: `decimals` after the point in `width` characters.
+const fn shown(header: &'static str, width: usize, decimals: usize) -> Option<Shown> {
+    Some(Shown {
+        header,
+        width,
+        decimals,
+        scale: 1.0,
+        suffix: "",
+    })
+}
+
+/// paraxial.csv: first order per wavelength (F, d, C), lengths in mm.
+pub const PARAXIAL_COLUMNS: &[Column<Paraxial>] = &[
+    Column {
+        name: "wavelength_nm",
+        value: |p| Value::Real(p.wavelength_nm),
+        shown: shown("lambda_nm", 10, 4),
+    },
+    Column {
+        name: "efl_mm",
+        value: |p| Value::Real(p.efl),
+        shown: shown("EFL", 10, 4),
+    },
+    Column {
+        name: "bfl_mm",
+        value: |p| Value::Real(p.bfl),
+        shown: shown("BFL", 10, 4),
+    },
+    Column {
+        name: "f_number",
+        value: |p| Value::Real(p.f_number),
+        shown: shown("f/#", 7, 3),
+    },
+    Column {
+        name: "entrance_pupil_z_mm",
+        value: |p| Value::Real(p.entrance_pupil_z),
+        shown: shown("EP_z", 9, 4),
+    },
+    Column {
+        name: "entrance_pupil_diameter_mm",
+        value: |p| Value::Real(p.entrance_pupil_diameter),
+        shown: shown("EPD", 9, 4),
+    },
+    Column {
+        name: "exit_pupil_z_mm",
+        value: |p| Value::Real(p.exit_pupil_z),
+        shown: shown("XP_z", 9, 4),
+    },
+    Column {
+        name: "exit_pupil_diameter_mm",
+        value: |p| Value::Real(p.exit_pupil_diameter),
+        shown: shown("XPD", 9, 4),
+    },
+];
+
+/// focal_shift.csv: a row (λ nm, BFL mm, BFL − BFL(reference) mm) of
+/// [`LensReport::focal_shift`].
+pub const FOCAL_SHIFT_COLUMNS: &[Column<(f64, f64, f64)>] = &[
+    Column {
+        name: "wavelength_nm",
+        value: |r| Value::Real(r.0),
+        shown: None,
+    },
+    Column {
+        name: "bfl_mm",
+        value: |r| Value::Real(r.1),
+        shown: None,
+    },
+    Column {
+        name: "focal_shift_mm",
+        value: |r| Value::Real(r.2),
+        shown: None,
+    },
+];
+
+/// spots.csv: one row per field and wavelength; the summary shows the radii in µm and
+/// the vignetted share in percent.
+pub const SPOT_COLUMNS: &[Column<Spot>] = &[
+    Column {
+        name: "field_deg",
+        value: |s| Value::Real(s.field_deg),
+        shown: shown("field_deg", 9, 2),
+    },
+    Column {
+        name: "wavelength_nm",
+        value: |s| Value::Real(s.wavelength_nm),
+        shown: shown("lambda_nm", 10, 4),
+    },
+    Column {
+        name: "rays",
+        value: |s| Value::Count(s.rays),
+        shown: shown("rays", 6, 0),
+    },
+    Column {
+        name: "rms_radius_mm",
+        value: |s| Value::Real(s.rms_radius),
+        shown: Some(Shown {
+            header: "RMS_um",
+            width: 12,
+            decimals: 3,
+            scale: 1e3,
+            suffix: "",
+        }),
+    },
+    Column {
+        name: "geo_radius_mm",
+        value: |s| Value::Real(s.geo_radius),
+        shown: Some(Shown {
+            header: "geo_um",
+            width: 12,
+            decimals: 3,
+            scale: 1e3,
+            suffix: "",
+        }),
+    },
+    Column {
+        name: "centroid_x_mm",
+        value: |s| Value::Real(s.centroid.0),
+        shown: None,
+    },
+    Column {
+        name: "centroid_y_mm",
+        value: |s| Value::Real(s.centroid.1),
+        shown: None,
+    },
+    Column {
+        name: "vignetted_fraction",
+        value: |s| Value::Real(s.vignetted_fraction),
+        shown: Some(Shown {
+            header: "vignetted",
+            width: 10,
+            decimals: 1,
+            scale: 100.0,
+            suffix: "%",
+        }),
+    },
+];
+
+/// `rows` as CSV with a header line, by `columns`.
+fn csv<T>(columns: &[Column<T>], rows: &[T]) -> String {
+    let names: Vec<&str> = columns.iter().map(|c| c.name).collect();
+    let mut s = names.join(",");
+    s.push('\n');
+    for r in rows {
+        let cells: Vec<String> = columns.iter().map(|c| (c.value)(r).to_string()).collect();
+        s.push_str(&cells.join(","));
+        s.push('\n');
+    }
+    s
+}
+
+/// The summary's table of `rows`: the columns that are shown, separated by a space.
+fn summary_table<T>(columns: &[Column<T>], rows: &[T]) -> String {
+    let shown: Vec<(&Column<T>, Shown)> = columns
+        .iter()
+        .filter_map(|c| c.shown.map(|f| (c, f)))
+        .collect();
+    let header: Vec<String> = shown
+        .iter()
+        .map(|(_, f)| format!("{:>w$}", f.header, w = f.width + f.suffix.chars().count()))
+        .collect();
+    let mut s = header.join(" ");
+    s.push('\n');
+    for r in rows {
+        let cells: Vec<String> = shown
+            .iter()
+            .map(|(c, f)| match (c.value)(r) {
+                Value::Real(x) => format!(
+                    "{:>w$.d$}{}",
+                    f.scale * x,
+                    f.suffix,
+                    w = f.width,
+                    d = f.decimals
+                ),
+                Value::Count(n) => format!("{n:>w$}{}", f.suffix, w = f.width),
+            })
+            .collect();
+        s.push_str(&cells.join(" "));
+        s.push('\n');
+    }
+    s
+}
+
 impl LensReport {
     /// paraxial.csv
     pub fn paraxial_csv(&self) -> String {
-        let mut s = String::from("wavelength_nm,efl_mm,bfl_mm,f_number,entrance_pupil_z_mm,entrance_pupil_diameter_mm,exit_pupil_z_mm,exit_pupil_diameter_mm\n");
-        for p in &self.first_order {
-            let _ = writeln!(
-                s,
-                "{},{},{},{},{},{},{},{}",
-                p.wavelength_nm,
-                p.efl,
-                p.bfl,
-                p.f_number,
-                p.entrance_pupil_z,
-                p.entrance_pupil_diameter,
-                p.exit_pupil_z,
-                p.exit_pupil_diameter
-            );
-        }
-        s
+        csv(PARAXIAL_COLUMNS, &self.first_order)
     }
 
     /// focal_shift.csv
     pub fn focal_shift_csv(&self) -> String {
-        let mut s = String::from("wavelength_nm,bfl_mm,focal_shift_mm\n");
-        for (l, b, d) in &self.focal_shift {
-            let _ = writeln!(s, "{l},{b},{d}");
-        }
-        s
+        csv(FOCAL_SHIFT_COLUMNS, &self.focal_shift)
     }
 
     /// spots.csv
     pub fn spots_csv(&self) -> String {
-        let mut s = String::from("field_deg,wavelength_nm,rays,rms_radius_mm,geo_radius_mm,centroid_x_mm,centroid_y_mm,vignetted_fraction\n");
-        for p in &self.spots {
-            let _ = writeln!(
-                s,
-                "{},{},{},{},{},{},{},{}",
-                p.field_deg,
-                p.wavelength_nm,
-                p.rays,
-                p.rms_radius,
-                p.geo_radius,
-                p.centroid.0,
-                p.centroid.1,
-                p.vignetted_fraction
-            );
-        }
-        s
+        csv(SPOT_COLUMNS, &self.spots)
     }
 
     /// spot_points.csv: every ray's image point, relative to its spot's centroid.
@@ -217,25 +449,7 @@ impl LensReport {
     /// The summary `heron lens` prints.
     pub fn summary(&self) -> String {
         let mut s = format!("{}\n", self.name);
-        let _ = writeln!(
-            s,
-            "{:>10} {:>10} {:>10} {:>7} {:>9} {:>9} {:>9} {:>9}",
-            "lambda_nm", "EFL", "BFL", "f/#", "EP_z", "EPD", "XP_z", "XPD"
-        );
-        for p in &self.first_order {
-            let _ = writeln!(
-                s,
-                "{:>10.4} {:>10.4} {:>10.4} {:>7.3} {:>9.4} {:>9.4} {:>9.4} {:>9.4}",
-                p.wavelength_nm,
-                p.efl,
-                p.bfl,
-                p.f_number,
-                p.entrance_pupil_z,
-                p.entrance_pupil_diameter,
-                p.exit_pupil_z,
-                p.exit_pupil_diameter
-            );
-        }
+        s.push_str(&summary_table(PARAXIAL_COLUMNS, &self.first_order));
         let shift = |l: f64| {
             self.focal_shift
                 .iter()
@@ -249,23 +463,7 @@ impl LensReport {
             shift(400.0),
             shift(700.0)
         );
-        let _ = writeln!(
-            s,
-            "{:>9} {:>10} {:>6} {:>12} {:>12} {:>11}",
-            "field_deg", "lambda_nm", "rays", "RMS_um", "geo_um", "vignetted"
-        );
-        for p in &self.spots {
-            let _ = writeln!(
-                s,
-                "{:>9.2} {:>10.4} {:>6} {:>12.3} {:>12.3} {:>10.1}%",
-                p.field_deg,
-                p.wavelength_nm,
-                p.rays,
-                1e3 * p.rms_radius,
-                1e3 * p.geo_radius,
-                100.0 * p.vignetted_fraction
-            );
-        }
+        s.push_str(&summary_table(SPOT_COLUMNS, &self.spots));
         s
     }
 
@@ -381,5 +579,34 @@ mod tests {
         // At 40° the beam through the stop reaches the lens's 6 mm rims.
         let far = spot(&sys, 40.0, D_LINE, 64);
         assert!(far.vignetted_fraction > 0.1, "{}", far.vignetted_fraction);
+    }
+    /// The checks `heron lens` and `heron.lens` share, and the reference override.
+    #[test]
+    fn analyse_checks_arguments_and_moves_the_reference() {
+        let path = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/lenses/singlet-bk7.toml"
+        ));
+        let sys = crate::scene::load::lens::read_prescription(path).unwrap();
+        let msg = |r: Result<LensReport>| r.unwrap_err().to_string();
+        assert!(msg(analyse(&sys, &[], 8, None)).contains("--fields: expected at least one"));
+        assert!(msg(analyse(&sys, &[0.0, 90.0], 8, None)).contains("got 90"));
+        assert!(msg(analyse(&sys, &[0.0], 1, None)).contains("--rays: expected at least 2"));
+        let e = msg(analyse(&sys, &[0.0], 8, Some(300.0)));
+        assert!(e.contains("--reference-wavelength: expected"), "{e}");
+        let r = analyse(&sys, &[0.0, 5.0], 8, Some(550.0)).unwrap();
+        assert_eq!(r.reference_wavelength, 550.0);
+        assert_eq!(
+            sys.reference_wavelength, D_LINE,
+            "the system itself is unchanged"
+        );
+        let at_550 = r.focal_shift.iter().find(|f| f.0 == 550.0).unwrap();
+        assert_eq!(at_550.2, 0.0);
+        assert_eq!(r.spots.len(), 6);
+        // The CSV headers are the columns' names; the summary shows the same rows.
+        let header = |t: String| t.lines().next().unwrap().to_string();
+        assert_eq!(header(r.paraxial_csv()), "wavelength_nm,efl_mm,bfl_mm,f_number,entrance_pupil_z_mm,entrance_pupil_diameter_mm,exit_pupil_z_mm,exit_pupil_diameter_mm");
+        assert_eq!(header(r.spots_csv()), "field_deg,wavelength_nm,rays,rms_radius_mm,geo_radius_mm,centroid_x_mm,centroid_y_mm,vignetted_fraction");
+        assert_eq!(r.summary().lines().count(), 1 + 4 + 1 + 7);
     }
 }

@@ -9,7 +9,10 @@
 //! - `trace`, `sky_profile`, `color`, `ior`: the cores of `heron trace`, `heron sky
 //!   profile`, `heron color` (in memory) and the scene files' `ior` values;
 //! - `compare`: `heron compare`'s test of two images (EXR paths, render results or
-//!   arrays), with the same verdict and statistics.
+//!   arrays), with the same verdict and statistics;
+//! - `lens`: `heron lens`'s report of a lens prescription (a file or a list of surface
+//!   dicts): first order at F, d, C, the chromatic focal shift and spot diagrams, with
+//!   the CSV files' numbers.
 //!
 //! Errors: every bad input raises `heron.HeronError`, a subclass of `ValueError`, with
 //! the CLI's one-line message; where the CLI names a flag (`--lanes`), the message names
@@ -21,6 +24,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 mod compare;
 mod convert;
+mod lens;
 mod scene;
 mod tools;
 
@@ -97,7 +101,7 @@ pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// spectral bins) equal bit for bit to the EXR `heron render` writes for the same
 /// settings. `trace`, `sky_profile`, `color` and `ior` are the CLI's `heron trace`,
 /// `heron sky profile`, `heron color` and the scene files' refractive indices;
-/// `compare` is `heron compare`.
+/// `compare` is `heron compare`, `lens` is `heron lens`.
 /// Bad input raises `HeronError` (a `ValueError`) with the CLI's one-line message.
 /// `heron.__version__`: the crate version with the git commit as a PEP 440 local version
 /// label (PEP 440, "Local version identifiers"): `0.1.0+g<40 hex>`, `.dirty` appended when
@@ -124,5 +128,6 @@ fn heron(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::color, m)?)?;
     m.add_function(wrap_pyfunction!(tools::ior, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(lens::lens, m)?)?;
     Ok(())
 }

@@ -125,7 +125,7 @@ def bits(a) -> np.ndarray:
 
 def test_module_is_documented_and_typed():
     assert issubclass(heron.HeronError, ValueError)
-    public = ["load_scene", "trace", "sky_profile", "color", "ior", "Scene", "RenderResult"]
+    public = ["load_scene", "trace", "sky_profile", "color", "ior", "lens", "Scene", "RenderResult"]
     for name in public:
         doc = getattr(heron, name).__doc__
         assert doc and len(doc) > 40, f"heron.{name} has no docstring"
