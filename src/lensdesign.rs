@@ -549,18 +549,11 @@ impl LensReport {
 mod tests {
     use super::*;
     use crate::camera::lens::Surface;
-    use crate::spectrum::ior::Ior;
 
     /// The grid is Optiland's "uniform" pupil: 3096 of 64² points in the disc.
     #[test]
     fn spot_grid_and_vignetting() {
-        let surf = |radius, thickness, n: f32, sa, stop| Surface {
-            radius,
-            thickness,
-            medium: Ior::Constant(n),
-            semi_aperture: sa,
-            stop,
-        };
+        let surf = Surface::constant;
         let sys = LensSystem::new(
             "singlet",
             vec![
