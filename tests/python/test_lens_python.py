@@ -22,6 +22,8 @@ equal exactly, not within a tolerance:
   EFL by the thickness term only; the entrance pupil is the stop (it is in air, in front
   of the lens) and f-number = EFL / EPD; the focal-shift curve is BFL(λ) − BFL(d) from
   the same formula at each of its 61 wavelengths.
+- A lens scene (scenes/singlet-chromatic.toml) rendered by `Scene.render` has the
+  pixels `heron render` writes for the same spp and seed.
 - Bad input raises heron.HeronError (a ValueError), never a panic, with a one-line
   message naming the file or argument: the CLI's message with the flag renamed where
   the CLI has the same mistake, and "prescription: surface N" for a list.
@@ -314,3 +316,26 @@ def test_documented_and_typed():
     for name in ("def lens(", "class LensReport(", "class LensSpot(", "class LensParaxial(",
                  "class LensFocalShift("):
         assert name in stub, f"{name} missing in the stub"
+
+
+def test_lens_scene_renders_from_python_as_from_the_cli(tmp_path):
+    """The issue's "the scenes render from the CLI and Python": a lens scene rendered by
+    `Scene.render` has the pixels of `heron render` with the same spp and seed (both
+    run the same renderer; the image does not depend on the thread count), and the
+    lights in view are bright where the lens images them."""
+    import OpenEXR
+
+    scene = REPO / "scenes" / "singlet-chromatic.toml"
+    out = tmp_path / "s.exr"
+    p = subprocess.run([str(require_heron_bin()), "render", str(scene), "-o", str(out),
+                        "--spp", "2", "--seed", "7", "--no-png", "--quiet"],
+                       capture_output=True, text=True, cwd=REPO, timeout=300)
+    assert p.returncode == 0, p.stderr
+    with OpenEXR.File(str(out), separate_channels=True) as f:
+        ch = f.channels()
+        cli = np.stack([np.asarray(ch[c].pixels, dtype=np.float32) for c in "RGB"], -1)
+    py = heron.load_scene(scene).render(spp=2, seed=7, threads=1).rgb
+    assert py.shape == cli.shape == (240, 480, 3)
+    np.testing.assert_array_equal(py, cli)
+    # The light in focus sits at the film's centre.
+    assert py[110:130, 230:250].max() > 100 * max(py[:20, :20].max(), 1e-6)
