@@ -39,29 +39,14 @@ import tempfile
 import time
 import tomllib
 
-import numpy as np
+from exr_error import read_xyz, rel_rmse
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 HERON = REPO / "target" / "release" / "heron"
-XYZ_TO_SRGB = np.array([[3.2404542, -1.5371385, -0.4985314],
-                        [-0.9692660, 1.8760108, 0.0415560],
-                        [0.0556434, -0.2040259, 1.0572252]])
 SUMMARY = re.compile(r" in ([0-9.]+) s: ([0-9]+) rays")
 LENS_KEYS = ("type", "lens", "surface", "film_diagonal", "film_distance", "focus_distance",
              "focus_wavelength", "mm_per_unit", "f_number", "pupil")
 
-
-def read_xyz(path):
-    import OpenEXR
-
-    with OpenEXR.File(str(path), separate_channels=True) as f:
-        ch = f.channels()
-        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "XYZ"], -1)
-
-
-def rel_rmse(a, r):
-    a, r = a @ XYZ_TO_SRGB.T, r @ XYZ_TO_SRGB.T
-    return float(np.sqrt(((a - r) ** 2).sum() / (r ** 2).sum()))
 
 
 def render(exe, scene, spp, seed, threads, out):

@@ -49,22 +49,7 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests" / "python"))
 from mitsuba_scene import heron_spectra, mitsuba_dict, xyz_normalisation  # noqa: E402
 
-XYZ_TO_SRGB = np.array([[3.2404542, -1.5371385, -0.4985314],
-                        [-0.9692660, 1.8760108, 0.0415560],
-                        [0.0556434, -0.2040259, 1.0572252]])
-
-
-def read_xyz(path):
-    import OpenEXR
-
-    with OpenEXR.File(str(path), separate_channels=True) as f:
-        ch = f.channels()
-        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "XYZ"], -1)
-
-
-def rel_rmse(xyz, ref_xyz):
-    a, r = xyz @ XYZ_TO_SRGB.T, ref_xyz @ XYZ_TO_SRGB.T
-    return float(np.sqrt(((a - r) ** 2).sum() / (r ** 2).sum()))
+from exr_error import read_xyz, rel_rmse  # noqa: E402
 
 
 class Heron:

@@ -43,15 +43,10 @@ import numpy as np
 import pytest
 
 from heronrun import REPO, require_heron_bin
+# The CSV columns of the spec (lensref.py, the Optiland reference, defines them).
+from lensref import FDC, FOCAL_SHIFT_COLUMNS, PARAXIAL_COLUMNS, SPOT_COLUMNS
 
 LENSES = REPO / "lenses"
-PARAXIAL_COLUMNS = ("wavelength_nm", "efl_mm", "bfl_mm", "f_number", "entrance_pupil_z_mm",
-                    "entrance_pupil_diameter_mm", "exit_pupil_z_mm",
-                    "exit_pupil_diameter_mm")
-FOCAL_SHIFT_COLUMNS = ("wavelength_nm", "bfl_mm", "focal_shift_mm")
-SPOT_COLUMNS = ("field_deg", "wavelength_nm", "rays", "rms_radius_mm", "geo_radius_mm",
-                "centroid_x_mm", "centroid_y_mm", "vignetted_fraction")
-FDC = (486.1327, 587.5618, 656.2725)
 
 
 def run_cli(*args, check=True) -> subprocess.CompletedProcess:
