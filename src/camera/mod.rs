@@ -148,10 +148,13 @@ impl Camera {
         };
         let (fw, fh) = lens.film_size(self.width, self.height);
         // The lens turns the image upside down and left to right: the film point of
-        // the image's top-left corner is the film's bottom-right.
+        // the image's top-left corner is the film's bottom-right. The film's centre is
+        // at −film_offset for the same reason (the offset is in the image's
+        // orientation); adding (−0, −0) changes no bit of the centred film's points.
+        let (cx, cy) = lens.film_centre();
         let film = (
-            -(x as f64 / self.width as f64 - 0.5) * fw,
-            -(0.5 - y as f64 / self.height as f64) * fh,
+            -(x as f64 / self.width as f64 - 0.5) * fw + cx,
+            -(0.5 - y as f64 / self.height as f64) * fh + cy,
         );
         let u = u();
         let s = lens.sample(film, (u.x as f64, u.y as f64), lambda_nm as f64)?;

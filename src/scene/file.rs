@@ -4,7 +4,7 @@
 //! and lights are internally tagged by their `type` key. Every struct denies unknown
 //! keys, so a misspelt key is an error rather than a silently ignored default.
 //!
-//! The leaf types of this module ([`Point3`], [`Direction3`], [`PositiveNumber`],
+//! The leaf types of this module ([`Point2`], [`Point3`], [`Direction3`], [`PositiveNumber`],
 //! [`UnitNumber`], [`PositiveCount`], [`Resolution`], [`Reflectance`], [`Emission`])
 //! check their own range while they are deserialized, so that an out-of-range number is
 //! reported with the key path serde is at, in the words "expected …, got …". Checks that
@@ -157,6 +157,10 @@ pub struct CameraFile {
     /// Exit-pupil sampling: "bounds" (default) or "rear-element".
     #[serde(default)]
     pub pupil: Option<String>,
+    /// Where the film's centre sits in the image plane (mm from the optical axis, +x
+    /// toward the image's right, +y toward its top); default [0, 0].
+    #[serde(default)]
+    pub film_offset: Option<Point2>,
 }
 
 /// `[render]`: every key optional, defaults from `RenderSettings::default()`.
@@ -589,6 +593,10 @@ pub enum IorSpec {
     Abbe { n_d: f32, v_d: f32 },
 }
 
+/// `[x, y]`, two numbers finite in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point2(pub [f32; 2]);
+
 /// `[x, y, z]`, three numbers finite in f32.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point3(pub Vec3);
@@ -823,6 +831,24 @@ fn vec3(v: &toml::Value) -> Option<Vec3> {
 
 fn raw<'de, D: Deserializer<'de>>(d: D) -> Result<toml::Value, D::Error> {
     toml::Value::deserialize(d)
+}
+
+impl<'de> Deserialize<'de> for Point2 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let xy = match &v {
+            toml::Value::Array(a) if a.len() == 2 => {
+                finite_f32(&a[0]).and_then(|x| Some([x, finite_f32(&a[1])?]))
+            }
+            _ => None,
+        };
+        xy.map(Point2).ok_or_else(|| {
+            D::Error::custom(format!(
+                "expected [x, y] with two finite numbers, got {}",
+                show(&v)
+            ))
+        })
+    }
 }
 
 impl<'de> Deserialize<'de> for Point3 {

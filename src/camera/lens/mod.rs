@@ -8,12 +8,21 @@
 //! centre is the camera's `eye` and +z of the lens is the camera's backward direction;
 //! `mm_per_unit` scales the lens to scene units (1000: the scene is in metres).
 //!
+//! **Film window.** The film's centre is on the optical axis, or `film_offset` away from
+//! it in the image plane (a small detector anywhere in the field: with a small
+//! `film_diagonal`, it resolves an off-axis spot without rendering the whole frame).
+//! The offset is given in the orientation of the output image (+x toward its right, +y
+//! toward its top); the lens inverts the image, so in the lens's frame the window's
+//! centre is at −offset ([`crate::camera::Camera::ray`]).
+//!
 //! **Measurement.** A pixel's value is the film irradiance over it,
 //! E(x) = ∫ L cos⁴θ / z² dA over the plane of the rear vertex (z the film's distance from
 //! that plane; pbrt-v4 eq. 5.3), divided by E₀, the irradiance a uniform radiance of 1
-//! gives at the film's centre at the focus wavelength. So a uniformly bright scene has
-//! the value 1 at the image's centre, as with the pinhole camera, and the fall-off
-//! toward the corners (cos⁴, vignetting by the rims) is the lens's own.
+//! gives on the optical axis (the film's centre, without an offset) at the focus
+//! wavelength. So a uniformly bright scene has the value 1 at the image's centre, as with
+//! the pinhole camera, and the fall-off toward the corners (cos⁴, vignetting by the rims)
+//! is the lens's own; a window off the axis keeps the same E₀, so its values compare with
+//! the full frame's and with other windows'.
 //!
 //! **Sampling.** A film point's rays are aimed at points drawn uniformly in a
 //! rectangle of the rear plane that holds every ray that gets through (the exit
@@ -83,6 +92,9 @@ pub struct LensSettings {
     pub pupil: PupilSampling,
     /// Millimetres per scene unit (1000: the scene is in metres).
     pub mm_per_unit: f64,
+    /// Where the film's centre is in the image plane (mm from the optical axis), in the
+    /// output image's orientation: +x toward the image's right, +y toward its top.
+    pub film_offset: (f64, f64),
 }
 
 /// Radial rings of film radius with their own exit-pupil bounds.
@@ -111,7 +123,8 @@ pub struct LensCamera {
     /// Per ring: the bounds [x0, x1, y0, y1] on the rear plane (mm) for a film point on
     /// the +x axis.
     bounds: Vec<[f64; 4]>,
-    /// Half the film diagonal (mm).
+    /// The largest distance of a film point from the axis (mm): |film_offset| + half the
+    /// film diagonal. The rings cover radii 0 to r_max.
     r_max: f64,
     inv_e0: f64,
     hero_only: bool,
@@ -132,6 +145,12 @@ impl LensCamera {
             return Err(format!(
                 "film_diagonal: expected a length > 0 mm, got {}",
                 settings.film_diagonal
+            ));
+        }
+        let (ox, oy) = settings.film_offset;
+        if !(ox.is_finite() && oy.is_finite()) {
+            return Err(format!(
+                "film_offset: expected [x, y] with two finite numbers (mm), got [{ox}, {oy}]"
             ));
         }
         if !(settings.mm_per_unit.is_finite() && settings.mm_per_unit > 0.0) {
@@ -160,7 +179,7 @@ impl LensCamera {
             film_distance,
             settings,
             bounds: Vec::new(),
-            r_max: 0.5 * settings.film_diagonal,
+            r_max: ox.hypot(oy) + 0.5 * settings.film_diagonal,
             inv_e0: 1.0,
             hero_only: false,
         };
@@ -193,6 +212,14 @@ impl LensCamera {
     #[inline]
     pub fn hero_only(&self) -> bool {
         self.hero_only
+    }
+
+    /// Where the film's centre is in the lens's frame (mm): −film_offset, since the lens
+    /// inverts the image and the offset is given in the output image's orientation.
+    #[inline]
+    pub fn film_centre(&self) -> (f64, f64) {
+        let (ox, oy) = self.settings.film_offset;
+        (-ox, -oy)
     }
 
     /// The film's width and height (mm) for an image of `w` × `h` pixels.
@@ -375,6 +402,7 @@ mod tests {
             focus_wavelength: 587.56,
             pupil: PupilSampling::Bounds,
             mm_per_unit: 1000.0,
+            film_offset: (0.0, 0.0),
         }
     }
 
@@ -412,5 +440,27 @@ mod tests {
         }
         let mean = s / (n * n) as f64;
         assert!((mean - 1.0).abs() < 0.01, "{mean}");
+    }
+
+    /// A film window off the axis: the rings reach its far corner (|offset| + half the
+    /// diagonal), and the exposure is still normalised by the on-axis irradiance E₀
+    /// (found on ring 0's bounds, which now span a wider ring of radii, so E₀ moves by
+    /// the quadrature's error only); non-finite offsets are refused, naming the key.
+    #[test]
+    fn an_offset_window_keeps_e0_and_widens_the_rings() {
+        let centred = LensCamera::new(singlet(4.0), settings(Focus::Prescription)).unwrap();
+        let mut s = settings(Focus::Prescription);
+        s.film_diagonal = 2.0;
+        s.film_offset = (3.0, -4.0);
+        let off = LensCamera::new(singlet(4.0), s).unwrap();
+        assert_eq!(off.r_max, 6.0);
+        assert_eq!(off.film_centre(), (-3.0, 4.0));
+        let ratio = off.inv_e0 / centred.inv_e0;
+        assert!((ratio - 1.0).abs() < 2e-3, "{ratio}");
+        for bad in [(f64::NAN, 0.0), (0.0, f64::INFINITY)] {
+            s.film_offset = bad;
+            let e = LensCamera::new(singlet(4.0), s).unwrap_err();
+            assert!(e.starts_with("film_offset: expected [x, y]"), "{e}");
+        }
     }
 }

@@ -36,6 +36,7 @@ pub(super) fn build_camera(
                 ("mm_per_unit", c.mm_per_unit.is_some()),
                 ("f_number", c.f_number.is_some()),
                 ("pupil", c.pupil.is_some()),
+                ("film_offset", c.film_offset.is_some()),
             ];
             if let Some((k, _)) = lens_keys.iter().find(|(_, set)| *set) {
                 return Err(format!(
@@ -154,6 +155,9 @@ fn build_lens(
         focus_wavelength,
         pupil,
         mm_per_unit,
+        film_offset: c
+            .film_offset
+            .map_or((0.0, 0.0), |p| (p.0[0] as f64, p.0[1] as f64)),
     };
     LensCamera::new(system, settings).map_err(|e| format!("camera.{e}"))
 }
