@@ -16,7 +16,7 @@
 #
 # Every EXR records the commit heron was built from (heron.commit), so both sides are
 # built with HERON_BUILD_COMMIT=same-images (build.rs), the working tree's in
-# target/same-images/target too, not in target/release. (A BASE older than that attribute
+# target/same-images/target-worktree, not in target/release. (A BASE older than that attribute
 # differs in its header.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -67,8 +67,11 @@ if [ ! -e "$base_dir/complete" ]; then
   touch "$base_dir/complete"
 fi
 
-build "$PWD" "$root/target"
-cp "$root/target/release/heron" "$root/heron-worktree"
+# Not the base's target dir: cargo keys a package's build by its path relative to the
+# workspace, so the working tree's sources (older files than the base's fresh checkout)
+# would look up to date there and the base's binary would be compared with itself.
+build "$PWD" "$root/target-worktree"
+cp "$root/target-worktree/release/heron" "$root/heron-worktree"
 new_dir="$root/renders-worktree"
 rm -rf "$new_dir"
 render_all "$root/heron-worktree" "$new_dir" "${NEW_ARGS:-}"
