@@ -352,9 +352,9 @@ const BAD: &[(&str, &str, &[&str])] = &[
      &["shapes[0].material: expected a string, got 7"]),
     // Tags
     ("", "[[shapes]]\ntype = \"spher\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\n",
-     &["shapes[0].type: unknown variant \"spher\", expected one of sphere, triangle, plane, quad, mesh"]),
+     &["shapes[0].type: unknown variant \"spher\", expected one of sphere, triangle, plane, quad, mesh, waves"]),
     ("", "[[shapes]]\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\n",
-     &["shapes[0].type: missing required key (expected one of sphere, triangle, plane, quad, mesh)"]),
+     &["shapes[0].type: missing required key (expected one of sphere, triangle, plane, quad, mesh, waves)"]),
     ("", "[[shapes]]\ntype = 3\n", &["shapes[0].type: expected", "sphere", "got 3"]),
     ("", "[materials.x]\ntype = \"glas\"\n",
      &["materials.x.type: unknown variant \"glas\", expected one of lambertian, mirror, dielectric, glossy, conductor"]),
@@ -519,6 +519,16 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[materials]\nx = [\"lambertian\", 0.5]\n", &["materials.x: expected a table, got [\"lambertian\", 0.5]"]),
     ("lights = [1]\n", "", &["lights[0]: expected a table, got 1"]),
     ("background = \"blue\"\n", "", &["background: expected a colour"]),
+    ("", "[[shapes]]\ntype = \"waves\"\norigin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, -1]\nmaterial = \"floor\"\nwaves = [{ amplitude = -0.1, wavelength = 0.5, direction = [1, 0] }]\n",
+     &["shapes[0].waves[0].amplitude: expected a finite height >= 0, got -0.1"]),
+    ("", "[[shapes]]\ntype = \"waves\"\norigin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, -1]\nmaterial = \"floor\"\nwaves = [{ amplitude = 0.1, wavelength = 0.5, direction = [0, 0] }]\n",
+     &["shapes[0].waves[0].direction: expected a non-zero direction [along edge1, along edge2], got [0, 0]"]),
+    ("", "[[shapes]]\ntype = \"waves\"\norigin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, -1]\nmaterial = \"floor\"\nwaves = [{ amplitude = 0.1, wavelength = 0, direction = [1, 0] }]\n",
+     &["shapes[0].waves[0].wavelength"]),
+    ("", "[[shapes]]\ntype = \"waves\"\norigin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, -1]\nmaterial = \"floor\"\nresolution = [8192, 8192]\n",
+     &["shapes[0].resolution: expected at most 16777216 cells (2 triangles each), got [8192, 8192]"]),
+    ("", "[[shapes]]\ntype = \"waves\"\norigin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, -1]\nmaterial = \"floor\"\nwaves = [{ amplitude = 0.1, wavelength = 0.5, direction = [1, 0], speed = 2 }]\n",
+     &["unknown key \"speed\""]),
 ];
 
 #[test]
@@ -1298,5 +1308,58 @@ fn ior_table_errors_name_the_file_and_the_line() {
     for (csv, wants) in cases {
         dir.write("bad.csv", csv);
         ior_errors(&dir, "{ table = \"bad.csv\" }", wants);
+    }
+}
+
+/// A `waves` surface is its quad's grid moved along edge1 × edge2 by the sum of its sine
+/// waves: every vertex at its height, two triangles per cell, each facing the normal's
+/// side.
+#[test]
+fn waves_are_the_quad_grid_displaced_by_the_sum_of_sines() {
+    let scene = load_scene_from_str(
+        r#"
+[camera]
+eye = [0, 3, 0.1]
+look_at = [0, 0, 0]
+resolution = [4, 4]
+[materials.water]
+type = "dielectric"
+ior = "water"
+[[shapes]]
+type = "waves"
+origin = [-1.0, 0.5, 1.0]
+edge1 = [2.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -2.0]
+resolution = [20, 10]
+material = "water"
+waves = [
+  { amplitude = 0.05, wavelength = 0.7, direction = [1.0, 0.0], phase = 30.0 },
+  { amplitude = 0.02, wavelength = 0.3, direction = [0.0, 2.0] },
+]
+"#,
+        std::path::Path::new("w.toml"),
+    )
+    .unwrap();
+    let ShapeKind::Mesh(m) = &scene.shapes[0].kind else {
+        panic!("waves make a mesh")
+    };
+    assert_eq!((m.positions.len(), m.indices.len()), (21 * 11, 2 * 20 * 10));
+    let tau = std::f64::consts::TAU;
+    for (k, p) in m.positions.iter().enumerate() {
+        let (i, j) = ((k % 21) as f64, (k / 21) as f64);
+        // Along edge1 (x) from −1, along edge2 (−z) from 1.
+        let (u, v) = (2.0 * i / 20.0, 2.0 * j / 10.0);
+        assert!((p.x as f64 - (u - 1.0)).abs() < 1e-6 && (p.z as f64 - (1.0 - v)).abs() < 1e-6);
+        let h = 0.05 * (tau * u / 0.7 + 30f64.to_radians()).sin() + 0.02 * (tau * v / 0.3).sin();
+        assert!(
+            (p.y as f64 - 0.5 - h).abs() < 1e-6,
+            "vertex {k}: {} vs {}",
+            p.y,
+            0.5 + h
+        );
+    }
+    for t in &m.indices {
+        let [a, b, c] = t.map(|i| m.positions[i as usize]);
+        assert!((b - a).cross(c - a).y > 0.0, "a triangle faces down");
     }
 }

@@ -288,12 +288,14 @@ pub enum ShapeFile {
     Plane(PlaneFile),
     Quad(QuadFile),
     Mesh(MeshFile),
+    Waves(WavesFile),
 }
 
 impl ShapeFile {
     /// The `type` values, in declaration order (serde's `rename_all = "lowercase"` of the
     /// variants; `tests::names_are_the_serde_tags` holds them to it).
-    pub const NAMES: &'static [&'static str] = &["sphere", "triangle", "plane", "quad", "mesh"];
+    pub const NAMES: &'static [&'static str] =
+        &["sphere", "triangle", "plane", "quad", "mesh", "waves"];
 
     /// The entry's material name, emission and two-sidedness.
     pub fn emission(&self) -> (Option<&String>, Option<&Emission>, Option<bool>) {
@@ -303,6 +305,7 @@ impl ShapeFile {
             ShapeFile::Plane(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
             ShapeFile::Quad(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
             ShapeFile::Mesh(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+            ShapeFile::Waves(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
         }
     }
 
@@ -314,6 +317,7 @@ impl ShapeFile {
             ShapeFile::Plane(x) => x.medium.as_ref(),
             ShapeFile::Quad(x) => x.medium.as_ref(),
             ShapeFile::Mesh(x) => x.medium.as_ref(),
+            ShapeFile::Waves(x) => x.medium.as_ref(),
         }
     }
 
@@ -325,6 +329,7 @@ impl ShapeFile {
             ShapeFile::Plane(_) => 2,
             ShapeFile::Quad(_) => 3,
             ShapeFile::Mesh(_) => 4,
+            ShapeFile::Waves(_) => 5,
         };
         Self::NAMES[i]
     }
@@ -402,6 +407,49 @@ pub struct QuadFile {
     /// A participating medium inside the shape (closed shapes only).
     #[serde(default)]
     pub medium: Option<MediumFile>,
+}
+
+/// A water surface: the quad `origin`, `edge1`, `edge2` cut into `resolution` cells of
+/// two triangles each, its vertices moved along the quad's normal (edge1 × edge2) by
+/// h = Σ aᵢ sin(2π (dᵢ · x)/λᵢ + φᵢ), x the vertex's position in the quad's plane (along
+/// edge1 and edge2, from the origin) and dᵢ a unit direction in that plane (a sum of
+/// sine waves, the simplest ocean of Tessendorf 2001's §3).
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WavesFile {
+    pub origin: Point3,
+    pub edge1: Direction3,
+    pub edge2: Direction3,
+    /// Cells along edge1 and edge2 (default [128, 128]).
+    #[serde(default)]
+    pub resolution: Option<[PositiveCount; 2]>,
+    #[serde(default)]
+    pub waves: Vec<WaveFile>,
+    #[serde(default)]
+    pub material: Option<String>,
+    #[serde(default)]
+    pub emission: Option<Emission>,
+    #[serde(default)]
+    pub two_sided: Option<bool>,
+    /// A participating medium inside the shape (closed shapes only, which a sheet of
+    /// waves is not: given here so that the error says so).
+    #[serde(default)]
+    pub medium: Option<MediumFile>,
+}
+
+/// One sine wave of a `waves` surface.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaveFile {
+    /// Height of the crest above the mean surface, in scene units (≥ 0).
+    pub amplitude: f32,
+    /// Crest-to-crest distance, in scene units.
+    pub wavelength: PositiveNumber,
+    /// The direction of travel in the quad's plane: [along edge1, along edge2].
+    pub direction: Point2,
+    /// Phase at the origin, in degrees (default 0).
+    #[serde(default)]
+    pub phase: f32,
 }
 
 /// A Wavefront OBJ triangle mesh.
@@ -1240,13 +1288,17 @@ mod tests {
                 "origin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 1, 0]",
             ),
             ("mesh", "file = \"m.obj\""),
+            (
+                "waves",
+                "origin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, 1]",
+            ),
         ] {
             let v: toml::Value = toml::from_str(&format!("type = \"{name}\"\n{keys}")).unwrap();
             assert_eq!(ShapeFile::deserialize(v).unwrap().name(), name);
         }
         assert_eq!(
             ShapeFile::NAMES.len(),
-            5,
+            6,
             "a new shape type needs a line above"
         );
         for (i, n) in MediumType::NAMES.iter().enumerate() {

@@ -7,7 +7,7 @@ use crate::error::HeronError;
 use crate::scene::file::{
     show, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile,
     LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, ShapeFile,
-    SphereFile, SpotLightFile, SunLightFile, TriangleFile,
+    SphereFile, SpotLightFile, SunLightFile, TriangleFile, WavesFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -191,6 +191,7 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("shapes", "plane") => check::<PlaneFile>(t),
         ("shapes", "quad") => check::<QuadFile>(t),
         ("shapes", "mesh") => check::<MeshFile>(t),
+        ("shapes", "waves") => check::<WavesFile>(t),
         ("lights", "point") => check::<PointLightFile>(t),
         ("lights", "directional") => check::<DirectionalLightFile>(t),
         ("lights", "sun") => check::<SunLightFile>(t),

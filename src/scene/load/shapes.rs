@@ -8,7 +8,7 @@ use super::obj;
 use crate::error::Result;
 use crate::geometry::{Mesh, Shape, ShapeKind, MIN_RELATIVE_RADIUS};
 use crate::scene::file::{
-    fmt_f32, MeshFile, PlaneFile, QuadFile, ShapeFile, SphereFile, TriangleFile,
+    fmt_f32, MeshFile, PlaneFile, QuadFile, ShapeFile, SphereFile, TriangleFile, WavesFile,
 };
 use glam::Vec3;
 use std::collections::{BTreeMap, HashMap};
@@ -65,6 +65,10 @@ pub(super) fn build_shapes(
             ShapeFile::Quad(q) => {
                 let material = resolve(&at, s)?;
                 shapes.push(Shape::new(quad(&at, q).map_err(err)?, material));
+            }
+            ShapeFile::Waves(wv) => {
+                let material = resolve(&at, s)?;
+                shapes.push(Shape::new(waves(&at, wv).map_err(err)?, material));
             }
             ShapeFile::Mesh(m) => {
                 if m.two_sided.is_some() && m.emission.is_none() {
@@ -170,6 +174,95 @@ fn quad(at: &str, q: &QuadFile) -> std::result::Result<ShapeKind, String> {
         ));
     }
     Ok(mesh(v, vec![[0, 1, 2], [0, 2, 3]]))
+}
+
+/// The most triangles a `waves` entry may make (2 per cell).
+const MAX_WAVE_TRIANGLES: u64 = 1 << 25;
+
+/// A `waves` entry at key path `at`: the quad's grid of cells, displaced along its normal
+/// by the sum of the entry's sine waves (`WavesFile`).
+fn waves(at: &str, w: &WavesFile) -> std::result::Result<ShapeKind, String> {
+    let (o, e1, e2) = (w.origin.0, w.edge1.0, w.edge2.0);
+    let [nu, nv] = w.resolution.map_or([128, 128], |r| [r[0].0, r[1].0]);
+    if nu as u64 * nv as u64 * 2 > MAX_WAVE_TRIANGLES {
+        return Err(format!(
+            "{at}.resolution: expected at most {} cells (2 triangles each), got [{nu}, {nv}]",
+            MAX_WAVE_TRIANGLES / 2
+        ));
+    }
+    // The quad's own checks (finite corners, a non-zero area).
+    quad(
+        at,
+        &QuadFile {
+            origin: w.origin,
+            edge1: w.edge1,
+            edge2: w.edge2,
+            material: None,
+            emission: None,
+            two_sided: None,
+            medium: None,
+        },
+    )?;
+    let (u1, u2) = (w.edge1.unit(), w.edge2.unit());
+    let normal = e1.cross(e2);
+    let normal = (normal / normal.abs().max_element()).normalize();
+    let mut terms = Vec::with_capacity(w.waves.len());
+    for (i, wave) in w.waves.iter().enumerate() {
+        let wat = format!("{at}.waves[{i}]");
+        if !(wave.amplitude >= 0.0 && wave.amplitude.is_finite()) {
+            return Err(format!(
+                "{wat}.amplitude: expected a finite height >= 0, got {}",
+                fmt_f32(wave.amplitude)
+            ));
+        }
+        if !wave.phase.is_finite() {
+            return Err(format!("{wat}.phase: expected a finite angle in degrees"));
+        }
+        let [a, b] = wave.direction.0;
+        let d = a * u1 + b * u2;
+        if !(d.length() > 0.0) || !d.is_finite() {
+            return Err(format!(
+                "{wat}.direction: expected a non-zero direction [along edge1, along edge2], got [{}, {}]",
+                fmt_f32(a),
+                fmt_f32(b)
+            ));
+        }
+        let k = std::f64::consts::TAU / wave.wavelength.0 as f64;
+        let d = d.normalize().as_dvec3() * k;
+        terms.push((wave.amplitude as f64, d, (wave.phase as f64).to_radians()));
+    }
+    let height = |x: glam::DVec3| -> f64 {
+        terms
+            .iter()
+            .map(|(a, d, phi)| a * (d.dot(x) + phi).sin())
+            .sum()
+    };
+    let mut positions = Vec::with_capacity((nu as usize + 1) * (nv as usize + 1));
+    for j in 0..=nv {
+        for i in 0..=nu {
+            let x = e1.as_dvec3() * (i as f64 / nu as f64) + e2.as_dvec3() * (j as f64 / nv as f64);
+            let p = o.as_dvec3() + x + normal.as_dvec3() * height(x);
+            positions.push(p.as_vec3());
+        }
+    }
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(format!(
+            "{at}: expected a surface with finite vertices, got waves overflowing f32"
+        ));
+    }
+    let row = nu + 1;
+    let mut indices = Vec::with_capacity(2 * nu as usize * nv as usize);
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = j * row + i;
+            let (b, c, d) = (a + 1, a + row + 1, a + row);
+            // The quad's winding (origin, +edge1, +edge1 + edge2, +edge2), so the
+            // normal is edge1 × edge2's side.
+            indices.push([a, b, c]);
+            indices.push([a, c, d]);
+        }
+    }
+    Ok(mesh(positions, indices))
 }
 
 /// Checks that the bounding sphere of `shapes` (the lights at infinity start their paths
