@@ -65,7 +65,7 @@ class Scene:
         spp: Optional[int] = None,
         seed: Optional[int] = None,
         lanes: Literal[1, 4, 8] = 8,
-        integrator: Optional[Literal["whitted", "path", "lighttrace", "bdpt"]] = None,
+        integrator: Optional[Literal["whitted", "path", "lighttrace", "bdpt", "sppm"]] = None,
         wavelengths: Literal["visible", "uniform"] = "visible",
         threads: int = 0,
         spectral_bins: int = 0,
@@ -76,6 +76,9 @@ class Scene:
         packets: Optional[Literal["auto", "paths", "camera", "off"]] = None,
         medium_nee: Optional[Literal["forced", "collision"]] = None,
         sun_guide: Optional[float] = None,
+        sppm_photons: Optional[int] = None,
+        sppm_alpha: Optional[float] = None,
+        sppm_radius: Optional[float] = None,
     ) -> "RenderResult":
         """Renders the scene with ``heron render``'s options and defaults.
 
@@ -85,7 +88,10 @@ class Scene:
         (``heron render --variance``, at least 2 spp); packets chooses how rays go to
         Embree (``--packets``); medium_nee ("forced" or "collision") and sun_guide (a
         fraction in [0, 1)) choose the path tracer's estimators in media
-        (``--medium-nee``, ``--sun-guide``). The GIL is released while
+        (``--medium-nee``, ``--sun-guide``); integrator "sppm" is stochastic
+        progressive photon mapping (spp: its iterations) with sppm_photons,
+        sppm_alpha and sppm_radius (``--sppm-photons``, ``--sppm-alpha``,
+        ``--sppm-radius``). The GIL is released while
         rendering; Ctrl-C stops the render within a row of a tile and raises
         KeyboardInterrupt.
         """

@@ -22,7 +22,9 @@
 //! `variance`, then the two lengths (u64) of the arrays of squares and the arrays:
 //! the sums of squares of the samples' linear sRGB (3 × 24 bytes per pixel, 192-bit
 //! integers, `film::fixed::SquareSum`) and of the splats' (the same per pixel for a
-//! splatting integrator, else empty).
+//! splatting integrator, else empty); with `sppm: true` in the header (photon
+//! mapping's checkpoints), then the pixel count (u64) and per pixel the photon count N,
+//! then per pixel the squared radius R² (f32 each), from which a resumed render goes on.
 //!
 //! Variance (`Checkpoint::film`): a pixel's value is the mean of its n finite samples,
 //! so its variance is estimated from their sums S₁ = Σ c and S₂ = Σ c² as
@@ -37,6 +39,7 @@
 //! checkpoints or shards.
 use crate::film::fixed::{to_f64, SquareSum};
 use crate::film::{linear_srgb_f64, Film, SpectralBins};
+use crate::integrator::sppm::SppmPixels;
 use crate::{HeronError, Result};
 use std::path::Path;
 
@@ -111,6 +114,10 @@ pub struct Checkpoint {
     /// Per pixel, Σ sⱼ² of the samples' splats into it (empty without `variance` or
     /// when the integrator does not splat).
     pub splat_sq: Vec<[SquareSum; 3]>,
+    /// Photon mapping's per-pixel state (photon count N and squared radius R²), which a
+    /// resumed `sppm` render continues from; None for the other integrators, and for
+    /// a merged film (whose shards were independent chains: see `render.rs`).
+    pub sppm: Option<SppmPixels>,
 }
 
 fn err(path: &Path, message: impl Into<String>) -> HeronError {
@@ -135,6 +142,9 @@ impl Checkpoint {
         });
         if self.variance {
             header["variance"] = true.into();
+        }
+        if self.sppm.is_some() {
+            header["sppm"] = true.into();
         }
         b.extend_from_slice(header.to_string().as_bytes());
         b.push(b'\n');
@@ -167,6 +177,12 @@ impl Checkpoint {
             }
             for q in self.sum_sq.iter().chain(&self.splat_sq).flatten() {
                 b.extend_from_slice(&q.to_le_bytes());
+            }
+        }
+        if let Some(s) = &self.sppm {
+            b.extend_from_slice(&(s.n.len() as u64).to_le_bytes());
+            for v in s.n.iter().chain(&s.r2) {
+                b.extend_from_slice(&v.to_le_bytes());
             }
         }
         b
@@ -233,10 +249,11 @@ impl Checkpoint {
         };
         let (width, height) = (u32_of("width")?, u32_of("height")?);
         let (any_splat, xyz_channels) = (bool_of("anySplat")?, bool_of("xyzChannels")?);
-        let variance = match header.get("variance") {
-            None => false,
-            Some(v) => v.as_bool().ok_or_else(|| bad("variance"))?,
+        let flag = |k: &str| match header.get(k) {
+            None => Ok(false),
+            Some(v) => v.as_bool().ok_or_else(|| bad(k)),
         };
+        let (variance, has_sppm) = (flag("variance")?, flag("sppm")?);
         let mut r = Reader { b: &rest[nl + 1..] };
         let passes_done = r.u32()?;
         let spp_done = r.u32()?;
@@ -277,6 +294,24 @@ impl Checkpoint {
             sum_sq = squares(n_sq)?;
             splat_sq = squares(n_splat_sq)?;
         }
+        let sppm = if has_sppm {
+            let n = r.len()?;
+            if n != n_xyz {
+                return Err(format!(
+                    "its photon-mapping state does not fit its {width}x{height} image"
+                ));
+            }
+            let mut floats = || {
+                (0..n)
+                    .map(|_| r.f32())
+                    .collect::<std::result::Result<Vec<_>, _>>()
+            };
+            let counts = floats()?;
+            let r2 = floats()?;
+            Some(SppmPixels { n: counts, r2 })
+        } else {
+            None
+        };
         if !r.b.is_empty() {
             return Err(format!("{} bytes after the data", r.b.len()));
         }
@@ -300,6 +335,7 @@ impl Checkpoint {
             variance,
             sum_sq,
             splat_sq,
+            sppm,
         })
     }
 
@@ -580,6 +616,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
         good: vec![0; first.good.len()],
         sum_sq: vec![Default::default(); first.sum_sq.len()],
         splat_sq: vec![Default::default(); first.splat_sq.len()],
+        sppm: None,
         ..first.clone()
     };
     for (_, c) in parts {
@@ -606,6 +643,9 @@ impl Reader<'_> {
     }
     fn u64(&mut self) -> std::result::Result<u64, String> {
         Ok(u64::from_le_bytes(self.take()?))
+    }
+    fn f32(&mut self) -> std::result::Result<f32, String> {
+        Ok(f32::from_le_bytes(self.take()?))
     }
     fn i128(&mut self) -> std::result::Result<i128, String> {
         Ok(i128::from_le_bytes(self.take()?))
@@ -652,9 +692,21 @@ mod tests {
             variance: false,
             sum_sq: vec![],
             splat_sq: vec![],
+            sppm: None,
         };
         let b = c.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&b).unwrap(), c);
+        // With photon mapping's state.
+        let s = Checkpoint {
+            sppm: Some(SppmPixels {
+                n: vec![3.5, 0.0],
+                r2: vec![1e-4, 2.5],
+            }),
+            ..c.clone()
+        };
+        let sb = s.to_bytes();
+        assert_eq!(Checkpoint::from_bytes(&sb).unwrap(), s);
+        assert!(Checkpoint::from_bytes(&sb[..sb.len() - 1]).is_err());
         for cut in [0, 5, MAGIC.len() + 3, b.len() - 1] {
             assert!(Checkpoint::from_bytes(&b[..cut]).is_err(), "{cut}");
         }

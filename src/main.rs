@@ -22,6 +22,8 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per run: the size of the largest variant costs nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview, or (with -o
@@ -657,6 +659,18 @@ struct RenderArgs {
     /// scene's render.sun_guide.
     #[arg(long, value_name = "FRACTION")]
     sun_guide: Option<f64>,
+    /// sppm: photons traced per iteration (default: one per pixel). Overrides the
+    /// scene's render.sppm_photons.
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    sppm_photons: Option<i64>,
+    /// sppm: the share α of each iteration's photons a pixel keeps, in (0, 1) (default
+    /// 2/3): smaller shrinks the radii faster. Overrides the scene's render.sppm_alpha.
+    #[arg(long, value_name = "FRACTION", allow_hyphen_values = true)]
+    sppm_alpha: Option<f64>,
+    /// sppm: the initial gather radius in scene units (default 0: two pixel footprints
+    /// at each pixel's first visible point). Overrides the scene's render.sppm_radius.
+    #[arg(long, value_name = "RADIUS", allow_hyphen_values = true)]
+    sppm_radius: Option<f64>,
     /// Do not write the PNG preview.
     #[arg(long)]
     no_png: bool,
@@ -678,9 +692,10 @@ struct RenderArgs {
     #[arg(long, default_value = "visible", value_parser = ["uniform", "visible"])]
     wavelengths: String,
     /// whitted (the seed's tracer), path (path tracing with MIS), lighttrace (paths from
-    /// the lights, splatted) or bdpt (bidirectional); default: the scene's [render]
+    /// the lights, splatted), bdpt (bidirectional) or sppm (stochastic progressive photon
+    /// mapping; --spp is then its iterations); default: the scene's [render]
     /// integrator, else whitted.
-    #[arg(long, value_parser = ["whitted", "path", "lighttrace", "bdpt"])]
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(heron::settings::IntegratorKind::NAMES))]
     integrator: Option<String>,
     /// Where random numbers come from: sobol (Owen-scrambled Sobol' points along a Morton
     /// curve) or independent [default: sobol].
@@ -1000,6 +1015,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         no_packets: args.no_packets,
         medium_nee: args.medium_nee.as_deref(),
         sun_guide: args.sun_guide,
+        sppm_photons: args.sppm_photons,
+        sppm_alpha: args.sppm_alpha,
+        sppm_radius: args.sppm_radius,
     };
     // Before the scene loads, which may take seconds (sky and medium tables).
     settings_args.check().map_err(anyhow::Error::msg)?;

@@ -89,6 +89,10 @@ pub const KEYS: [&str; 15] = [
 /// path tracer's estimators there), so that other scenes' EXRs keep their bytes.
 pub const MEDIA_KEYS: [&str; 2] = ["mediumNee", "sunGuide"];
 
+/// Keys written last only for photon mapping (`integrator = "sppm"`): its photons per
+/// iteration (as resolved for the image), α and initial radius (0: automatic).
+pub const SPPM_KEYS: [&str; 3] = ["sppmPhotons", "sppmAlpha", "sppmRadius"];
+
 impl Provenance {
     /// The provenance a film's settings key holds (the key of `render.rs` contains every
     /// provenance entry), with `spp` samples per pixel: what `heron merge` writes, the
@@ -99,6 +103,7 @@ impl Provenance {
     ) -> Option<Provenance> {
         KEYS.iter()
             .chain(MEDIA_KEYS.iter().filter(|k| key.contains_key(**k)))
+            .chain(SPPM_KEYS.iter().filter(|k| key.contains_key(**k)))
             .map(|&k| {
                 let v = key.get(k)?.as_str()?;
                 Some((
@@ -154,6 +159,13 @@ impl Provenance {
         if !scene.media.is_empty() {
             p.0.push(("mediumNee", settings.medium_nee.name().to_string()));
             p.0.push(("sunGuide", settings.sun_guide.to_string()));
+        }
+        if settings.integrator == crate::settings::IntegratorKind::Sppm {
+            let pixels = scene.camera.width * scene.camera.height;
+            let sppm = &settings.sppm;
+            p.0.push(("sppmPhotons", sppm.photons_for(pixels).to_string()));
+            p.0.push(("sppmAlpha", sppm.alpha.to_string()));
+            p.0.push(("sppmRadius", sppm.radius.to_string()));
         }
         p
     }

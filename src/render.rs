@@ -229,7 +229,9 @@ fn render_with(
     opts: &RenderOptions,
 ) -> Result<(Checkpoint, RenderStats)> {
     let kind = opts.settings.integrator;
-    if scene.camera.lens.is_some() && kind.splats() {
+    if scene.camera.lens.is_some()
+        && matches!(kind, IntegratorKind::LightTrace | IntegratorKind::Bdpt)
+    {
         return Err(HeronError::Invalid(format!(
             "integrator {}: the lens camera (camera.type = \"lens\") has no importance function We and no connection to the film yet, which light tracing and BDPT need to reach the camera from the lights; use integrator = \"path\" or \"whitted\"",
             kind.name()
@@ -245,6 +247,22 @@ fn render_with(
     let k = Features::of(scene)
         .choose(kind, opts.settings.kernel)
         .map_err(HeronError::Invalid)?;
+    if kind == IntegratorKind::Sppm {
+        // Rays one at a time: the camera pass follows specular chains and the photons
+        // scatter from wherever the lights put them, so neither has packets.
+        let mut opts = opts.clone();
+        opts.settings.packets = Packets::Off;
+        let (state, mut stats) = match opts.settings.lanes {
+            1 => render_sppm::<1>(&ctx, pool, &opts),
+            4 => render_sppm::<4>(&ctx, pool, &opts),
+            8 => render_sppm::<8>(&ctx, pool, &opts),
+            n => Err(HeronError::Invalid(format!(
+                "lanes: expected 1, 4 or 8, got {n}"
+            ))),
+        }?;
+        stats.kernel = k;
+        return Ok((state, stats));
+    }
     let mut opts = opts.clone();
     // `auto` resolved: the provenance records what ran (light tracing has no camera
     // rays, so no camera packets).
@@ -389,68 +407,11 @@ pub(crate) fn render_passes(
         .collect();
     let n_work = tiles.len() as u64 * passes.len() as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
-    let npix = (cam.width * cam.height) as usize;
     let nb = opts.settings.spectral_bins;
     // Unnormalised sums over the whole render: XYZ and bins per pixel, finite samples per
     // pixel, and splatted XYZ.
     let key = settings_key(ctx.scene, opts, pass_spp);
-    let mut state = match &opts.resume {
-        Some(c) => {
-            if c.variance != opts.variance {
-                let with = |v: bool| if v { "with" } else { "without" };
-                return Err(HeronError::Invalid(format!(
-                    "--resume: the checkpoint was made {} --variance, this render is {} it",
-                    with(c.variance),
-                    with(opts.variance)
-                )));
-            }
-            if let Some(m) = c.mismatch(&key) {
-                return Err(HeronError::Invalid(format!(
-                    "--resume: the checkpoint was made with other settings ({m})"
-                )));
-            }
-            if c.shard != opts.shard {
-                let show = |s: Option<Shard>| s.map_or("no shard".into(), |s| format!("shard {s}"));
-                return Err(HeronError::Invalid(format!(
-                    "--resume: the checkpoint holds {}, this render {}",
-                    show(c.shard),
-                    show(opts.shard)
-                )));
-            }
-            let splat_len = if kind_splats(opts) { npix * nb } else { 0 };
-            let (sq_len, splat_sq_len) = variance_lens(opts, npix);
-            if (c.width, c.height) != (cam.width, cam.height)
-                || c.sum_bins.len() != npix * nb
-                || c.splat_bins.len() != splat_len
-                || c.sum_sq.len() != sq_len
-                || c.splat_sq.len() != splat_sq_len
-                || c.passes_done as usize > passes.len()
-            {
-                return Err(HeronError::Invalid(
-                    "--resume: the checkpoint's film does not fit this render".into(),
-                ));
-            }
-            (**c).clone()
-        }
-        None => Checkpoint {
-            key: key.clone(),
-            shard: opts.shard,
-            width: cam.width,
-            height: cam.height,
-            // Splats count when the integrator splats (a resumed render or a shard may
-            // add none itself), or when any sample splatted.
-            any_splat: kind_splats(opts),
-            sum_xyz: vec![[0; 3]; npix],
-            sum_bins: vec![0; npix * nb],
-            good: vec![0u32; npix],
-            splat: vec![[0; 3]; npix],
-            splat_bins: vec![0; if kind_splats(opts) { npix * nb } else { 0 }],
-            variance: opts.variance,
-            sum_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).0],
-            splat_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).1],
-            ..Default::default()
-        },
-    };
+    let mut state = initial_state(ctx.scene, opts, key, passes.len())?;
     let mut stats = RenderStats {
         resumed_from: opts.resume.as_ref().map(|c| c.spp_done),
         ..Default::default()
@@ -461,9 +422,8 @@ pub(crate) fn render_passes(
         first_pass as u64 * tiles.len() as u64,
         std::sync::atomic::Ordering::Relaxed,
     );
-    let start = Instant::now();
-    let mut last_checkpoint = Instant::now();
-    let mut last_preview = Instant::now();
+    let mut clock = PassClock::new();
+    let start = clock.start;
     for &(s0, s1) in &passes[first_pass..] {
         let results: Vec<TileResult> = pool.install(|| {
             tiles
@@ -525,94 +485,301 @@ pub(crate) fn render_passes(
             return Err(HeronError::Cancelled);
         }
         for t in results {
-            for y in 0..t.h {
-                for x in 0..t.w {
-                    let (dst, src) = (
-                        ((t.y0 + y) * cam.width + t.x0 + x) as usize,
-                        (y * t.w + x) as usize,
-                    );
-                    for j in 0..3 {
-                        state.sum_xyz[dst][j] = state.sum_xyz[dst][j].wrapping_add(t.xyz[src][j]);
-                    }
-                    state.good[dst] += t.good[src];
-                    if let Some(sq) = t.sq.get(src) {
-                        for (a, b) in state.sum_sq[dst].iter_mut().zip(sq) {
-                            a.add(*b);
-                        }
-                    }
-                    for (a, b) in state.sum_bins[dst * nb..(dst + 1) * nb]
-                        .iter_mut()
-                        .zip(&t.spectral[src * nb..(src + 1) * nb])
-                    {
-                        *a = a.wrapping_add(*b);
-                    }
-                }
-            }
-            for &(p, c) in &t.splats.list {
-                state.any_splat = true;
-                match to_fixed3(c) {
-                    Some(f) => {
-                        for (a, b) in state.splat[p as usize].iter_mut().zip(f) {
-                            *a = a.wrapping_add(b);
-                        }
-                    }
-                    None => state.nonfinite += 1,
-                }
-            }
-            if state.splat_sq.is_empty() && !t.splat_sq.is_empty() {
-                // Splats from an integrator not known to splat (as `any_splat`).
-                state.splat_sq = vec![[SquareSum::default(); 3]; npix];
-            }
-            for (p, sq) in &t.splat_sq {
-                for (a, b) in state.splat_sq[*p as usize].iter_mut().zip(sq) {
-                    a.add(*b);
-                }
-            }
-            for &(p, k, v) in &t.splats.spectral {
-                // A splat too large for the film was counted with its XYZ above.
-                if let Some(f) = to_fixed(v) {
-                    let a = &mut state.splat_bins[p as usize * nb + k as usize];
-                    *a = a.wrapping_add(f);
-                }
-            }
-            state.rays += t.counters.rays;
-            state.shadow_rays += t.counters.shadow_rays;
-            state.nonfinite += t.nonfinite + t.splats.nonfinite;
-            stats.first_nonfinite = stats.first_nonfinite.or(t.first_nonfinite);
+            add_tile(&mut state, &mut stats, t, cam.width, nb);
         }
         state.passes_done += 1;
         state.spp_done = s1 - range.start;
-        let last = s1 == range.end;
+        if clock.end_pass(opts, &state, s1 == range.end)? {
+            stats.stopped = true;
+            break;
+        }
+    }
+    stats.finish(&state, start, (rays0, shadow0));
+    Ok((state, stats))
+}
+
+impl RenderStats {
+    /// The statistics of a render that ended with `state`, started at `start` from a
+    /// state that had traced `before` (camera and shadow rays).
+    fn finish(&mut self, state: &Checkpoint, start: Instant, before: (u64, u64)) {
+        self.wall = start.elapsed();
+        self.spp = state.spp_done;
+        self.samples = state.width as u64 * state.height as u64 * state.spp_done as u64;
+        // This process's rays (a resumed render's earlier ones are in the checkpoint).
+        self.counters.rays = state.rays - before.0;
+        self.counters.shadow_rays = state.shadow_rays - before.1;
+        self.nonfinite = state.nonfinite;
+    }
+}
+
+/// A photon-mapping render (`integrator = "sppm"`): `spp` iterations of
+/// [`integrator::sppm::iteration`], each a pass. An iteration's camera paths are the
+/// film's samples (their light, the direct light, goes into its sums as any sample's
+/// does); its photons' sums Σ Φ/(πR²) are added to the film's splats, which the film
+/// divides by the iterations done, so the image is the direct light's mean plus
+/// Hachisuka & Jensen's estimate of the rest. Checkpoints add the pixels' photon counts
+/// and radii, from which `--resume` continues.
+///
+/// Shards: the estimator is progressive, each iteration's radii depending on the ones
+/// before, so an iteration cannot be split across processes. Shard K/N instead runs
+/// iterations ⌊K·I/N⌋ to ⌊(K+1)·I/N⌋ − 1 as a chain of its own, from the initial radii,
+/// and `heron merge` adds the sums and iteration counts: the merged image is the
+/// iteration-weighted mean of N independent SPPM estimates. It has the variance of one
+/// render of I iterations but the bias of a render of I/N (the radii shrink only as far
+/// as each shard's iterations take them), so it is not that render's bytes.
+fn render_sppm<const N: usize>(
+    ctx: &Context,
+    pool: &rayon::ThreadPool,
+    opts: &RenderOptions,
+) -> Result<(Checkpoint, RenderStats)> {
+    if opts.variance {
+        return Err(HeronError::Invalid(
+            "--variance: photon mapping's pixels are not means of independent samples (each iteration's radii depend on the ones before), so it has no per-pixel variance; use integrator path or bdpt for --variance".into(),
+        ));
+    }
+    let scene = ctx.scene;
+    let cam = &scene.camera;
+    let nb = opts.settings.spectral_bins;
+    let range = opts
+        .shard
+        .map_or(0..opts.settings.spp, |s| s.samples(opts.settings.spp));
+    let key = settings_key(scene, opts, 1);
+    let mut state = initial_state(scene, opts, key, range.len())?;
+    let mut stats = RenderStats {
+        resumed_from: opts.resume.as_ref().map(|c| c.spp_done),
+        ..Default::default()
+    };
+    let before = (state.rays, state.shadow_rays);
+    let mut clock = PassClock::new();
+    let start = clock.start;
+    let first = range.start + state.passes_done;
+    let cancel = || cancelled(opts);
+    for k in first..range.end {
+        let mut pixels = state.sppm.take().unwrap_or_default();
+        let it = pool.install(|| integrator::sppm::iteration::<N>(ctx, &mut pixels, k, &cancel));
+        if cancelled(opts) {
+            return Err(HeronError::Cancelled);
+        }
+        state.sppm = Some(pixels);
+        // The camera paths' light, as one tile of the whole image.
+        let mut sums = TileSums::new(cam.width, cam.height, nb, false);
+        for y in 0..cam.height {
+            for x in 0..cam.width {
+                let l = &it.l[(y * cam.width + x) as usize];
+                sums.add::<N, false>((0, 0), (x, y, k), l, &it.wl);
+            }
+        }
+        let tile = sums.result(
+            (0, 0, cam.width, cam.height),
+            Splats::new(0),
+            Vec::new(),
+            it.counters,
+        );
+        add_tile(&mut state, &mut stats, tile, cam.width, nb);
+        // The photons' sums, already exact integers.
+        for (a, b) in state.splat.iter_mut().zip(&it.photons.xyz) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.wrapping_add(y.load());
+            }
+        }
+        for (a, b) in state.splat_bins.iter_mut().zip(&it.photons.bins) {
+            *a = a.wrapping_add(b.load());
+        }
+        state.nonfinite += it
+            .photons
+            .nonfinite
+            .load(std::sync::atomic::Ordering::Relaxed);
+        state.passes_done += 1;
+        state.spp_done = k + 1 - range.start;
+        if let Some(p) = &opts.progress {
+            p(state.spp_done as u64, range.len() as u64);
+        }
+        if clock.end_pass(opts, &state, k + 1 == range.end)? {
+            stats.stopped = true;
+            break;
+        }
+    }
+    stats.finish(&state, start, before);
+    Ok((state, stats))
+}
+
+/// When a render last wrote a checkpoint and a preview, for the decisions at the end
+/// of each pass.
+struct PassClock {
+    start: Instant,
+    last_checkpoint: Instant,
+    last_preview: Instant,
+}
+
+impl PassClock {
+    fn new() -> PassClock {
+        let now = Instant::now();
+        PassClock {
+            start: now,
+            last_checkpoint: now,
+            last_preview: now,
+        }
+    }
+
+    /// At the end of a pass (`last`: the render's last): writes the checkpoint when one
+    /// is due or the render stops here, calls the preview when due; returns true when the
+    /// render stops before its last pass (a time limit, SIGINT).
+    fn end_pass(&mut self, opts: &RenderOptions, state: &Checkpoint, last: bool) -> Result<bool> {
         let stop = opts
             .stop
             .as_ref()
             .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
-            || opts.time_limit.is_some_and(|t| start.elapsed() >= t);
+            || opts.time_limit.is_some_and(|t| self.start.elapsed() >= t);
         if let Some((path, every)) = &opts.checkpoint {
-            if !last && (stop || last_checkpoint.elapsed() >= *every) {
+            if !last && (stop || self.last_checkpoint.elapsed() >= *every) {
                 state.write(path)?;
-                last_checkpoint = Instant::now();
+                self.last_checkpoint = Instant::now();
             }
         }
         if stop && !last {
-            stats.stopped = true;
-            break;
+            return Ok(true);
         }
         if let Some((every, preview)) = &opts.preview {
-            if !last && last_preview.elapsed() >= *every {
-                preview(&state);
-                last_preview = Instant::now();
+            if !last && self.last_preview.elapsed() >= *every {
+                preview(state);
+                self.last_preview = Instant::now();
+            }
+        }
+        Ok(false)
+    }
+}
+
+/// Adds one tile's sums of a pass (and its splats) to the film's state.
+fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, width: u32, nb: usize) {
+    let npix = state.sum_xyz.len();
+    for y in 0..t.h {
+        for x in 0..t.w {
+            let (dst, src) = (
+                ((t.y0 + y) * width + t.x0 + x) as usize,
+                (y * t.w + x) as usize,
+            );
+            for j in 0..3 {
+                state.sum_xyz[dst][j] = state.sum_xyz[dst][j].wrapping_add(t.xyz[src][j]);
+            }
+            state.good[dst] += t.good[src];
+            if let Some(sq) = t.sq.get(src) {
+                for (a, b) in state.sum_sq[dst].iter_mut().zip(sq) {
+                    a.add(*b);
+                }
+            }
+            for (a, b) in state.sum_bins[dst * nb..(dst + 1) * nb]
+                .iter_mut()
+                .zip(&t.spectral[src * nb..(src + 1) * nb])
+            {
+                *a = a.wrapping_add(*b);
             }
         }
     }
-    stats.wall = start.elapsed();
-    stats.spp = state.spp_done;
-    stats.samples = cam.width as u64 * cam.height as u64 * state.spp_done as u64;
-    // This process's rays (a resumed render's earlier ones are in the checkpoint).
-    stats.counters.rays = state.rays - rays0;
-    stats.counters.shadow_rays = state.shadow_rays - shadow0;
-    stats.nonfinite = state.nonfinite;
-    Ok((state, stats))
+    for &(p, c) in &t.splats.list {
+        state.any_splat = true;
+        match to_fixed3(c) {
+            Some(f) => {
+                for (a, b) in state.splat[p as usize].iter_mut().zip(f) {
+                    *a = a.wrapping_add(b);
+                }
+            }
+            None => state.nonfinite += 1,
+        }
+    }
+    if state.splat_sq.is_empty() && !t.splat_sq.is_empty() {
+        // Splats from an integrator not known to splat (as `any_splat`).
+        state.splat_sq = vec![[SquareSum::default(); 3]; npix];
+    }
+    for (p, sq) in &t.splat_sq {
+        for (a, b) in state.splat_sq[*p as usize].iter_mut().zip(sq) {
+            a.add(*b);
+        }
+    }
+    for &(p, k, v) in &t.splats.spectral {
+        // A splat too large for the film was counted with its XYZ above.
+        if let Some(f) = to_fixed(v) {
+            let a = &mut state.splat_bins[p as usize * nb + k as usize];
+            *a = a.wrapping_add(f);
+        }
+    }
+    state.rays += t.counters.rays;
+    state.shadow_rays += t.counters.shadow_rays;
+    state.nonfinite += t.nonfinite + t.splats.nonfinite;
+    stats.first_nonfinite = stats.first_nonfinite.or(t.first_nonfinite);
+}
+
+/// The film's state a render starts from: the checkpoint `opts` resumes, checked against
+/// this render (its settings `key`, image, arrays and at most `passes` passes), or empty
+/// sums.
+fn initial_state(
+    scene: &Scene,
+    opts: &RenderOptions,
+    key: serde_json::Map<String, serde_json::Value>,
+    passes: usize,
+) -> Result<Checkpoint> {
+    let cam = &scene.camera;
+    let npix = (cam.width * cam.height) as usize;
+    let nb = opts.settings.spectral_bins;
+    let sppm = opts.settings.integrator == IntegratorKind::Sppm;
+    Ok(match &opts.resume {
+        Some(c) => {
+            if c.variance != opts.variance {
+                let with = |v: bool| if v { "with" } else { "without" };
+                return Err(HeronError::Invalid(format!(
+                    "--resume: the checkpoint was made {} --variance, this render is {} it",
+                    with(c.variance),
+                    with(opts.variance)
+                )));
+            }
+            if let Some(m) = c.mismatch(&key) {
+                return Err(HeronError::Invalid(format!(
+                    "--resume: the checkpoint was made with other settings ({m})"
+                )));
+            }
+            if c.shard != opts.shard {
+                let show = |s: Option<Shard>| s.map_or("no shard".into(), |s| format!("shard {s}"));
+                return Err(HeronError::Invalid(format!(
+                    "--resume: the checkpoint holds {}, this render {}",
+                    show(c.shard),
+                    show(opts.shard)
+                )));
+            }
+            let splat_len = if kind_splats(opts) { npix * nb } else { 0 };
+            let (sq_len, splat_sq_len) = variance_lens(opts, npix);
+            if (c.width, c.height) != (cam.width, cam.height)
+                || c.sum_bins.len() != npix * nb
+                || c.splat_bins.len() != splat_len
+                || c.sum_sq.len() != sq_len
+                || c.splat_sq.len() != splat_sq_len
+                || c.passes_done as usize > passes
+                || c.sppm.as_ref().map(|s| s.n.len()) != sppm.then_some(npix)
+            {
+                return Err(HeronError::Invalid(
+                    "--resume: the checkpoint's film does not fit this render".into(),
+                ));
+            }
+            (**c).clone()
+        }
+        None => Checkpoint {
+            key,
+            shard: opts.shard,
+            width: cam.width,
+            height: cam.height,
+            // Splats count when the integrator splats (a resumed render or a shard may
+            // add none itself), or when any sample splatted.
+            any_splat: kind_splats(opts),
+            sum_xyz: vec![[0; 3]; npix],
+            sum_bins: vec![0; npix * nb],
+            good: vec![0u32; npix],
+            splat: vec![[0; 3]; npix],
+            splat_bins: vec![0; if kind_splats(opts) { npix * nb } else { 0 }],
+            variance: opts.variance,
+            sum_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).0],
+            splat_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).1],
+            sppm: sppm.then(|| integrator::sppm::SppmPixels::new(npix)),
+            ..Default::default()
+        },
+    })
 }
 
 /// The lengths of the film's arrays of squares: (per pixel, per pixel for splats), zero

@@ -20,14 +20,20 @@ pub enum IntegratorKind {
     LightTrace,
     /// Bidirectional path tracing, every strategy, power-heuristic MIS.
     Bdpt,
+    /// Stochastic progressive photon mapping: visible points from the camera, photons
+    /// from the lights, radii shrinking per pixel (`integrator::sppm`).
+    Sppm,
 }
 
 impl IntegratorKind {
-    pub const NAMES: &'static [&'static str] = &["whitted", "path", "lighttrace", "bdpt"];
+    pub const NAMES: &'static [&'static str] = &["whitted", "path", "lighttrace", "bdpt", "sppm"];
 
     /// Whether the integrator adds to other pixels than the one it samples.
     pub fn splats(self) -> bool {
-        matches!(self, IntegratorKind::LightTrace | IntegratorKind::Bdpt)
+        matches!(
+            self,
+            IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm
+        )
     }
 
     /// Whether it starts from the camera ray of the pixel sample (light tracing does
@@ -42,6 +48,7 @@ impl IntegratorKind {
             "path" => Ok(IntegratorKind::Path),
             "lighttrace" => Ok(IntegratorKind::LightTrace),
             "bdpt" => Ok(IntegratorKind::Bdpt),
+            "sppm" => Ok(IntegratorKind::Sppm),
             other => Err(format!(
                 "expected one of {}, got {other:?}",
                 Self::NAMES.join(", ")
@@ -55,6 +62,7 @@ impl IntegratorKind {
             IntegratorKind::Path => "path",
             IntegratorKind::LightTrace => "lighttrace",
             IntegratorKind::Bdpt => "bdpt",
+            IntegratorKind::Sppm => "sppm",
         }
     }
 }
@@ -296,6 +304,78 @@ pub fn parse_sun_guide(v: f64) -> Result<f32, String> {
     }
 }
 
+/// The options of stochastic progressive photon mapping (`integrator = "sppm"`;
+/// Hachisuka & Jensen 2009), read only by that integrator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SppmSettings {
+    /// Photons traced per iteration; 0: one per pixel (pbrt-v4's default).
+    pub photons: u32,
+    /// The fraction α of each iteration's new photons a pixel keeps, which sets how fast
+    /// its radius shrinks: R² ← R² (N + αM)/(N + M) (Hachisuka & Jensen 2009, eq. 5).
+    pub alpha: f32,
+    /// The initial gather radius in scene units; 0: this many pixel footprints at the
+    /// first visible point ([`SppmSettings::RADIUS_PIXELS`]).
+    pub radius: f32,
+}
+
+impl SppmSettings {
+    /// The initial radius in pixel footprints when `radius` is 0 (BENCHMARKS.md,
+    /// "Photon mapping", chose it).
+    pub const RADIUS_PIXELS: f32 = 2.0;
+
+    /// Photons per iteration for a film of `pixels` pixels.
+    pub fn photons_for(&self, pixels: u32) -> u32 {
+        if self.photons == 0 {
+            pixels.max(1)
+        } else {
+            self.photons
+        }
+    }
+}
+
+impl Default for SppmSettings {
+    fn default() -> Self {
+        SppmSettings {
+            photons: 0,
+            alpha: 2.0 / 3.0,
+            radius: 0.0,
+        }
+    }
+}
+
+/// α from a flag or key: in (0, 1).
+pub fn parse_sppm_alpha(v: f64) -> Result<f32, String> {
+    if v > 0.0 && v < 1.0 {
+        Ok(v as f32)
+    } else {
+        Err(format!(
+            "expected a fraction in (0, 1) (the share of new photons a pixel keeps; 2/3 is usual), got {v}"
+        ))
+    }
+}
+
+/// The initial radius from a flag or key: 0 (automatic) or a positive finite length.
+pub fn parse_sppm_radius(v: f64) -> Result<f32, String> {
+    if v >= 0.0 && v.is_finite() && (v as f32).is_finite() {
+        Ok(v as f32)
+    } else {
+        Err(format!(
+            "expected 0 (automatic: pixel footprints) or a positive radius in scene units, got {v}"
+        ))
+    }
+}
+
+/// Photons per iteration from a flag or key: 0 (one per pixel) to 2³¹.
+pub fn parse_sppm_photons(v: i64) -> Result<u32, String> {
+    if (0..=1i64 << 31).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(format!(
+            "expected 0 (one per pixel) or a photon count up to 2147483648, got {v}"
+        ))
+    }
+}
+
 /// How rays go to Embree. Embree's packet kernels return the same hits as its single-ray
 /// kernel up to the last bits of t, u and v (tests/embree.rs), so the choices give the
 /// same image up to those bits (tests/packets.rs bounds the difference).
@@ -393,6 +473,8 @@ pub struct RenderSettings {
     /// toward the sun is bright (near the phase function's forward peak) are drawn as
     /// often as they matter (0: off; ignored without a sun; `integrator::path`).
     pub sun_guide: f32,
+    /// Stochastic progressive photon mapping's options.
+    pub sppm: SppmSettings,
 }
 
 impl Default for RenderSettings {
@@ -416,6 +498,7 @@ impl Default for RenderSettings {
             kernel: KernelChoice::Auto,
             medium_nee: MediumNee::Forced,
             sun_guide: DEFAULT_SUN_GUIDE,
+            sppm: SppmSettings::default(),
         }
     }
 }
@@ -442,6 +525,9 @@ pub struct SettingsArgs<'a> {
     pub no_packets: bool,
     pub medium_nee: Option<&'a str>,
     pub sun_guide: Option<f64>,
+    pub sppm_photons: Option<i64>,
+    pub sppm_alpha: Option<f64>,
+    pub sppm_radius: Option<f64>,
 }
 
 impl SettingsArgs<'_> {
@@ -521,6 +607,15 @@ impl RenderSettings {
         if let Some(g) = a.sun_guide {
             s.sun_guide = parse_sun_guide(g).map_err(|e| format!("--sun-guide: {e}"))?;
         }
+        if let Some(n) = a.sppm_photons {
+            s.sppm.photons = parse_sppm_photons(n).map_err(|e| format!("--sppm-photons: {e}"))?;
+        }
+        if let Some(v) = a.sppm_alpha {
+            s.sppm.alpha = parse_sppm_alpha(v).map_err(|e| format!("--sppm-alpha: {e}"))?;
+        }
+        if let Some(v) = a.sppm_radius {
+            s.sppm.radius = parse_sppm_radius(v).map_err(|e| format!("--sppm-radius: {e}"))?;
+        }
         *self = s;
         Ok(())
     }
@@ -579,7 +674,7 @@ mod tests {
                     integrator: Some("nope"),
                     ..SettingsArgs::default()
                 },
-                "--integrator: expected one of whitted, path, lighttrace, bdpt, got \"nope\"",
+                "--integrator: expected one of whitted, path, lighttrace, bdpt, sppm, got \"nope\"",
             ),
             (
                 SettingsArgs {

@@ -26,6 +26,9 @@ const RENAMES: &[(&str, &str)] = &[
     ("--packets", "packets"),
     ("--medium-nee", "medium_nee"),
     ("--sun-guide", "sun_guide"),
+    ("--sppm-photons", "sppm_photons"),
+    ("--sppm-alpha", "sppm_alpha"),
+    ("--sppm-radius", "sppm_radius"),
 ];
 
 /// How often the thread that called `render` wakes to let Python run its signal
@@ -169,12 +172,16 @@ impl Scene {
     /// `--spectral-bins`; variance.R, .G, .B with `--variance`). medium_nee "forced" or
     /// "collision" and sun_guide (a fraction in [0, 1)) choose the path tracer's
     /// estimators in media (`heron render --medium-nee`, `--sun-guide`; default: the
-    /// scene's `[render]` values, else forced and 0.25).
+    /// scene's `[render]` values, else forced and 0.25). integrator "sppm" is
+    /// stochastic progressive photon mapping, spp its iterations; sppm_photons (per
+    /// iteration, 0: one per pixel), sppm_alpha (in (0, 1)) and sppm_radius (scene
+    /// units, 0: automatic) are `heron render --sppm-photons`, `--sppm-alpha`,
+    /// `--sppm-radius`.
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
@@ -193,6 +200,9 @@ impl Scene {
         packets: Option<&str>,
         medium_nee: Option<&str>,
         sun_guide: Option<f64>,
+        sppm_photons: Option<i64>,
+        sppm_alpha: Option<f64>,
+        sppm_radius: Option<f64>,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -219,6 +229,9 @@ impl Scene {
                     no_packets: false,
                     medium_nee,
                     sun_guide,
+                    sppm_photons,
+                    sppm_alpha,
+                    sppm_radius,
                 })
                 .map_err(|e| lib_err(e, RENAMES))?;
             opts.threads = threads as usize;

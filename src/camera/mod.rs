@@ -196,6 +196,23 @@ impl Camera {
         (u * self.b1 + w * self.b2 + self.d * self.v).normalize()
     }
 
+    /// The angle (radians) one pixel subtends at the centre of the image: 1/(d·height)
+    /// for the pinhole; for a lens, the film's pixel pitch over the lens's effective
+    /// focal length at its focus wavelength. Photon mapping sizes its first gather radii
+    /// by it.
+    pub fn pixel_angle(&self) -> f32 {
+        match &self.lens {
+            None => 1.0 / (self.d * self.height as f32),
+            Some(lens) => {
+                let (_, fh) = lens.film_size(self.width, self.height);
+                let efl = lens::paraxial::paraxial(&lens.system, lens.settings.focus_wavelength)
+                    .efl
+                    .abs();
+                (fh / self.height as f64 / efl.max(1e-9)) as f32
+            }
+        }
+    }
+
     /// The unit viewing direction (the camera's axis).
     pub fn forward(&self) -> Vec3 {
         self.v

@@ -125,10 +125,78 @@ impl SquareSum {
     }
 }
 
+/// A fixed-point sum (as [`to_fixed`] makes them) that threads add to at once, with the
+/// same bits whatever the order: the i128 is kept as two 64-bit limbs, and an add puts
+/// its low limb in with one atomic add and its high limb, plus the carry that add
+/// produced, with another. Each add's carry is decided by its own low-limb add, so the
+/// limbs end as the exact sum modulo 2¹²⁸ once every add has finished, as the plain
+/// wrapping sums do. Photon mapping's deposits (`integrator::sppm`) land in visible
+/// points from every thread; a lock-free exact sum keeps its image thread-independent.
+#[derive(Debug, Default)]
+pub struct AtomicFixed {
+    lo: std::sync::atomic::AtomicU64,
+    hi: std::sync::atomic::AtomicU64,
+}
+
+impl AtomicFixed {
+    #[inline]
+    pub fn add(&self, v: i128) {
+        use std::sync::atomic::Ordering::Relaxed;
+        let (lo, hi) = (v as u64, (v >> 64) as u64);
+        let old = self.lo.fetch_add(lo, Relaxed);
+        let carry = old.overflowing_add(lo).1 as u64;
+        // A small positive value (below 4) with no carry leaves the high limb as it is:
+        // most deposits, whose second locked add is then saved.
+        let h = hi.wrapping_add(carry);
+        if h != 0 {
+            self.hi.fetch_add(h, Relaxed);
+        }
+    }
+
+    /// The sum; exact once no thread adds any more.
+    #[inline]
+    pub fn load(&self) -> i128 {
+        use std::sync::atomic::Ordering::Relaxed;
+        let (lo, hi) = (self.lo.load(Relaxed), self.hi.load(Relaxed));
+        (((hi as u128) << 64) | lo as u128) as i128
+    }
+
+    /// The sum, and zero left in its place.
+    #[inline]
+    pub fn take(&self) -> i128 {
+        use std::sync::atomic::Ordering::Relaxed;
+        let (lo, hi) = (self.lo.swap(0, Relaxed), self.hi.swap(0, Relaxed));
+        (((hi as u128) << 64) | lo as u128) as i128
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::math::rng::Rng;
+
+    #[test]
+    fn atomic_sums_from_threads_equal_the_wrapping_sum() {
+        // Values of both signs and magnitudes whose low limbs carry and borrow.
+        let mut rng = Rng::new(7, 1);
+        let values: Vec<i128> = (0..40_000)
+            .map(|i| {
+                let v = (rng.uniform() as f64 - 0.5) * 10f64.powi(i % 13 - 6);
+                to_fixed(v as f32).unwrap()
+            })
+            .collect();
+        let plain = values.iter().fold(0i128, |a, &b| a.wrapping_add(b));
+        let sum = AtomicFixed::default();
+        std::thread::scope(|s| {
+            for part in values.chunks(10_000) {
+                let sum = &sum;
+                s.spawn(move || part.iter().for_each(|&v| sum.add(v)));
+            }
+        });
+        assert_eq!(sum.load(), plain);
+        assert_eq!(sum.take(), plain);
+        assert_eq!(sum.load(), 0);
+    }
 
     #[test]
     fn converts_exactly_where_the_float_fits() {

@@ -5,9 +5,11 @@
 //! - `path`: a spectral unidirectional path tracer with next-event estimation and
 //!   multiple importance sampling;
 //! - `lighttrace`: paths from the lights, connected to the camera and splatted;
-//! - `bdpt`: bidirectional path tracing with every connection strategy and MIS.
+//! - `bdpt`: bidirectional path tracing with every connection strategy and MIS;
+//! - `sppm`: stochastic progressive photon mapping, which `render.rs` runs as
+//!   iterations of a camera pass and a photon pass rather than per pixel sample.
 //!
-//! All four see materials and lights only through their methods (`Material::eval`,
+//! All five see materials and lights only through their methods (`Material::eval`,
 //! `sample`, `pdf`, `flags`; `Light::sample_li`, `pdf_li`, `l`, `le`, `sample_le`), take
 //! what they share from `toolkit` (the next hit, a light chosen and sampled with its
 //! density, that density for MIS, Russian roulette, the start of a light path, the
@@ -17,6 +19,7 @@
 pub mod bdpt;
 pub mod lighttrace;
 pub mod path;
+pub mod sppm;
 pub(crate) mod toolkit;
 pub mod whitted;
 
@@ -196,11 +199,16 @@ pub fn kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> RadianceF
                 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
         IntegratorKind::LightTrace => lighttrace_any::<N>,
         IntegratorKind::Bdpt => bdpt_any::<N>,
+        // Photon mapping runs its own iterations (`sppm::iteration`, called by
+        // `render.rs`), not a function per pixel sample; this entry, the general path
+        // tracer, is never called for it.
+        IntegratorKind::Sppm => path_k::<N, { ALL & !SPECULAR }>,
     }
 }
 
 /// The start and step of integrator `kind` with `N` lanes and kernel flags `k`, for the
-/// packet engine; `None` for light tracing and BDPT, which run one path at a time.
+/// packet engine; `None` for light tracing, BDPT and photon mapping, which run one path
+/// at a time.
 pub fn path_fns<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> Option<PathFns<N>> {
     let k = (k & ALL) as usize;
     match kind {
@@ -214,6 +222,6 @@ pub fn path_fns<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> Option<
             step: kernels!(path_step, N, SPECULAR, StepFn; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
                 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
         }),
-        IntegratorKind::LightTrace | IntegratorKind::Bdpt => None,
+        IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm => None,
     }
 }

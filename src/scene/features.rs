@@ -107,7 +107,8 @@ impl Features {
     /// The kernel flags `kind` needs for these features. The Whitted tracer is
     /// specialised on shadows, specular, emitters and escape; the path tracer on shadows
     /// (its next-event estimation), emitters, escape and media; light tracing and BDPT
-    /// always run their general kernel.
+    /// always run their general kernel, and so does photon mapping's (its iterations are not
+    /// per-sample kernels).
     pub fn kernel(&self, kind: IntegratorKind) -> KernelFlags {
         let bit = |on: bool, f: KernelFlags| if on { f } else { 0 };
         match kind {
@@ -123,7 +124,7 @@ impl Features {
                     | bit(self.escape, ESCAPE)
                     | bit(self.media, MEDIA)
             }
-            IntegratorKind::LightTrace | IntegratorKind::Bdpt => ALL,
+            IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm => ALL,
         }
     }
 
@@ -141,7 +142,10 @@ impl Features {
             ));
         }
         let need = self.kernel(kind);
-        let specialised = !matches!(kind, IntegratorKind::LightTrace | IntegratorKind::Bdpt);
+        let specialised = !matches!(
+            kind,
+            IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm
+        );
         let missing = stripped_of(need);
         if specialised && missing != 0 {
             return Err(format!(

@@ -196,6 +196,15 @@ pub struct RenderFile {
     /// The fraction of phase samples drawn about the sun at medium vertices, in [0, 1).
     #[serde(default)]
     pub sun_guide: Option<f64>,
+    /// SPPM: photons per iteration (0: one per pixel).
+    #[serde(default)]
+    pub sppm_photons: Option<i64>,
+    /// SPPM: the share α of new photons a pixel keeps, in (0, 1) (default 2/3).
+    #[serde(default)]
+    pub sppm_alpha: Option<f64>,
+    /// SPPM: the initial gather radius in scene units (0: automatic).
+    #[serde(default)]
+    pub sppm_radius: Option<f64>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.

@@ -166,6 +166,14 @@ RENDERS = [
         dict(spp=2, integrator="lighttrace", offset="epsilon"),
         ["--spp", "2", "--integrator", "lighttrace", "--offset", "epsilon"],
     ),
+    (
+        "dict-sppm",
+        "small",
+        dict(spp=3, lanes=4, integrator="sppm", sppm_photons=500, sppm_alpha=0.5,
+             spectral_bins=4),
+        ["--spp", "3", "--lanes", "4", "--integrator", "sppm", "--sppm-photons", "500",
+         "--sppm-alpha", "0.5", "--spectral-bins", "4"],
+    ),
 ]
 
 
@@ -269,7 +277,13 @@ def test_render_argument_errors(tmp_path):
     assert py_error(scene.render, spp=0) == cli("--spp", "0").replace("--spp", "spp")
     assert py_error(scene.render, wavelengths="red") == 'wavelengths: expected uniform or visible, got "red"'
     assert py_error(scene.render, integrator="photon") == (
-        'integrator: expected one of whitted, path, lighttrace, bdpt, got "photon"')
+        'integrator: expected one of whitted, path, lighttrace, bdpt, sppm, got "photon"')
+    assert py_error(scene.render, integrator="sppm", sppm_alpha=1.0) == (
+        cli("--integrator", "sppm", "--sppm-alpha", "1").replace("--sppm-alpha", "sppm_alpha"))
+    assert py_error(scene.render, integrator="sppm", sppm_radius=-2.0).startswith(
+        "sppm_radius: expected 0 (automatic")
+    assert py_error(scene.render, integrator="sppm", sppm_photons=-1).startswith(
+        "sppm_photons: expected 0 (one per pixel)")
     assert py_error(scene.render, sampler="halton") == 'sampler: expected sobol or independent, got "halton"'
     assert py_error(scene.render, offset="big") == 'offset: expected auto, epsilon or robust, got "big"'
     assert py_error(scene.render, spectral_bins=471).startswith("spectral_bins: expected 0 (none) or 1 to 470")
@@ -281,7 +295,7 @@ def test_render_argument_errors(tmp_path):
     g = tmp_path / "t.toml"
     g.write_text(SMALL_SCENE.replace('"bdpt"', '"photon"'))
     assert cli_error("render", g, "-o", tmp_path / "o.exr").endswith(
-        'render.integrator: expected one of whitted, path, lighttrace, bdpt, got "photon"')
+        'render.integrator: expected one of whitted, path, lighttrace, bdpt, sppm, got "photon"')
 
 
 def test_render_packets_choose_the_engine_and_agree():

@@ -2,7 +2,8 @@
 //! `RenderSettings::default()`.
 use crate::scene::file::RenderFile;
 use crate::settings::{
-    parse_sun_guide, IntegratorKind, LightSamplerKind, MediumNee, OffsetMode, RenderSettings,
+    parse_sppm_alpha, parse_sppm_photons, parse_sppm_radius, parse_sun_guide, IntegratorKind,
+    LightSamplerKind, MediumNee, OffsetMode, RenderSettings,
 };
 
 /// The settings of the `[render]` table `r` (defaults without one).
@@ -43,6 +44,17 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
     }
     if let Some(g) = r.sun_guide {
         settings.sun_guide = parse_sun_guide(g).map_err(|e| format!("render.sun_guide: {e}"))?;
+    }
+    if let Some(n) = r.sppm_photons {
+        settings.sppm.photons =
+            parse_sppm_photons(n).map_err(|e| format!("render.sppm_photons: {e}"))?;
+    }
+    if let Some(v) = r.sppm_alpha {
+        settings.sppm.alpha = parse_sppm_alpha(v).map_err(|e| format!("render.sppm_alpha: {e}"))?;
+    }
+    if let Some(v) = r.sppm_radius {
+        settings.sppm.radius =
+            parse_sppm_radius(v).map_err(|e| format!("render.sppm_radius: {e}"))?;
     }
     Ok(settings)
 }
