@@ -368,3 +368,137 @@ fn tempfile_dir() -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Where the central ray of the beam at `lambda` (from the middle of the slit, along the
+/// sun) meets the screen, by `heron trace`.
+fn screen_point(scene: &Scene, accel: &heron::accel::embree::Scene, lambda: f32) -> glam::Vec3 {
+    let slit = match &scene.lights[0] {
+        heron::light::Light::Sun(s) => s.portal.unwrap(),
+        _ => panic!("the sun is light 0"),
+    };
+    let centre = slit.origin + 0.5 * slit.edge1 + 0.5 * slit.edge2;
+    let dir = glam::Vec3::new(0.8370, 0.5473, 0.0);
+    let rep = heron::trace::trace(scene, accel, centre - 0.01 * dir, dir, lambda, &[]).unwrap();
+    let last = rep.events.last().unwrap();
+    assert_eq!(last.material.as_deref(), Some("screen"), "{lambda} nm: {rep:?}");
+    glam::Vec3::from(last.position)
+}
+
+/// The film position whose camera ray at `lambda` (through the lens, when it passes it)
+/// lands on the screen at `target`: Newton's method on the film position, from `guess`,
+/// with the Jacobian by central differences of `heron trace`'s rays.
+fn film_position_of(
+    scene: &Scene,
+    accel: &heron::accel::embree::Scene,
+    lambda: f32,
+    target: glam::Vec3,
+    guess: (f64, f64),
+) -> (f64, f64) {
+    let land = |x: f64, y: f64| -> glam::DVec3 {
+        let cam = &scene.camera;
+        let d = cam.direction(x as f32, y as f32);
+        let rep = heron::trace::trace(scene, accel, cam.eye, d, lambda, &[]).unwrap();
+        let last = rep.events.last().unwrap();
+        assert_eq!(last.material.as_deref(), Some("screen"), "({x}, {y}) {lambda} nm: {rep:?}");
+        glam::Vec3::from(last.position).as_dvec3()
+    };
+    // Screen coordinates: along its edge in the xy plane and along z.
+    let t = target.as_dvec3();
+    let along = glam::DVec3::new(0.492570, 0.753300, 0.0).normalize();
+    let coords = |p: glam::DVec3| glam::DVec2::new((p - t).dot(along), p.z - t.z);
+    let (mut x, mut y) = guess;
+    for _ in 0..8 {
+        let f = coords(land(x, y));
+        if f.length() < 1e-7 {
+            break;
+        }
+        let h = 0.25;
+        let fx = (coords(land(x + h, y)) - coords(land(x - h, y))) / (2.0 * h);
+        let fy = (coords(land(x, y + h)) - coords(land(x, y - h))) / (2.0 * h);
+        let det = fx.x * fy.y - fy.x * fx.y;
+        x -= (f.x * fy.y - fy.x * f.y) / det;
+        y -= (fx.x * f.y - f.x * fx.y) / det;
+    }
+    (x, y)
+}
+
+#[test]
+fn the_spectrum_seen_through_the_magnifier_lies_where_heron_trace_sends_each_band() {
+    // scenes/lens-over-spectrum.toml at 192×144 with 47 bins of 10 nm and uniform
+    // wavelengths: the iterations' heroes are stratified, so 188 iterations give each
+    // bin 4 wavelengths spread over it, whose rays the prediction traces. The prism ends the companions, so one lane is
+    // enough (and 188 iterations of it cost what 47 would with 4 lanes).
+    // The sun's disk shrunk to 0.02° (from 0.2666°): each band's image is then a few
+    // pixels wide, over which the magnifier's distortion is well below a pixel; with the
+    // real sun the bands near the lens's rim are 20 pixels wide and stretched more on
+    // their outer side, which moves their centroids outward by up to 3 pixels.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lens-over-spectrum.toml");
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "type = \"sun\"\n",
+        "type = \"sun\"\nangular_radius = 0.02\n",
+    );
+    assert!(text.contains("angular_radius = 0.02"));
+    let mut scene = load_scene_from_str(&text, &path).unwrap();
+    scene.camera = scene.camera.resized(192, 144).unwrap();
+    let state = sppm(&scene, 188, 2, |o| {
+        o.settings.lanes = 1;
+        o.settings.spectral_bins = 47;
+        o.settings.wavelengths = heron::settings::WavelengthSampler::Uniform;
+    });
+    let film = state.film();
+    let renderer = heron::render::Renderer::new(&scene).unwrap();
+    let accel = renderer.accel();
+    let (bins, data) = film.spectral.as_ref().unwrap();
+    let (w, h, nb) = (film.width as usize, film.height as usize, bins.count);
+    for lambda in [455.0f32, 555.0, 655.0] {
+        let k = bins.index(lambda);
+        let centre = bins.centre(k);
+        // The band's image: its centroid first over the whole image, then, along the
+        // dispersion (x), within 6 rows of the traced point: the band is taller than the
+        // lens, whose rim cuts it, so its centroid across the dispersion tells where the
+        // rim is rather than where the ray goes.
+        let value = |x: usize, y: usize| (data[(y * w + x) * nb + k] as f64).max(0.0);
+        let (mut sx, mut sy, mut s) = (0.0, 0.0, 0.0);
+        for y in 0..h {
+            for x in 0..w {
+                sx += value(x, y) * (x as f64 + 0.5);
+                sy += value(x, y) * (y as f64 + 0.5);
+                s += value(x, y);
+            }
+        }
+        assert!(s > 0.0, "{centre} nm: the band is not in the image");
+        // The traced position: the mean over the heroes the iterations put in this bin
+        // (each iteration's one wavelength, as the render drew them), each ray traced to
+        // the screen and from the camera back to that point.
+        let heroes: Vec<f32> = (0..188)
+            .map(|i| {
+                heron::integrator::sppm::iteration_wavelengths::<1>(
+                    heron::settings::WavelengthSampler::Uniform,
+                    2,
+                    i,
+                )
+                .lambda[0]
+            })
+            .filter(|&l| bins.index(l) == k)
+            .collect();
+        assert!(heroes.len() >= 3, "{centre} nm: {heroes:?}");
+        let (mut tx, mut ty) = (0.0, 0.0);
+        for &l in &heroes {
+            let target = screen_point(&scene, accel, l);
+            let (x, y) = film_position_of(&scene, accel, l, target, (sx / s, sy / s));
+            tx += x / heroes.len() as f64;
+            ty += y / heroes.len() as f64;
+        }
+        let (mut sx, mut s) = (0.0, 0.0);
+        let row = ty.floor() as i64;
+        for y in (row - 6).max(0)..(row + 7).min(h as i64) {
+            for x in 0..w {
+                sx += value(x, y as usize) * (x as f64 + 0.5);
+                s += value(x, y as usize);
+            }
+        }
+        let cx = sx / s;
+        eprintln!("{centre} nm: centroid x {cx:.2}, traced ({tx:.2}, {ty:.2})");
+        assert!((cx - tx).abs() < 1.0, "{centre} nm: centroid x {cx:.2}, traced x {tx:.2}");
+    }
+}

@@ -32,6 +32,23 @@ pub fn xyz_of_sample<const N: usize>(
     [xyz.x, xyz.y, xyz.z]
 }
 
+/// The XYZ each lane adds per unit of its radiance, x̄(λ)/(N p(λ) Σȳ) (zero for an
+/// ended lane): [`xyz_of_sample`]'s weights, for a caller that weighs many samples at the
+/// same wavelengths (photon mapping's deposits of one iteration).
+pub fn xyz_lane_weights<const N: usize>(wl: &SampledWavelengths<N>) -> [glam::Vec3; N] {
+    let obs = cie1931();
+    let k = 1.0 / (N as f32 * obs.y_integral);
+    std::array::from_fn(|i| {
+        let p = wl.pdf[i];
+        let (j, t) = wl.position(i);
+        if p > 0.0 {
+            (k / p) * obs.xyz_at(j, t).truncate()
+        } else {
+            glam::Vec3::ZERO
+        }
+    })
+}
+
 /// Equal-width wavelength bins over 360–830 nm for spectral output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SpectralBins {

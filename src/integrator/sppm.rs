@@ -61,7 +61,7 @@ use super::{Context, TraceCounters};
 use crate::bsdf::{BsdfContext, LobeFlags, Material, TransportMode};
 use crate::camera::CameraRay;
 use crate::film::fixed::{to_fixed, to_fixed3, AtomicFixed, LIMIT};
-use crate::film::{xyz_of_sample, SpectralBins};
+use crate::film::{xyz_lane_weights, SpectralBins};
 use crate::geometry::SpawnPoint;
 use crate::light::SurfacePoint;
 use crate::math::warp::power_heuristic;
@@ -467,63 +467,62 @@ impl Grid {
 }
 
 /// One iteration's photon sums per pixel: XYZ and spectral bins of Σ Φ/(πR²) in fixed
-/// point, and the photons gathered, added to by every thread at once.
-pub struct PhotonSums {
+/// point, and the photons gathered, added to by every thread at once. Every deposit of an
+/// iteration has the iteration's wavelengths, so each lane's XYZ and bin weights are
+/// computed once.
+pub struct PhotonSums<const N: usize> {
     pub xyz: Vec<[AtomicFixed; 3]>,
     pub bins: Vec<AtomicFixed>,
     pub count: Vec<AtomicU32>,
     nb: usize,
+    xyz_w: [Vec3; N],
+    /// Each lane's bin and weight 1/(N p(λ) Δλ_bin) (0 for an ended lane).
+    bin_of: [usize; N],
+    bin_w: [f32; N],
     /// Deposits left out: not finite, or beyond the film's fixed-point range.
     pub nonfinite: std::sync::atomic::AtomicU64,
 }
 
-impl PhotonSums {
-    pub fn new(pixels: usize, bins: usize) -> PhotonSums {
+impl<const N: usize> PhotonSums<N> {
+    pub fn new(pixels: usize, bins: usize, wl: &SampledWavelengths<N>) -> PhotonSums<N> {
+        let b = SpectralBins { count: bins.max(1) };
+        let w = 1.0 / (N as f32 * b.width());
         PhotonSums {
             xyz: (0..pixels).map(|_| Default::default()).collect(),
             bins: (0..pixels * bins).map(|_| Default::default()).collect(),
             count: (0..pixels).map(|_| AtomicU32::new(0)).collect(),
             nb: bins,
+            xyz_w: xyz_lane_weights(wl),
+            bin_of: std::array::from_fn(|i| b.index(wl.lambda[i])),
+            bin_w: std::array::from_fn(|i| if wl.pdf[i] > 0.0 { w / wl.pdf[i] } else { 0.0 }),
             nonfinite: Default::default(),
         }
     }
 
-    /// Adds the radiance `c` at wavelengths `wl` to `pixel`.
+    /// Adds the radiance `c` (at the iteration's wavelengths) to `pixel`.
     #[inline]
-    fn add<const N: usize>(
-        &self,
-        pixel: usize,
-        c: &SampledSpectrum<N>,
-        wl: &SampledWavelengths<N>,
-    ) {
+    fn add(&self, pixel: usize, c: &SampledSpectrum<N>) {
         self.count[pixel].fetch_add(1, Relaxed);
-        let xyz = c
-            .is_finite()
-            .then(|| xyz_of_sample(c, wl))
-            .and_then(to_fixed3);
-        let bins = SpectralBins {
-            count: self.nb.max(1),
-        };
-        let w = 1.0 / (N as f32 * bins.width());
-        let lanes: [f32; N] = std::array::from_fn(|i| {
-            if wl.pdf[i] > 0.0 {
-                c.0[i] * w / wl.pdf[i]
-            } else {
-                0.0
-            }
-        });
-        let (Some(xyz), true) = (xyz, self.nb == 0 || lanes.iter().all(|v| v.abs() < LIMIT)) else {
+        let mut xyz = Vec3::ZERO;
+        for i in 0..N {
+            xyz += c.0[i] * self.xyz_w[i];
+        }
+        let lanes: [f32; N] = std::array::from_fn(|i| c.0[i] * self.bin_w[i]);
+        let fixed = to_fixed3(xyz.to_array());
+        let (Some(fixed), true) = (fixed, self.nb == 0 || lanes.iter().all(|v| v.abs() < LIMIT))
+        else {
             self.nonfinite.fetch_add(1, Relaxed);
             return;
         };
-        for (a, v) in self.xyz[pixel].iter().zip(xyz) {
-            a.add(v);
+        for (a, v) in self.xyz[pixel].iter().zip(fixed) {
+            if v != 0 {
+                a.add(v);
+            }
         }
         if self.nb > 0 {
             for (i, &v) in lanes.iter().enumerate() {
                 if v != 0.0 {
-                    let k = bins.index(wl.lambda[i]);
-                    self.bins[pixel * self.nb + k].add(to_fixed(v).unwrap_or(0));
+                    self.bins[pixel * self.nb + self.bin_of[i]].add(to_fixed(v).unwrap_or(0));
                 }
             }
         }
@@ -536,7 +535,7 @@ pub struct Gather<'a, const N: usize> {
     pub vps: &'a [Option<VisiblePoint<N>>],
     pub grid: &'a Grid,
     pub inv_area: &'a [f32],
-    pub sums: &'a PhotonSums,
+    pub sums: &'a PhotonSums<N>,
 }
 
 /// Traces one photon of an iteration whose M photons each carry 1/M of the lights'
@@ -629,7 +628,7 @@ fn deposit<const N: usize>(
             // Both sides hold hero × N (module documentation).
             c *= 1.0 / N as f32;
         }
-        g.sums.add(i, &c, wl);
+        g.sums.add(i, &c);
     }
 }
 
@@ -656,7 +655,7 @@ impl SppmPixels {
 pub struct Iteration<const N: usize> {
     pub wl: SampledWavelengths<N>,
     pub l: Vec<SampledSpectrum<N>>,
-    pub photons: PhotonSums,
+    pub photons: PhotonSums<N>,
     pub counters: TraceCounters,
 }
 
@@ -683,6 +682,7 @@ pub fn iteration<const N: usize>(
         shadow_rays: a.shadow_rays + b.shadow_rays,
     };
 
+    let t0 = std::time::Instant::now();
     // 1. Camera pass, a row per task.
     let mut l = vec![SampledSpectrum::<N>::zero(); npix];
     let mut vps: Vec<Option<VisiblePoint<N>>> = vec![None; npix];
@@ -742,9 +742,11 @@ pub fn iteration<const N: usize>(
         })
         .collect();
 
+    let t1 = std::time::Instant::now();
     // 2. Photon pass, a chunk of photons per task.
     let grid = Grid::build(&vps, &pixels.r2);
-    let photons = PhotonSums::new(npix, settings.spectral_bins);
+    let t2 = std::time::Instant::now();
+    let photons = PhotonSums::new(npix, settings.spectral_bins, &wl);
     let m = settings.sppm.photons_for(w * h);
     let gather = Gather {
         vps: &vps,
@@ -779,6 +781,10 @@ pub fn iteration<const N: usize>(
         })
         .reduce(TraceCounters::default, sum);
 
+    let t3 = std::time::Instant::now();
+    if std::env::var_os("HERON_SPPM_TIMING").is_some() {
+        eprintln!("TIMING camera {:?} grid {:?} ({} entries) photons {:?}", t1 - t0, t2 - t1, grid.entries.len(), t3 - t2);
+    }
     // 3. The radii.
     for i in 0..npix {
         let got = photons.count[i].load(Relaxed);
