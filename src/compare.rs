@@ -41,17 +41,107 @@
 //! Sobol'-sampled pixel is that of independent samples, an overestimate: conservative.
 //!
 //! Besides the verdict: the relative RMSE √(Σ(a − b)² / Σ b²) over all pixels and
-//! channels (B as the reference, as `heron converge` measures), the relMSE
-//! (1/3N) Σ (a − b)² / (b² + ε) with ε = 10⁻² (Rousselle, Knaus & Zwicker 2011,
-//! "Adaptive Sampling and Reconstruction using Greedy Error Minimization", ACM TOG
-//! 30(6) 159: the relative error with dark pixels regularised), and the image's mean
-//! difference per channel with its standard error (the whole-image test).
+//! channels (B as the reference), the relMSE (1/3N) Σ (a − b)² / (b² + ε) with
+//! ε = 10⁻² (Rousselle, Knaus & Zwicker 2011, "Adaptive Sampling and Reconstruction
+//! using Greedy Error Minimization", ACM TOG 30(6) 159: the relative error with dark
+//! pixels regularised), and the image's mean difference per channel with its standard
+//! error (the whole-image test). The two error measures are defined once, in
+//! [`errors`] and [`ErrorSums`], which `heron converge` calls too.
 use crate::files::write_atomically;
 use crate::film::exr::VARIANCE_CHANNELS;
 use crate::film::Film;
 use crate::{HeronError, Result};
 use serde::Serialize;
 use std::path::Path;
+
+/// The ε of the relMSE, in the images' own units (linear sRGB for heron's films, where
+/// a white surface under unit light is about 1): pixels much darker than √ε = 0.1 count
+/// their absolute rather than their relative error, so a black pixel that one sample
+/// lit does not dominate the mean (Rousselle, Knaus & Zwicker 2011 use 10⁻²).
+pub const REL_MSE_EPSILON: f64 = 1e-2;
+
+/// The relative squared error of a value whose reference is `r`, from their difference
+/// `d` = x − r: d² / (r² + ε), ε = [`REL_MSE_EPSILON`].
+pub fn rel_squared_error(d: f64, r: f64) -> f64 {
+    d * d / (r * r + REL_MSE_EPSILON)
+}
+
+/// The relative RMSE and the relMSE of one comparison.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Errors {
+    /// √(Σ (x − r)² / Σ r²): 0 when x = r everywhere, +∞ when the reference is black
+    /// and x is not.
+    pub rel_rmse: f64,
+    /// (1/n) Σ (x − r)² / (r² + ε) over the n values (pixels × channels).
+    pub rel_mse: f64,
+}
+
+/// The sums behind [`Errors`], one value (a pixel's channel) at a time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ErrorSums {
+    squared: f64,
+    reference_squared: f64,
+    relative: f64,
+    values: u64,
+}
+
+impl ErrorSums {
+    /// Adds one value by its difference `d` = x − r from its reference `r`.
+    pub fn add(&mut self, d: f64, r: f64) {
+        self.squared += d * d;
+        self.reference_squared += r * r;
+        self.relative += rel_squared_error(d, r);
+        self.values += 1;
+    }
+
+    pub fn errors(&self) -> Errors {
+        let rel_rmse = if self.squared == 0.0 {
+            0.0
+        } else if self.reference_squared == 0.0 {
+            f64::INFINITY
+        } else {
+            (self.squared / self.reference_squared).sqrt()
+        };
+        Errors {
+            rel_rmse,
+            rel_mse: self.relative / self.values.max(1) as f64,
+        }
+    }
+}
+
+/// The errors of `x` against `reference` (row-major pixels of three channels) over the
+/// pixels whose indices `pixels` lists, every channel.
+pub fn errors(
+    x: &[[f32; 3]],
+    reference: &[[f32; 3]],
+    pixels: impl IntoIterator<Item = usize>,
+) -> Errors {
+    let mut s = ErrorSums::default();
+    for i in pixels {
+        for c in 0..3 {
+            let r = reference[i][c] as f64;
+            s.add(x[i][c] as f64 - r, r);
+        }
+    }
+    s.errors()
+}
+
+/// The heat maps' colour of `s` in [−1, 1] (clamped): white at 0, fading linearly to
+/// full red at +1 and full blue at −1. `heron compare` colours z-scores with it and
+/// `heron converge --heatmap` relative squared errors.
+pub fn heat_colour(s: f64) -> [u8; 3] {
+    let s = s.clamp(-1.0, 1.0);
+    let fade = (255.0 * (1.0 - s.abs())).round() as u8;
+    if s >= 0.0 {
+        [255, fade, fade]
+    } else {
+        [fade, fade, 255]
+    }
+}
+
+/// The heat maps' colour of pixels left out (outside the mask or the region of
+/// interest).
+pub const HEAT_LEFT_OUT: [u8; 3] = [128, 128, 128];
 
 /// A three-channel image to compare, with an optional per-pixel variance of each
 /// channel's value (the variance of the pixel's mean, as `heron render --variance`
@@ -359,7 +449,7 @@ pub struct Comparison {
     pub identical: usize,
     /// √(Σ (a − b)² / Σ b²) over all compared pixels and channels.
     pub rel_rmse: f64,
-    /// (1/3N) Σ (a − b)² / (b² + 0.01).
+    /// (1/3N) Σ (a − b)² / (b² + ε), ε = [`REL_MSE_EPSILON`].
     pub rel_mse: f64,
 }
 
@@ -541,17 +631,11 @@ impl Comparison {
             for x in 0..w {
                 let i = (y * w + x) as usize;
                 let px = if mask.is_some_and(|m| !m[i]) {
-                    [128, 128, 128]
+                    HEAT_LEFT_OUT
                 } else if outline[i] {
                     [0, 0, 0]
                 } else {
-                    let s = (z[i] / scale).clamp(-1.0, 1.0);
-                    let fade = (255.0 * (1.0 - s.abs())).round() as u8;
-                    if s >= 0.0 {
-                        [255, fade, fade]
-                    } else {
-                        [fade, fade, 255]
-                    }
+                    heat_colour(z[i] / scale)
                 };
                 img.put_pixel(x, y, image::Rgb(px));
             }
@@ -651,22 +735,7 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
         t.fails = t.p < per_test;
     }
     // Relative errors over the compared pixels, B as the reference.
-    let (mut num, mut den, mut rel) = (0.0f64, 0.0f64, 0.0f64);
-    for &i in &all {
-        for c in 0..3 {
-            let (x, r) = (a.values[i][c] as f64, b.values[i][c] as f64);
-            num += (x - r) * (x - r);
-            den += r * r;
-            rel += (x - r) * (x - r) / (r * r + 1e-2);
-        }
-    }
-    let rel_rmse = if num == 0.0 {
-        0.0
-    } else if den == 0.0 {
-        f64::INFINITY
-    } else {
-        (num / den).sqrt()
-    };
+    let e = errors(&a.values, &b.values, all.iter().copied());
     Ok(Comparison {
         width: w,
         height: h,
@@ -682,8 +751,8 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
         regions,
         whole,
         identical,
-        rel_rmse,
-        rel_mse: rel / (3 * all.len()).max(1) as f64,
+        rel_rmse: e.rel_rmse,
+        rel_mse: e.rel_mse,
     })
 }
 
@@ -890,6 +959,44 @@ mod tests {
         assert!((student_two_sided(z, nu) / normal_two_sided(z) - 1.0).abs() < 1e-3);
         // I_x(a, 1) = x^a.
         assert!((incomplete_beta(0.3, 2.5, 1.0) - 0.3f64.powf(2.5)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn error_measures_have_their_known_values() {
+        // Differences (0, 1, 0) and (2, 0, −1) against references (1, 1, 0), (1, 0, 1):
+        // Σd² = 6, Σr² = 4, and every nonzero difference sits on a reference of
+        // magnitude 1 or 0.
+        let x = [[1.0, 2.0, 0.0], [3.0, 0.0, 0.0]];
+        let r = [[1.0, 1.0, 0.0], [1.0, 0.0, 1.0]];
+        let e = errors(&x, &r, 0..2);
+        assert!((e.rel_rmse - 1.5f64.sqrt()).abs() < 1e-12, "{e:?}");
+        // (1/1.01 + 4/1.01 + 1/1.01) / 6 values.
+        assert!((e.rel_mse - 1.0 / 1.01).abs() < 1e-12, "{e:?}");
+        // The second pixel alone: Σd² = 5, Σr² = 2; (4 + 1)/1.01 over 3 values.
+        let e = errors(&x, &r, [1]);
+        assert!((e.rel_rmse - 2.5f64.sqrt()).abs() < 1e-12);
+        assert!((e.rel_mse - 5.0 / 3.03).abs() < 1e-12);
+        // A black reference: the relMSE counts the absolute error over ε = 0.01 (0.1² /
+        // 0.01 = 1 in every channel), the relative RMSE is infinite.
+        let e = errors(&[[0.1; 3]], &[[0.0; 3]], [0]);
+        assert_eq!(e.rel_rmse, f64::INFINITY);
+        assert!((e.rel_mse - 1.0).abs() < 1e-6, "{e:?}");
+        assert_eq!(REL_MSE_EPSILON, 1e-2);
+        // Nothing differs: both are zero, even over a black reference.
+        let e = errors(&[[0.0; 3]], &[[0.0; 3]], [0]);
+        assert_eq!((e.rel_rmse, e.rel_mse), (0.0, 0.0));
+        // The relMSE does not depend on the sign of the difference, and scales as d².
+        assert_eq!(rel_squared_error(-0.3, 2.0), rel_squared_error(0.3, 2.0));
+        let q = rel_squared_error(0.6, 2.0) / rel_squared_error(0.3, 2.0);
+        assert!((q - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn heat_colour_fades_from_white() {
+        assert_eq!(heat_colour(0.0), [255, 255, 255]);
+        assert_eq!(heat_colour(1.0), [255, 0, 0]);
+        assert_eq!(heat_colour(-7.0), [0, 0, 255]);
+        assert_eq!(heat_colour(0.5), [255, 128, 128]);
     }
 
     #[test]

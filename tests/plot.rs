@@ -53,6 +53,9 @@ fn row(lanes: usize, spp: u32, wall_s: f64, rel_rmse: f64) -> ConvergeRow {
         ns_per_sample: 1.0,
         rel_rmse,
         rmse_sqrt_time: rel_rmse * wall_s.sqrt(),
+        rel_mse: rel_rmse * rel_rmse,
+        roi_rel_rmse: None,
+        roi_rel_mse: None,
     }
 }
 
