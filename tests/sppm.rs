@@ -380,7 +380,11 @@ fn screen_point(scene: &Scene, accel: &heron::accel::embree::Scene, lambda: f32)
     let dir = glam::Vec3::new(0.8370, 0.5473, 0.0);
     let rep = heron::trace::trace(scene, accel, centre - 0.01 * dir, dir, lambda, &[]).unwrap();
     let last = rep.events.last().unwrap();
-    assert_eq!(last.material.as_deref(), Some("screen"), "{lambda} nm: {rep:?}");
+    assert_eq!(
+        last.material.as_deref(),
+        Some("screen"),
+        "{lambda} nm: {rep:?}"
+    );
     glam::Vec3::from(last.position)
 }
 
@@ -399,7 +403,11 @@ fn film_position_of(
         let d = cam.direction(x as f32, y as f32);
         let rep = heron::trace::trace(scene, accel, cam.eye, d, lambda, &[]).unwrap();
         let last = rep.events.last().unwrap();
-        assert_eq!(last.material.as_deref(), Some("screen"), "({x}, {y}) {lambda} nm: {rep:?}");
+        assert_eq!(
+            last.material.as_deref(),
+            Some("screen"),
+            "({x}, {y}) {lambda} nm: {rep:?}"
+        );
         glam::Vec3::from(last.position).as_dvec3()
     };
     // Screen coordinates: along its edge in the xy plane and along z.
@@ -499,6 +507,9 @@ fn the_spectrum_seen_through_the_magnifier_lies_where_heron_trace_sends_each_ban
         }
         let cx = sx / s;
         eprintln!("{centre} nm: centroid x {cx:.2}, traced ({tx:.2}, {ty:.2})");
-        assert!((cx - tx).abs() < 1.0, "{centre} nm: centroid x {cx:.2}, traced x {tx:.2}");
+        assert!(
+            (cx - tx).abs() < 1.0,
+            "{centre} nm: centroid x {cx:.2}, traced x {tx:.2}"
+        );
     }
 }
