@@ -5,7 +5,7 @@ its time on the pool.
 
     .venv/bin/python scripts/bench_sppm.py [--scenes pool,lens-over-spectrum,caustic-dispersion]
         [--seconds 60] [--ref-seconds 600] [--sweep 30,60,120] [--threads 2]
-        [--keep DIR] [--reference-from DIR] [--heron target/release/heron]
+        [--keep DIR] [--reference-from DIR] [--tune] [--heron target/release/heron]
 
 For each scene a reference is rendered by `sppm` as two independent chains (seeds
 100000 and 100001) of --ref-seconds each (`--time-limit`), averaged; their difference
@@ -52,11 +52,12 @@ ROI = {
 }
 
 
-def render(heron, scene, integrator, seconds, seed, threads, out):
+def render(heron, scene, integrator, seconds, seed, threads, out, extra=()):
     p = subprocess.run(
         [str(heron), "render", str(scene), "-o", str(out), "--integrator", integrator,
          "--spp", "1000000", "--time-limit", str(seconds), "--seed", str(seed),
-         "--threads", str(threads), "--lanes", "4", "--xyz", "--no-png", "--quiet"],
+         "--threads", str(threads), "--lanes", "4", "--xyz", "--no-png", "--quiet",
+         *extra],
         check=True, capture_output=True, text=True)
     m = re.search(r"at (\d+) spp.* in ([0-9.]+) s:", p.stderr)
     return int(m.group(1)), float(m.group(2))
@@ -79,6 +80,11 @@ def main():
     ap.add_argument("--keep", type=pathlib.Path)
     ap.add_argument("--reference-from", type=pathlib.Path)
     ap.add_argument("--heron", type=pathlib.Path, default=REPO / "target/release/heron")
+    ap.add_argument("--tune", action="store_true",
+                    help="on the pool, also sppm at --seconds for photons per iteration of "
+                         "1/4, 1 and 4 per pixel and initial radii of automatic "
+                         "(SppmSettings::RADIUS_PIXELS footprints; a footprint is about "
+                         "7 mm on the pool's floor), 6 and 25 mm")
     a = ap.parse_args()
     tmp = pathlib.Path(tempfile.mkdtemp())
     if a.keep:
@@ -111,6 +117,14 @@ def main():
                 row(name, integ, spp, t, read_xyz(out), ref, roi)
                 if a.keep and order[0] == "path":
                     shutil.copyfile(out, a.keep / f"{name}-{integ}.exr")
+        if name == "pool" and a.tune:
+            for photons in (65536, 262144, 1048576):
+                for radius in ("0", "0.006", "0.025"):
+                    out = tmp / "tune.exr"
+                    spp, t = render(a.heron, scene, "sppm", a.seconds, 1, a.threads, out,
+                                    ["--sppm-photons", str(photons), "--sppm-radius", radius])
+                    row(name, f"sppm-photons{photons}-radius{radius}", spp, t, read_xyz(out),
+                        ref, roi)
         if name == "pool":
             points = []
             for s in [float(x) for x in a.sweep.split(",")]:

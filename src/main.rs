@@ -683,7 +683,7 @@ struct RenderArgs {
     /// 2/3): smaller shrinks the radii faster. Overrides the scene's render.sppm_alpha.
     #[arg(long, value_name = "FRACTION", allow_hyphen_values = true)]
     sppm_alpha: Option<f64>,
-    /// sppm: the initial gather radius in scene units (default 0: two pixel footprints
+    /// sppm: the initial gather radius in scene units (default 0: four pixel footprints
     /// at each pixel's first visible point). Overrides the scene's render.sppm_radius.
     #[arg(long, value_name = "RADIUS", allow_hyphen_values = true)]
     sppm_radius: Option<f64>,

@@ -321,7 +321,7 @@ pub struct SppmSettings {
 impl SppmSettings {
     /// The initial radius in pixel footprints when `radius` is 0 (BENCHMARKS.md,
     /// "Photon mapping", chose it).
-    pub const RADIUS_PIXELS: f32 = 2.0;
+    pub const RADIUS_PIXELS: f32 = 4.0;
 
     /// Photons per iteration for a film of `pixels` pixels.
     pub fn photons_for(&self, pixels: u32) -> u32 {

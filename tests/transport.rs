@@ -232,38 +232,7 @@ fn path_tracing_is_deterministic_for_any_thread_count() {
 /// regions).
 #[test]
 fn ending_the_companion_lanes_keeps_the_path_tracer_unbiased() {
-    let scene = load(
-        r#"
-[camera]
-eye = [0.0, 1.2, 2.2]
-look_at = [0.0, 0.2, 0.0]
-resolution = [48, 36]
-[render]
-max_depth = 8
-[materials.floor]
-type = "lambertian"
-rho_d = 0.8
-[materials.flint]
-type = "dielectric"
-ior = "N-SF11"
-[[shapes]]
-type = "quad"
-origin = [-2.0, 0.0, 2.0]
-edge1 = [4.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, -4.0]
-material = "floor"
-[[shapes]]
-type = "sphere"
-center = [0.0, 0.4, 0.0]
-radius = 0.4
-material = "flint"
-[[shapes]]
-type = "sphere"
-center = [0.6, 1.6, 0.2]
-radius = 0.3
-emission = { spectrum = "E", scale = 20.0 }
-"#,
-    );
+    let scene = load(&common::scenes::flint_caustic(48, 36));
     let mut films = Vec::new();
     for (lanes, seed) in [(4usize, 11u64), (1, 12)] {
         // At 1024 spp, dropping the hero's factor N shows up at 5.3 standard errors.

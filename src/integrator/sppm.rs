@@ -180,41 +180,25 @@ pub fn camera_path<const N: usize>(
         }
         let sp = it.spawn_point();
         if flags.has_non_specular() {
-            let g = bsdf_ctx.with_lobes(NON_DELTA);
-            out.l += direct_light(
-                ctx,
-                &sp,
+            let v = Vertex {
+                sp,
                 material,
-                &frame,
+                frame,
                 wo,
                 beta,
-                &g,
-                u_light,
-                u_light_point,
-                wl,
-                counters,
-            );
+                bsdf: bsdf_ctx.with_lobes(NON_DELTA),
+            };
+            out.l += v.direct_light(ctx, u_light, u_light_point, wl, counters);
             if gather {
-                let beta_vp = beta * w;
-                out.l += emission_by_bsdf(
-                    ctx,
-                    &sp,
-                    material,
-                    &frame,
-                    wo,
-                    beta_vp,
-                    &g,
-                    (u_lobe, u_dir),
-                    wl,
-                    counters,
-                );
+                // Linear in the throughput: the lobe choice's factor applies after.
+                out.l += v.emission_by_bsdf(ctx, u_lobe, u_dir, wl, counters) * w;
                 out.vp = Some(VisiblePoint {
                     p: it.position,
                     frame,
                     wo,
                     material: it.material,
-                    beta: beta_vp,
-                    ctx: g,
+                    beta: beta * w,
+                    ctx: v.bsdf,
                 });
                 return out;
             }
@@ -234,101 +218,104 @@ pub fn camera_path<const N: usize>(
     out
 }
 
-/// Next-event estimation at a visible point: a light sample weighted by the power
-/// heuristic against the non-delta lobes' density.
-#[allow(clippy::too_many_arguments)]
-fn direct_light<const N: usize>(
-    ctx: &Context,
-    sp: &SpawnPoint,
-    material: &Material,
-    frame: &Frame,
+/// A camera path's vertex with a diffuse or glossy lobe: where rays leave it, what
+/// scatters there (only its non-delta lobes, `bsdf`), toward where, and the throughput
+/// that reached it.
+struct Vertex<'a, const N: usize> {
+    sp: SpawnPoint,
+    material: &'a Material,
+    frame: Frame,
     wo: Vec3,
     beta: SampledSpectrum<N>,
-    g: &BsdfContext,
-    u_light: f32,
-    u_point: glam::Vec2,
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-) -> SampledSpectrum<N> {
-    let zero = SampledSpectrum::zero();
-    let Some(cl) = sample_light(ctx, sp.p, u_light, u_point, wl) else {
-        return zero;
-    };
-    let ls = &cl.sample;
-    let wi = frame.to_local(ls.wi);
-    let f = material.eval(wo, wi, wl, g).f * wi.z.abs();
-    if f.is_zero() {
-        return zero;
-    }
-    let Some(q) = ctx.offset.shadow(sp, ls.wi, ls.dist, &ls.target()) else {
-        return zero;
-    };
-    counters.shadow_rays += 1;
-    if ctx.accel.occluded1(&q) {
-        return zero;
-    }
-    let weight = if ls.delta {
-        1.0
-    } else {
-        power_heuristic(cl.pdf, material.pdf(wo, wi, wl, g))
-    };
-    beta * f * ls.l * (weight / cl.pdf)
+    bsdf: BsdfContext,
 }
 
-/// The emission a BSDF sample from a visible point reaches directly (an area light, or
-/// the sky and sun's disk beyond the scene), weighted by the power heuristic against
-/// light sampling: the other half of [`direct_light`]'s estimate.
-#[allow(clippy::too_many_arguments)]
-fn emission_by_bsdf<const N: usize>(
-    ctx: &Context,
-    sp: &SpawnPoint,
-    material: &Material,
-    frame: &Frame,
-    wo: Vec3,
-    beta: SampledSpectrum<N>,
-    g: &BsdfContext,
-    (u_lobe, u_dir): (f32, glam::Vec2),
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-) -> SampledSpectrum<N> {
-    let scene = ctx.scene;
-    let zero = SampledSpectrum::zero();
-    if scene.lights.is_empty() {
-        return zero;
-    }
-    let Some(bs) = material.sample(wo, u_lobe, u_dir, wl, g) else {
-        return zero;
-    };
-    let b = beta * bs.weight();
-    if b.is_zero() {
-        return zero;
-    }
-    let dir = frame.to_world(bs.wi);
-    let ray = ctx.offset.spawn(sp, dir);
-    let Some(hit) = next_hit(ctx, &ray, &mut None, counters) else {
-        let mut l = zero;
-        for &i in &scene.infinite_lights {
-            let le = scene.lights[i as usize].le(dir, wl);
-            if !le.is_zero() {
-                l += le * power_heuristic(bs.pdf, light_pdf(ctx, i as usize, sp.p, dir, None));
-            }
+impl<const N: usize> Vertex<'_, N> {
+    /// Next-event estimation: a light sample weighted by the power heuristic against the
+    /// non-delta lobes' density.
+    fn direct_light(
+        &self,
+        ctx: &Context,
+        u_light: f32,
+        u_point: glam::Vec2,
+        wl: &SampledWavelengths<N>,
+        counters: &mut TraceCounters,
+    ) -> SampledSpectrum<N> {
+        let zero = SampledSpectrum::zero();
+        let Some(cl) = sample_light(ctx, self.sp.p, u_light, u_point, wl) else {
+            return zero;
+        };
+        let ls = &cl.sample;
+        let wi = self.frame.to_local(ls.wi);
+        let f = self.material.eval(self.wo, wi, wl, &self.bsdf).f * wi.z.abs();
+        if f.is_zero() {
+            return zero;
         }
-        return b * l;
-    };
-    let light = scene.shapes[hit.geom_id as usize].light;
-    if light == NO_LIGHT {
-        return zero;
+        let Some(q) = ctx.offset.shadow(&self.sp, ls.wi, ls.dist, &ls.target()) else {
+            return zero;
+        };
+        counters.shadow_rays += 1;
+        if ctx.accel.occluded1(&q) {
+            return zero;
+        }
+        let weight = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(cl.pdf, self.material.pdf(self.wo, wi, wl, &self.bsdf))
+        };
+        self.beta * f * ls.l * (weight / cl.pdf)
     }
-    let (it, _) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
-    let le = scene.lights[light as usize].l(it.n_outward, -dir, wl);
-    if le.is_zero() {
-        return zero;
+
+    /// The emission a BSDF sample reaches directly (an area light, or the sky and the
+    /// sun's disk beyond the scene), weighted by the power heuristic against light
+    /// sampling: the other half of [`Vertex::direct_light`]'s estimate.
+    fn emission_by_bsdf(
+        &self,
+        ctx: &Context,
+        u_lobe: f32,
+        u_dir: glam::Vec2,
+        wl: &SampledWavelengths<N>,
+        counters: &mut TraceCounters,
+    ) -> SampledSpectrum<N> {
+        let scene = ctx.scene;
+        let zero = SampledSpectrum::zero();
+        if scene.lights.is_empty() {
+            return zero;
+        }
+        let Some(bs) = self.material.sample(self.wo, u_lobe, u_dir, wl, &self.bsdf) else {
+            return zero;
+        };
+        let b = self.beta * bs.weight();
+        if b.is_zero() {
+            return zero;
+        }
+        let (p, dir) = (self.sp.p, self.frame.to_world(bs.wi));
+        let ray = ctx.offset.spawn(&self.sp, dir);
+        let Some(hit) = next_hit(ctx, &ray, &mut None, counters) else {
+            let mut l = zero;
+            for &i in &scene.infinite_lights {
+                let le = scene.lights[i as usize].le(dir, wl);
+                if !le.is_zero() {
+                    l += le * power_heuristic(bs.pdf, light_pdf(ctx, i as usize, p, dir, None));
+                }
+            }
+            return b * l;
+        };
+        let light = scene.shapes[hit.geom_id as usize].light;
+        if light == NO_LIGHT {
+            return zero;
+        }
+        let (it, _) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
+        let le = scene.lights[light as usize].l(it.n_outward, -dir, wl);
+        if le.is_zero() {
+            return zero;
+        }
+        let hp = SurfacePoint {
+            p: it.position,
+            n: it.n_outward,
+        };
+        b * le * power_heuristic(bs.pdf, light_pdf(ctx, light as usize, p, dir, Some(&hp)))
     }
-    let hp = SurfacePoint {
-        p: it.position,
-        n: it.n_outward,
-    };
-    b * le * power_heuristic(bs.pdf, light_pdf(ctx, light as usize, sp.p, dir, Some(&hp)))
 }
 
 /// The visible points of one iteration in a hashed uniform grid (Hachisuka & Jensen
@@ -682,7 +669,6 @@ pub fn iteration<const N: usize>(
         shadow_rays: a.shadow_rays + b.shadow_rays,
     };
 
-    let t0 = std::time::Instant::now();
     // 1. Camera pass, a row per task.
     let mut l = vec![SampledSpectrum::<N>::zero(); npix];
     let mut vps: Vec<Option<VisiblePoint<N>>> = vec![None; npix];
@@ -742,10 +728,8 @@ pub fn iteration<const N: usize>(
         })
         .collect();
 
-    let t1 = std::time::Instant::now();
     // 2. Photon pass, a chunk of photons per task.
     let grid = Grid::build(&vps, &pixels.r2);
-    let t2 = std::time::Instant::now();
     let photons = PhotonSums::new(npix, settings.spectral_bins, &wl);
     let m = settings.sppm.photons_for(w * h);
     let gather = Gather {
@@ -781,10 +765,6 @@ pub fn iteration<const N: usize>(
         })
         .reduce(TraceCounters::default, sum);
 
-    let t3 = std::time::Instant::now();
-    if std::env::var_os("HERON_SPPM_TIMING").is_some() {
-        eprintln!("TIMING camera {:?} grid {:?} ({} entries) photons {:?}", t1 - t0, t2 - t1, grid.entries.len(), t3 - t2);
-    }
     // 3. The radii.
     for i in 0..npix {
         let got = photons.count[i].load(Relaxed);

@@ -51,3 +51,42 @@ medium = {medium}
 "#
     )
 }
+
+/// A dense-flint ball (N-SF11) on a white floor under a small spherical area light, seen
+/// by a `width` × `height` camera, paths of up to 8 events: its caustic is refraction
+/// paths only, which end the companion wavelengths at every refraction
+/// (`tests/transport.rs`, `tests/sppm.rs`).
+pub fn flint_caustic(width: u32, height: u32) -> String {
+    format!(
+        r#"
+[camera]
+eye = [0.0, 1.2, 2.2]
+look_at = [0.0, 0.2, 0.0]
+resolution = [{width}, {height}]
+[render]
+max_depth = 8
+[materials.floor]
+type = "lambertian"
+rho_d = 0.8
+[materials.flint]
+type = "dielectric"
+ior = "N-SF11"
+[[shapes]]
+type = "quad"
+origin = [-2.0, 0.0, 2.0]
+edge1 = [4.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -4.0]
+material = "floor"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.4, 0.0]
+radius = 0.4
+material = "flint"
+[[shapes]]
+type = "sphere"
+center = [0.6, 1.6, 0.2]
+radius = 0.3
+emission = {{ spectrum = "E", scale = 20.0 }}
+"#
+    )
+}
