@@ -573,10 +573,6 @@ unsafe fn fill_packet<const W: usize>(
                 };
                 let (ox, oy, oz, tnear) = transpose(a0, a1, a2, a3);
                 let (dx, dy, dz, tfar) = transpose(b0, b1, b2, b3);
-                let fields = [ox, oy, oz, tnear, dx, dy, dz, zero, tfar, ones, zero, zero];
-                for (f, v) in fields.into_iter().enumerate() {
-                    _mm_store_ps(p.add(f * W + k), v);
-                }
                 // valid_ray, four lanes at once: x - x is 0 for a finite x and NaN for
                 // ±inf and NaN, and a NaN survives the sum (IEEE 754 §6.2).
                 let d = |v| _mm_sub_ps(v, v);
@@ -594,6 +590,31 @@ unsafe fn fill_packet<const W: usize>(
                 );
                 let bits = _mm_and_si128(_mm_set1_epi32((active >> k) as i32), lane_bits);
                 let on = _mm_and_ps(ok, _mm_castsi128_ps(_mm_cmpeq_epi32(bits, lane_bits)));
+                let mut fields = [ox, oy, oz, tnear, dx, dy, dz, zero, tfar, ones, zero, zero];
+                if W == 16 {
+                    // Embree 3 on a CPU without AVX-512 answers 16-wide queries by
+                    // splitting them, and its Debian build asserts that every lane it
+                    // then traces is a valid ray, whatever the mask says: inactive lanes
+                    // get the ray from the origin along +z with tnear = tfar = 0, and the
+                    // caller reads only active lanes' hits. (Compiled out at W = 4, 8.)
+                    let safe = [
+                        zero,
+                        zero,
+                        zero,
+                        zero,
+                        zero,
+                        zero,
+                        _mm_set1_ps(1.0),
+                        zero,
+                        zero,
+                    ];
+                    for (v, s) in fields.iter_mut().zip(safe) {
+                        *v = _mm_or_ps(_mm_and_ps(on, *v), _mm_andnot_ps(on, s));
+                    }
+                }
+                for (f, v) in fields.into_iter().enumerate() {
+                    _mm_store_ps(p.add(f * W + k), v);
+                }
                 _mm_store_ps(valid.add(k).cast::<f32>(), on);
                 any = _mm_or_ps(any, on);
                 k += 4;
@@ -727,8 +748,11 @@ macro_rules! packet_query {
                     v: rh.hit.v[i],
                 };
                 // Embree writes hit lanes only, so a lane that is inactive or missed still
-                // holds the invalid geometry ID.
-                let hit = |i: usize| rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID;
+                // holds the invalid geometry ID; the mask is tested too, for the inactive
+                // lanes a split 16-wide query may trace (`fill_packet`).
+                let hit = |i: usize| {
+                    (valid.0[i] != 0) & (rh.hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID)
+                };
                 if let Some(rec) = rec {
                     let hits: [Option<Hit>; $w] = std::array::from_fn(|i| hit(i).then(|| lane(i)));
                     rec.packet(false, rays, lane_bits(&valid.0), coherent, &hits, 0);
