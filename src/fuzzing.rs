@@ -291,6 +291,7 @@ pub fn obj(data: &[u8]) -> Outcome {
         groups: BTreeMap::new(),
         scale: None,
         translate: None,
+        transform: None,
         emission: None,
         two_sided: None,
         medium: None,

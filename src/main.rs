@@ -29,6 +29,10 @@ enum Command {
     /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview, or (with -o
     /// FILE.heronfilm, e.g. one shard of a render) to a film file for heron merge.
     Render(RenderArgs),
+    /// Convert a Mitsuba 3 scene (.xml) to heron's TOML: the scene heron renders from it,
+    /// opened by a comment listing what was not carried over as written (also printed as
+    /// warnings).
+    Convert(ConvertArgs),
     /// Merge the film files of a sharded render (heron render --shard K/N -o
     /// part-K.heronfilm) into its EXR and PNG: byte-identical to one heron render with all
     /// the samples, whatever the number of shards and the order of the parts.
@@ -78,6 +82,98 @@ enum Command {
         /// Scene file (TOML).
         scene: PathBuf,
     },
+}
+
+/// How a scene in another renderer's format is imported (heron render, heron convert).
+#[derive(clap::Args, Clone, Default)]
+struct ImportArgs {
+    /// Scenes in another renderer's format (.xml): fail on the first element or parameter
+    /// heron does not carry over, instead of warning.
+    #[arg(long)]
+    strict: bool,
+    /// Mitsuba 3 XML: set the parameter $NAME (as Mitsuba's -D NAME=VALUE), overriding the
+    /// file's <default>. Repeatable.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
+    define: Vec<(String, String)>,
+}
+
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v)) if !k.is_empty() => Ok((k.to_string(), v.to_string())),
+        _ => Err(format!("expected NAME=VALUE, got {s:?}")),
+    }
+}
+
+impl ImportArgs {
+    fn options(&self) -> heron::scene::import::ImportOptions {
+        heron::scene::import::ImportOptions {
+            strict: self.strict,
+            defines: self.define.iter().cloned().collect(),
+        }
+    }
+}
+
+/// The scene at `path`: heron's TOML, or a converted scene of another format (its
+/// warnings printed).
+fn load_any_scene(path: &Path, import: &ImportArgs) -> anyhow::Result<heron::scene::Scene> {
+    use heron::scene::import::{import_scene, Format};
+    if Format::of(path) == Format::Heron {
+        if import.strict || !import.define.is_empty() {
+            anyhow::bail!("--strict and --define apply to scenes in another renderer's format (.xml), not to heron's TOML");
+        }
+        return Ok(load_scene(path)?);
+    }
+    let imported = import_scene(path, &import.options())?;
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(heron::scene::load::load_imported(&imported)?)
+}
+
+#[derive(clap::Args)]
+struct ConvertArgs {
+    /// The scene: Mitsuba 3 XML (.xml).
+    scene: PathBuf,
+    /// The TOML file to write (mesh paths are written relative to its folder).
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    import: ImportArgs,
+}
+
+fn cmd_convert(a: ConvertArgs) -> anyhow::Result<()> {
+    use heron::scene::import::{import_scene, Format};
+    if Format::of(&a.scene) == Format::Heron {
+        anyhow::bail!(
+            "{}: expected a Mitsuba 3 scene (.xml); heron's TOML needs no conversion",
+            a.scene.display()
+        );
+    }
+    let imported = import_scene(&a.scene, &a.import.options())?;
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    // The conversion must be a scene heron renders; its errors are found before writing.
+    heron::scene::load::load_imported(&imported)?;
+    let dir = match a.output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let text = imported.to_toml(&dir);
+    heron::files::write_atomically(&a.output, |tmp| {
+        std::fs::write(tmp, &text).map_err(|e| e.to_string())
+    })?;
+    eprintln!(
+        "{}: written, {} warning{}",
+        a.output.display(),
+        imported.warnings.len(),
+        if imported.warnings.len() == 1 {
+            ""
+        } else {
+            "s"
+        }
+    );
+    Ok(())
 }
 
 #[derive(clap::Args)]
@@ -630,8 +726,10 @@ struct DisplayCmdArgs {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// Scene file (TOML).
+    /// Scene file: heron's TOML, or Mitsuba 3 XML (.xml), converted as heron convert does.
     scene: PathBuf,
+    #[command(flatten)]
+    import: ImportArgs,
     /// Output EXR path; the PNG preview goes next to it with the extension .png. A path
     /// ending in .heronfilm writes the film's unnormalised sums instead (for heron merge).
     #[arg(short, long)]
@@ -932,6 +1030,7 @@ fn main() {
     };
     let result = match cli.command {
         Command::Render(args) => cmd_render(args),
+        Command::Convert(args) => cmd_convert(args),
         Command::Merge(args) => cmd_merge(args),
         Command::Trace(args) => cmd_trace(args),
         Command::Converge(args) => cmd_converge(args),
@@ -1037,7 +1136,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     };
     // Before the scene loads, which may take seconds (sky and medium tables).
     settings_args.check().map_err(anyhow::Error::msg)?;
-    let scene = load_scene(&args.scene)?;
+    let scene = load_any_scene(&args.scene, &args.import)?;
     let mut opts = RenderOptions::from_scene(&scene);
     opts.settings
         .apply(&settings_args)

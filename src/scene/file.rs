@@ -461,7 +461,7 @@ pub struct WaveFile {
     pub phase: f32,
 }
 
-/// A Wavefront OBJ triangle mesh.
+/// A triangle mesh: a Wavefront OBJ file, or a PLY file (by its `.ply` extension).
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshFile {
@@ -480,6 +480,10 @@ pub struct MeshFile {
     /// Default `[0, 0, 0]`.
     #[serde(default)]
     pub translate: Option<Point3>,
+    /// An affine 4×4 matrix, row by row (last row `[0, 0, 0, 1]`), applied after
+    /// `scale` and `translate`: Mitsuba's `to_world`, as `heron convert` writes it.
+    #[serde(default)]
+    pub transform: Option<Vec<Vec<f64>>>,
     /// Radiance emitted by every triangle of the mesh: it becomes an area light.
     #[serde(default)]
     pub emission: Option<Emission>,

@@ -3,6 +3,7 @@
 pub mod export;
 pub mod features;
 pub mod file;
+pub mod import;
 pub mod load;
 
 pub use features::Features;

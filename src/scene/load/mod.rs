@@ -25,6 +25,7 @@
 //! (`[sky]` to a [`crate::sky::SkySpec`]), `settings.rs` (`[render]`), `camera.rs`.
 //! [`build`] runs them in the order of the errors they report.
 pub(crate) mod obj;
+mod ply;
 
 mod camera;
 mod errors;
@@ -51,9 +52,32 @@ use std::path::Path;
 /// Reads, parses and validates the scene file at `path` (meshes are resolved relative to
 /// it). Every error names the file, the key path and what was expected.
 pub fn load_scene(path: &Path) -> Result<Scene> {
+    if super::import::Format::of(path) != super::import::Format::Heron {
+        let imported = super::import::import_scene(path, &Default::default())?;
+        for w in &imported.warnings {
+            eprintln!("heron: warning: {w}");
+        }
+        return load_imported(&imported);
+    }
     let text = std::fs::read_to_string(path)
         .map_err(|e| scene_error(path, format!("cannot read the scene file: {e}")))?;
     load_scene_from_str(&text, path)
+}
+
+/// The scene of a converted file ([`super::import`]); its errors name the source
+/// file and the key of the converted scene, which `heron convert` writes out.
+pub fn load_imported(imported: &super::import::Imported) -> Result<Scene> {
+    let dir = imported.source.parent().unwrap_or(Path::new(""));
+    let text = imported.to_toml(dir);
+    load_scene_from_str(&text, &imported.source).map_err(|e| match e {
+        crate::error::HeronError::Scene { file, message } if file == imported.source => {
+            crate::error::HeronError::Scene {
+                file,
+                message: format!("in the converted scene (heron convert writes it): {message}"),
+            }
+        }
+        e => e,
+    })
 }
 
 /// Like [`load_scene`] for scene text already in memory; `path` names the file in error

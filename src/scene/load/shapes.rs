@@ -10,7 +10,7 @@ use crate::geometry::{Mesh, Shape, ShapeKind, MIN_RELATIVE_RADIUS};
 use crate::scene::file::{
     fmt_f32, MeshFile, PlaneFile, QuadFile, ShapeFile, SphereFile, TriangleFile, WavesFile,
 };
-use glam::Vec3;
+use glam::{DMat4, Vec3};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -391,12 +391,33 @@ fn build_mesh(
     }
 
     let mesh_path: PathBuf = base_dir.join(&m.file);
-    let text = std::fs::read_to_string(&mesh_path).map_err(|e| {
+    let read_error = |e: std::io::Error| {
         scene_error(
             &mesh_path,
             format!("{at}.file: cannot read the mesh file: {e}"),
         )
-    })?;
+    };
+    let is_ply = mesh_path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+    if is_ply {
+        let bytes = std::fs::read(&mesh_path).map_err(read_error)?;
+        let stem = mesh_path
+            .file_stem()
+            .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+        let groups = super::ply::parse_ply(&bytes, &stem)
+            .map_err(|msg| scene_error(&mesh_path, format!("{at}.file: {msg}")))?;
+        return shapes_of_groups(
+            groups,
+            scene_path,
+            &mesh_path,
+            at,
+            m,
+            &group_material,
+            default_material,
+        );
+    }
+    let text = std::fs::read_to_string(&mesh_path).map_err(read_error)?;
     mesh_shapes(
         &text,
         scene_path,
@@ -406,6 +427,42 @@ fn build_mesh(
         &group_material,
         default_material,
     )
+}
+
+/// A mesh entry's `transform`: four rows of four finite numbers, the last `[0, 0, 0,
+/// 1]`, invertible.
+fn mesh_transform(
+    at: &str,
+    t: &Option<Vec<Vec<f64>>>,
+) -> std::result::Result<Option<DMat4>, String> {
+    let Some(rows) = t else {
+        return Ok(None);
+    };
+    let bad = || {
+        format!("{at}.transform: expected four rows of four finite numbers, the last [0, 0, 0, 1] (an affine matrix), got {rows:?}")
+    };
+    if rows.len() != 4
+        || rows
+            .iter()
+            .any(|r| r.len() != 4 || r.iter().any(|x| !x.is_finite()))
+    {
+        return Err(bad());
+    }
+    if rows[3] != [0.0, 0.0, 0.0, 1.0] {
+        return Err(bad());
+    }
+    let m = DMat4::from_cols_array_2d(&[
+        [rows[0][0], rows[1][0], rows[2][0], 0.0],
+        [rows[0][1], rows[1][1], rows[2][1], 0.0],
+        [rows[0][2], rows[1][2], rows[2][2], 0.0],
+        [rows[0][3], rows[1][3], rows[2][3], 1.0],
+    ]);
+    if m.determinant() == 0.0 || !m.determinant().is_finite() {
+        return Err(format!(
+            "{at}.transform: expected an invertible matrix, got determinant 0"
+        ));
+    }
+    Ok(Some(m))
 }
 
 /// The shapes of mesh entry `m` (at key path `at`) from the text of its OBJ file
@@ -421,6 +478,30 @@ pub(crate) fn mesh_shapes(
 ) -> Result<Vec<Shape>> {
     let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
     let groups = obj::parse_obj(text).map_err(merr)?;
+    shapes_of_groups(
+        groups,
+        scene_path,
+        mesh_path,
+        at,
+        m,
+        group_material,
+        default_material,
+    )
+}
+
+/// The shapes of mesh entry `m` from its file's groups (OBJ objects and groups, or the
+/// one group of a PLY file).
+fn shapes_of_groups(
+    groups: Vec<obj::ObjGroup>,
+    scene_path: &Path,
+    mesh_path: &Path,
+    at: &str,
+    m: &MeshFile,
+    group_material: &BTreeMap<&str, u32>,
+    default_material: Option<u32>,
+) -> Result<Vec<Shape>> {
+    let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
+    let transform = mesh_transform(at, &m.transform).map_err(|msg| scene_error(scene_path, msg))?;
 
     for g in m.groups.keys() {
         if !groups.iter().any(|x| &x.name == g) {
@@ -484,7 +565,10 @@ pub(crate) fn mesh_shapes(
             }
         };
         for tri in &g.indices {
-            let p = tri.map(|i| g.positions[i as usize] * scale + translate);
+            let mut p = tri.map(|i| g.positions[i as usize] * scale + translate);
+            if let Some(t) = &transform {
+                p = p.map(|v| t.transform_point3(v.as_dvec3()).as_vec3());
+            }
             if p.iter().any(|x| !x.is_finite()) {
                 return Err(merr(format!(
                     "a vertex of object {:?} is not finite after scale {} and translate {}",

@@ -1,0 +1,221 @@
+//! Mitsuba 3's XML scene format as a tree of [`Node`]s with their file and line, after
+//! the document-level rules of Mitsuba's loader (`src/core/xml.cpp`): `<default>`
+//! parameters and `$name` substitution in attribute values, `<include filename=…>`
+//! spliced in place, and every element's `id` collected so that `<ref id=…>` can be
+//! resolved by the converter. The format is documented in Mitsuba 3's "File format"
+//! chapter (mitsuba.readthedocs.io, "Scene XML file format").
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Includes nested deeper than this are taken for a cycle.
+const MAX_INCLUDE_DEPTH: usize = 16;
+
+/// One XML element: its tag, attributes (after `$name` substitution), the file and line
+/// it was read from, and its element children (includes already spliced in).
+#[derive(Clone, Debug)]
+pub struct Node {
+    pub tag: String,
+    pub attrs: Vec<(String, String)>,
+    pub file: Arc<PathBuf>,
+    pub line: u32,
+    pub children: Vec<Node>,
+}
+
+/// A problem at a place in a file: errors and warnings alike.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diagnostic {
+    pub file: PathBuf,
+    pub line: u32,
+    pub message: String,
+}
+
+impl std::fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: line {}: {}",
+            self.file.display(),
+            self.line,
+            self.message
+        )
+    }
+}
+
+impl Node {
+    pub fn attr(&self, name: &str) -> Option<&str> {
+        self.attrs
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// A diagnostic at this element, its message prefixed by how the element reads
+    /// (`<bsdf type="diffuse">`).
+    pub fn diag(&self, message: impl std::fmt::Display) -> Diagnostic {
+        Diagnostic {
+            file: self.file.as_ref().clone(),
+            line: self.line,
+            message: format!("{}: {message}", self.describe()),
+        }
+    }
+
+    /// `<tag type="…" name="…">` with the attributes that identify the element.
+    pub fn describe(&self) -> String {
+        let mut s = format!("<{}", self.tag);
+        for key in ["type", "name", "id"] {
+            if let Some(v) = self.attr(key) {
+                s.push_str(&format!(" {key}=\"{v}\""));
+            }
+        }
+        s.push('>');
+        s
+    }
+}
+
+/// The document of `path`: its root `<scene>` element with includes spliced in and
+/// defaults substituted; `defines` override `<default>` values (as Mitsuba's `-D`).
+pub fn read_document(path: &Path, defines: &BTreeMap<String, String>) -> Result<Node, Diagnostic> {
+    let mut params = defines.clone();
+    read_file(path, &mut params, defines, 0, None)
+}
+
+/// Reads one file; `params` holds the `<default>`s seen so far (includes share their
+/// parent's), `defines` the caller's overrides, `from` the including element.
+fn read_file(
+    path: &Path,
+    params: &mut BTreeMap<String, String>,
+    defines: &BTreeMap<String, String>,
+    depth: usize,
+    from: Option<&Node>,
+) -> Result<Node, Diagnostic> {
+    let at_from = |message: String| match from {
+        Some(n) => n.diag(message),
+        None => Diagnostic {
+            file: path.to_path_buf(),
+            line: 1,
+            message,
+        },
+    };
+    if depth > MAX_INCLUDE_DEPTH {
+        return Err(at_from(format!(
+            "includes nested more than {MAX_INCLUDE_DEPTH} deep (does {} include itself?)",
+            path.display()
+        )));
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| at_from(format!("cannot read {}: {e}", path.display())))?;
+    let file = Arc::new(path.to_path_buf());
+    let doc = roxmltree::Document::parse(&text).map_err(|e| {
+        let pos = e.pos();
+        Diagnostic {
+            file: file.as_ref().clone(),
+            line: pos.row,
+            message: format!("malformed XML: {e}"),
+        }
+    })?;
+    let root = doc.root_element();
+    if root.tag_name().name() != "scene" {
+        return Err(Diagnostic {
+            file: file.as_ref().clone(),
+            line: doc.text_pos_at(root.range().start).row,
+            message: format!(
+                "expected the root element <scene> of a Mitsuba 3 scene, got <{}>",
+                root.tag_name().name()
+            ),
+        });
+    }
+    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    convert(&doc, root, &file, &base, params, defines, depth)
+}
+
+fn convert(
+    doc: &roxmltree::Document,
+    el: roxmltree::Node,
+    file: &Arc<PathBuf>,
+    base: &Path,
+    params: &mut BTreeMap<String, String>,
+    defines: &BTreeMap<String, String>,
+    depth: usize,
+) -> Result<Node, Diagnostic> {
+    let line = doc.text_pos_at(el.range().start).row;
+    let tag = el.tag_name().name().to_string();
+    let mut node = Node {
+        tag,
+        attrs: Vec::new(),
+        file: file.clone(),
+        line,
+        children: Vec::new(),
+    };
+    for a in el.attributes() {
+        let value = substitute(a.value(), params).map_err(|m| node.diag(m))?;
+        node.attrs.push((a.name().to_string(), value));
+    }
+    for child in el.children().filter(|c| c.is_element()) {
+        let c = convert(doc, child, file, base, params, defines, depth)?;
+        match c.tag.as_str() {
+            "default" => {
+                let (Some(name), Some(value)) = (c.attr("name"), c.attr("value")) else {
+                    return Err(c.diag("expected the attributes name and value"));
+                };
+                // A define given by the caller wins over the file's default.
+                if !defines.contains_key(name) {
+                    params.insert(name.to_string(), value.to_string());
+                }
+            }
+            "include" => {
+                let Some(f) = c.attr("filename") else {
+                    return Err(c.diag("expected the attribute filename"));
+                };
+                let included = read_file(&base.join(f), params, defines, depth + 1, Some(&c))?;
+                node.children.extend(included.children);
+            }
+            _ => node.children.push(c),
+        }
+    }
+    Ok(node)
+}
+
+/// `value` with each `$name` replaced by its parameter; an unknown one is an error.
+fn substitute(value: &str, params: &BTreeMap<String, String>) -> Result<String, String> {
+    if !value.contains('$') {
+        return Ok(value.to_string());
+    }
+    let mut out = String::new();
+    let mut rest = value;
+    while let Some(i) = rest.find('$') {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i + 1..];
+        let end = tail
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(tail.len());
+        let name = &tail[..end];
+        match params.get(name) {
+            Some(v) => out.push_str(v),
+            None => {
+                return Err(format!(
+                    "${name} is not defined (expected a <default name=\"{name}\" value=\"…\"/> before it, or -D {name}=…)"
+                ))
+            }
+        }
+        rest = &tail[end..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn substitution_replaces_every_parameter_and_names_an_unknown_one() {
+        let mut p = BTreeMap::new();
+        p.insert("spp".to_string(), "64".to_string());
+        p.insert("res".to_string(), "256".to_string());
+        assert_eq!(substitute("$spp", &p).unwrap(), "64");
+        assert_eq!(substitute("$res, $res", &p).unwrap(), "256, 256");
+        let e = substitute("$nope", &p).unwrap_err();
+        assert!(e.contains("$nope is not defined"), "{e}");
+    }
+}

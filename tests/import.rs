@@ -1,0 +1,540 @@
+//! Mitsuba 3 XML scenes through heron's importer (`heron::scene::import`): each
+//! supported element converted to the heron scene it should be, the Cornell box written
+//! as XML rendering exactly the pixels of heron's own `cornell-box.toml`, meshes (OBJ
+//! and PLY with a `to_world`) placed where the transform puts them, what heron does not
+//! support named in a warning with its line (an error under `--strict`), and malformed
+//! files as one-line errors naming the file and line.
+mod common;
+
+use common::render::run;
+use glam::{DMat4, DVec3};
+use heron::geometry::ShapeKind;
+use heron::scene::import::{import_scene, ImportOptions, Imported};
+use heron::scene::load::{load_imported, load_scene};
+use heron::settings::IntegratorKind;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A scene around `body` with a sensor, so that the body's elements are what is tested.
+fn scene(body: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="45"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="20"/><rfilter type="box"/></film>
+    </sensor>
+{body}
+</scene>
+"#
+    )
+}
+
+fn import_text(text: &str) -> (tempfile::TempDir, heron::error::Result<Imported>) {
+    import_with(text, &ImportOptions::default())
+}
+
+fn import_with(
+    text: &str,
+    o: &ImportOptions,
+) -> (tempfile::TempDir, heron::error::Result<Imported>) {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "scene.xml", text);
+    let r = import_scene(&p, o);
+    (dir, r)
+}
+
+fn get<'a>(t: &'a toml::Table, path: &str) -> &'a toml::Value {
+    let mut v: Option<&toml::Value> = None;
+    let mut cur = t;
+    for (i, key) in path.split('.').enumerate() {
+        let next = match key.parse::<usize>() {
+            Ok(k) => v.and_then(|x| x.get(k)),
+            Err(_) if i == 0 => cur.get(key),
+            Err(_) => v.and_then(|x| x.get(key)),
+        };
+        v = Some(next.unwrap_or_else(|| panic!("no {path} in {t:#?}")));
+        if let Some(tt) = v.unwrap().as_table() {
+            cur = tt;
+        }
+    }
+    v.unwrap()
+}
+
+fn f(v: &toml::Value) -> f64 {
+    v.as_float().or(v.as_integer().map(|i| i as f64)).unwrap()
+}
+
+fn v3(v: &toml::Value) -> DVec3 {
+    let a = v.as_array().unwrap();
+    DVec3::new(f(&a[0]), f(&a[1]), f(&a[2]))
+}
+
+#[test]
+fn the_cornell_box_as_mitsuba_xml_renders_the_pixels_of_heron_s_own_file() {
+    let xml = load_scene(&repo().join("scenes/mitsuba/cornell-box.xml")).unwrap();
+    let toml = load_scene(&repo().join("scenes/cornell-box.toml")).unwrap();
+    // Mitsuba's max_depth 8 counts the emitter's vertex: heron's 7, as the TOML says.
+    assert_eq!(xml.settings.max_depth, toml.settings.max_depth);
+    assert_eq!(xml.settings.integrator, IntegratorKind::Path);
+    assert_eq!((xml.camera.width, xml.camera.height), (256, 256));
+    assert!(
+        (xml.camera.d - toml.camera.d).abs() < 1e-6,
+        "{} {}",
+        xml.camera.d,
+        toml.camera.d
+    );
+    let mut a = xml;
+    let mut b = toml;
+    a.camera = a.camera.resized(24, 24).unwrap();
+    b.camera = b.camera.resized(24, 24).unwrap();
+    let fa = run(&a, IntegratorKind::Path, 8, 3);
+    let fb = run(&b, IntegratorKind::Path, 8, 3);
+    // The same quads to f32 rounding, the same materials and light: the same samples.
+    assert_eq!(fa.xyz, fb.xyz);
+}
+
+#[test]
+fn sensor_film_sampler_and_integrator_convert_with_mitsuba_s_conventions() {
+    let text = r#"<scene version="3.0.0">
+    <default name="spp" value="32"/>
+    <integrator type="volpath"><integer name="max_depth" value="-1"/><integer name="rr_depth" value="5"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="60"/>
+        <transform name="to_world">
+            <lookat origin="1, 2, 3" target="1, 2, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent"><integer name="sample_count" value="$spp"/><integer name="seed" value="7"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="300"/><integer name="height" value="200"/><rfilter type="box"/></film>
+    </sensor>
+</scene>"#;
+    let (_d, r) = import_text(text);
+    let t = r.unwrap().table;
+    assert_eq!(v3(get(&t, "camera.eye")), DVec3::new(1.0, 2.0, 3.0));
+    assert_eq!(v3(get(&t, "camera.look_at")), DVec3::new(1.0, 2.0, 2.0));
+    assert_eq!(v3(get(&t, "camera.up")), DVec3::Y);
+    // fov_axis x (Mitsuba's default): the horizontal field is 60°, heron's d is the
+    // distance to an image plane of height 1, width 1.5.
+    let d = f(get(&t, "camera.d"));
+    let fov_x = 2.0 * (0.75 / d).atan();
+    assert!(
+        (fov_x.to_degrees() - 60.0).abs() < 1e-9,
+        "{}",
+        fov_x.to_degrees()
+    );
+    assert_eq!(get(&t, "render.spp").as_integer(), Some(32));
+    assert_eq!(get(&t, "render.seed").as_integer(), Some(7));
+    assert_eq!(get(&t, "render.integrator").as_str(), Some("path"));
+    assert_eq!(
+        get(&t, "render.max_depth").as_integer(),
+        Some(heron::scene::import::UNBOUNDED_DEPTH)
+    );
+    assert_eq!(get(&t, "render.rr_depth").as_integer(), Some(4));
+
+    // fov_axis y, and a focal length (36 mm along the longer side of the image, as
+    // Mitsuba 3.9 computes its x_fov), and -D overriding a default.
+    for (fov, axis, want_tan_y) in [
+        (
+            "<float name=\"fov\" value=\"30\"/>",
+            "y",
+            (15f64).to_radians().tan(),
+        ),
+        (
+            "<string name=\"focal_length\" value=\"50mm\"/>",
+            "x",
+            18.0 / 50.0 / 1.5,
+        ),
+    ] {
+        let text = text.replace(
+            "<float name=\"fov\" value=\"60\"/>",
+            &format!("{fov}<string name=\"fov_axis\" value=\"{axis}\"/>"),
+        );
+        let mut o = ImportOptions::default();
+        o.defines.insert("spp".into(), "9".into());
+        let (_d, r) = import_with(&text, &o);
+        let t = r.unwrap().table;
+        let tan_y = 0.5 / f(get(&t, "camera.d"));
+        assert!(
+            (tan_y - want_tan_y).abs() < 1e-12,
+            "{fov}: {tan_y} vs {want_tan_y}"
+        );
+        assert_eq!(get(&t, "render.spp").as_integer(), Some(9));
+    }
+}
+
+#[test]
+fn bsdfs_convert_to_heron_materials_and_say_what_changes() {
+    let body = r#"
+    <bsdf type="twosided" id="wall"><bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.4, 0.6"/></bsdf></bsdf>
+    <bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>
+    <bsdf type="dielectric" id="resin"><float name="int_ior" value="1.55"/><float name="ext_ior" value="1.33"/></bsdf>
+    <bsdf type="roughdielectric" id="frosted"><float name="alpha" value="0.2"/><string name="distribution" value="ggx"/><string name="int_ior" value="acrylic glass"/></bsdf>
+    <bsdf type="conductor" id="gold"><string name="material" value="Au"/></bsdf>
+    <bsdf type="conductor" id="mirror"/>
+    <bsdf type="roughconductor" id="brushed"><string name="material" value="Al"/><float name="alpha" value="0.3"/></bsdf>
+    <bsdf type="conductor" id="custom"><float name="eta" value="0.2"/><float name="k" value="3.1"/></bsdf>
+    <bsdf type="roughplastic" id="plastic"><rgb name="diffuse_reflectance" value="0.5, 0.5, 0.5"/><float name="alpha" value="0.1"/></bsdf>
+    <shape type="sphere"><ref id="wall"/></shape>
+    <shape type="sphere"><ref id="glass"/></shape>
+    <shape type="sphere"><ref id="resin"/></shape>
+    <shape type="sphere"><ref id="frosted"/></shape>
+    <shape type="sphere"><ref id="gold"/></shape>
+    <shape type="sphere"><ref id="mirror"/></shape>
+    <shape type="sphere"><ref id="brushed"/></shape>
+    <shape type="sphere"><ref id="custom"/></shape>
+    <shape type="sphere"><ref id="plastic"/></shape>
+    <shape type="sphere"/>
+"#;
+    let (_d, r) = import_text(&scene(body));
+    let imp = r.unwrap();
+    let t = &imp.table;
+    assert_eq!(get(t, "materials.wall.type").as_str(), Some("lambertian"));
+    assert_eq!(
+        v3(get(t, "materials.wall.rho_d")),
+        DVec3::new(0.2, 0.4, 0.6)
+    );
+    // Named Mitsuba glasses heron has in its catalogue keep their dispersion.
+    assert_eq!(get(t, "materials.glass.ior").as_str(), Some("N-BK7"));
+    assert_eq!(f(get(t, "materials.glass.outside_ior")), 1.000277);
+    assert_eq!(f(get(t, "materials.resin.ior")), 1.55);
+    assert_eq!(f(get(t, "materials.resin.outside_ior")), 1.33);
+    assert_eq!(f(get(t, "materials.frosted.ior")), 1.49);
+    assert_eq!(f(get(t, "materials.frosted.roughness")), 0.2);
+    assert_eq!(get(t, "materials.gold.metal").as_str(), Some("Au"));
+    assert_eq!(get(t, "materials.mirror.type").as_str(), Some("mirror"));
+    assert_eq!(f(get(t, "materials.brushed.roughness")), 0.3);
+    assert_eq!(f(get(t, "materials.custom.metal.k")), 3.1);
+    // Plastic → glossy: ρs the Fresnel reflectance at normal incidence of 1.49 in air,
+    // the Phong exponent of Beckmann α = 0.1 (2/α² − 2 = 198).
+    let eta: f64 = 1.49 / 1.000277;
+    let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+    assert!((f(get(t, "materials.plastic.rho_s")) - f0).abs() < 1e-9);
+    assert!((f(get(t, "materials.plastic.shininess")) - 198.0).abs() < 1e-6);
+    // A shape without a BSDF gets Mitsuba's default, diffuse 0.5.
+    assert_eq!(
+        get(t, "shapes.9.material").as_str(),
+        Some("mitsuba-default-diffuse")
+    );
+    assert_eq!(f(get(t, "materials.mitsuba-default-diffuse.rho_d")), 0.5);
+    // What changes is said, with the line: bk7's dispersion, Beckmann read as GGX on the
+    // rough conductor (Mitsuba's default distribution), plastic's mapping.
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    let has = |s: &str, line: u32| {
+        imp.warnings
+            .iter()
+            .any(|d| d.message.contains(s) && d.line == line)
+    };
+    assert!(has("\"N-BK7\", with its dispersion", 9), "{w:#?}");
+    assert!(
+        has("distribution \"beckmann\" (Mitsuba's default)", 14),
+        "{w:#?}"
+    );
+    assert!(has("mapped to heron's glossy", 16), "{w:#?}");
+    // The scene loads: every table is one heron renders.
+    load_imported(&imp).unwrap();
+}
+
+#[test]
+fn shapes_and_emitters_land_where_their_transforms_put_them() {
+    let body = r#"
+    <shape type="rectangle">
+        <transform name="to_world"><scale x="2" y="3"/><rotate x="1" angle="90"/><translate y="4"/></transform>
+        <emitter type="area"><rgb name="radiance" value="5, 6, 7"/></emitter>
+    </shape>
+    <shape type="cube"><transform name="to_world"><translate x="10"/></transform></shape>
+    <shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/>
+        <transform name="to_world"><scale value="2"/><translate z="1"/></transform></shape>
+    <shape type="disk"><transform name="to_world"><translate z="-3"/></transform></shape>
+    <emitter type="point"><point name="position" value="0, 5, 0"/><rgb name="intensity" value="10"/></emitter>
+    <emitter type="directional"><vector name="direction" value="0, -1, 0"/><spectrum name="irradiance" value="2"/></emitter>
+    <emitter type="constant"><rgb name="radiance" value="0.1, 0.2, 0.3"/></emitter>
+"#;
+    let (_d, r) = import_text(&scene(body));
+    let imp = r.unwrap();
+    let t = &imp.table;
+    // The rectangle [-1, 1]² scaled, turned so its normal (+z) points down (−y), lifted.
+    let o = v3(get(t, "shapes.0.origin"));
+    let (e1, e2) = (v3(get(t, "shapes.0.edge1")), v3(get(t, "shapes.0.edge2")));
+    assert_eq!(o, DVec3::new(-2.0, 4.0, -3.0));
+    assert_eq!(e1, DVec3::new(4.0, 0.0, 0.0));
+    assert_eq!(e2, DVec3::new(0.0, 0.0, 6.0));
+    assert!(e1.cross(e2).normalize().abs_diff_eq(-DVec3::Y, 1e-12));
+    assert_eq!(v3(get(t, "shapes.0.emission")), DVec3::new(5.0, 6.0, 7.0));
+    // Six outward faces of the cube around x = 10.
+    for k in 1..=6 {
+        let s = get(t, &format!("shapes.{k}")).as_table().unwrap();
+        let (o, e1, e2) = (v3(&s["origin"]), v3(&s["edge1"]), v3(&s["edge2"]));
+        let centre = o + 0.5 * (e1 + e2);
+        let n = e1.cross(e2).normalize();
+        assert!(
+            (centre - DVec3::new(10.0, 0.0, 0.0)).dot(n) > 0.99,
+            "face {k} faces inward"
+        );
+    }
+    // The sphere: centre and radius through the uniform scale, then the translation.
+    assert_eq!(v3(get(t, "shapes.7.center")), DVec3::new(2.0, 0.0, 1.0));
+    assert_eq!(f(get(t, "shapes.7.radius")), 1.0);
+    // The disk: a fan of DISK_SEGMENTS triangles at z = −3, facing +z.
+    let n = heron::scene::import::DISK_SEGMENTS;
+    let fan: Vec<_> = (8..8 + n).map(|k| get(t, &format!("shapes.{k}"))).collect();
+    assert!(fan.iter().all(|s| s["type"].as_str() == Some("triangle")));
+    let tri = fan[0]["vertices"].as_array().unwrap();
+    let (a, b, c) = (v3(&tri[0]), v3(&tri[1]), v3(&tri[2]));
+    assert_eq!(a, DVec3::new(0.0, 0.0, -3.0));
+    assert!((b - a).cross(c - a).z > 0.0);
+    let area: f64 = fan
+        .iter()
+        .map(|s| {
+            let v = s["vertices"].as_array().unwrap();
+            let (a, b, c) = (v3(&v[0]), v3(&v[1]), v3(&v[2]));
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    assert!((area / std::f64::consts::PI - 1.0).abs() < 5e-4, "{area}");
+    assert_eq!(get(t, "lights.0.type").as_str(), Some("point"));
+    assert_eq!(v3(get(t, "lights.0.position")), DVec3::new(0.0, 5.0, 0.0));
+    assert_eq!(f(get(t, "lights.0.intensity")), 10.0);
+    assert_eq!(get(t, "lights.1.type").as_str(), Some("directional"));
+    assert_eq!(f(get(t, "lights.1.radiance")), 2.0);
+    assert_eq!(v3(get(t, "background")), DVec3::new(0.1, 0.2, 0.3));
+    let scene = load_imported(&imp).unwrap();
+    assert_eq!(scene.shapes.len(), 8 + n);
+}
+
+/// A tetrahedron as OBJ and as binary PLY: the same mesh through the same `to_world`.
+#[test]
+fn obj_and_ply_meshes_take_the_transform() {
+    let dir = tempfile::tempdir().unwrap();
+    let v = [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let faces = [[0u32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let mut obj = String::new();
+    for p in v {
+        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    for t in faces {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    std::fs::create_dir(dir.path().join("meshes")).unwrap();
+    std::fs::write(dir.path().join("meshes/tet.obj"), obj).unwrap();
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+    for p in v {
+        for c in p {
+            ply.extend(c.to_le_bytes());
+        }
+    }
+    for t in faces {
+        ply.push(3);
+        for i in t {
+            ply.extend((i as i32).to_le_bytes());
+        }
+    }
+    std::fs::write(dir.path().join("meshes/tet.ply"), ply).unwrap();
+    let tf = r#"<transform name="to_world"><scale value="2"/><rotate z="1" angle="30"/><translate x="1" y="2" z="3"/></transform>"#;
+    let xml = scene(&format!(
+        r#"<shape type="obj"><string name="filename" value="meshes/tet.obj"/>{tf}</shape>
+    <shape type="ply"><string name="filename" value="meshes/tet.ply"/>{tf}</shape>"#
+    ));
+    let p = write(dir.path(), "scene.xml", &xml);
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    assert_eq!(
+        get(&imp.table, "shapes.0.file").as_str(),
+        Some("meshes/tet.obj")
+    );
+    let scene = load_imported(&imp).unwrap();
+    let want = DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0))
+        * DMat4::from_rotation_z(30f64.to_radians())
+        * DMat4::from_scale(DVec3::splat(2.0));
+    let mut meshes = scene.shapes.iter().map(|s| match &s.kind {
+        ShapeKind::Mesh(m) => m.clone(),
+        other => panic!("{other:?}"),
+    });
+    let (a, b) = (meshes.next().unwrap(), meshes.next().unwrap());
+    assert_eq!(a.positions, b.positions);
+    assert_eq!(a.indices, b.indices);
+    // Every vertex is the transform of one of the file's vertices, and each is there.
+    assert_eq!(a.positions.len(), v.len());
+    for q in v {
+        let w = want.transform_point3(DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64));
+        assert!(
+            a.positions
+                .iter()
+                .any(|p| (p.as_dvec3() - w).length() < 1e-5),
+            "{w} not among {:?}",
+            a.positions
+        );
+    }
+    // heron convert writes the mesh path relative to the TOML's folder, and the TOML
+    // loads to the same meshes.
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let text = imp.to_toml(&out);
+    assert!(text.contains("file = \"../meshes/tet.obj\""), "{text}");
+    let toml_path = write(&out, "scene.toml", &text);
+    let again = load_scene(&toml_path).unwrap();
+    match &again.shapes[1].kind {
+        ShapeKind::Mesh(m) => assert_eq!(m.positions, b.positions),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
+    let body = r#"
+    <shape type="sphere">
+        <bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="wood.png"/></texture></bsdf>
+    </shape>
+    <emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>
+    <shape type="cylinder"/>
+    <shape type="sphere"><float name="nonsense" value="1"/></shape>
+"#;
+    let (_d, r) = import_text(&scene(body));
+    let imp = r.unwrap();
+    let lines: Vec<(u32, &str)> = imp
+        .warnings
+        .iter()
+        .map(|w| (w.line, w.message.as_str()))
+        .collect();
+    let has = |line: u32, s: &str| lines.iter().any(|(l, m)| *l == line && m.contains(s));
+    assert!(has(9, "textures are not supported"), "{lines:#?}");
+    assert!(has(11, "emitter \"envmap\" is not supported"), "{lines:#?}");
+    assert!(has(12, "shape \"cylinder\" is not supported"), "{lines:#?}");
+    assert!(has(13, "parameter \"nonsense\""), "{lines:#?}");
+    assert!(imp.warnings[0]
+        .to_string()
+        .starts_with(&format!("{}: line 9: ", imp.source.display())));
+    let strict = ImportOptions {
+        strict: true,
+        ..Default::default()
+    };
+    let (_d, r) = import_with(&scene(body), &strict);
+    let e = r.unwrap_err().to_string();
+    assert!(
+        e.contains("scene.xml: line 9: ") && e.contains("textures"),
+        "{e}"
+    );
+}
+
+#[test]
+fn malformed_files_are_one_line_errors_with_file_and_line() {
+    let cases: &[(&str, &str)] = &[
+        ("<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n</scene>\n", "line 3: malformed XML"),
+        (&scene("<shape type=\"sphere\"><ref id=\"nowhere\"/></shape>"), "line 7: <ref id=\"nowhere\">: no element has the id \"nowhere\""),
+        (&scene("<shape type=\"sphere\"><float name=\"radius\" value=\"one\"/></shape>"), "line 7: <float name=\"radius\">: value: expected a finite number, got \"one\""),
+        (&scene("<shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>"), "$r is not defined"),
+        (&scene("<shape type=\"sphere\"><transform name=\"to_world\"><scale x=\"1\" y=\"2\"/></transform></shape>"), "heron's spheres take a uniform scale only"),
+        (&scene("<shape type=\"serialized\"/>"), "save the mesh as PLY"),
+        (&scene("<bsdf type=\"conductor\" id=\"m\"><string name=\"material\" value=\"Unobtainium\"/></bsdf><shape type=\"sphere\"><ref id=\"m\"/></shape>"), "expected one of the metals heron tabulates (Ag, Al, Au, Cu)"),
+        (&scene("<bsdf type=\"dielectric\" id=\"g\"><string name=\"int_ior\" value=\"glass\"/></bsdf><shape type=\"sphere\"><ref id=\"g\"/></shape>"), "int_ior: expected a number or one of Mitsuba's named indices"),
+        ("<scene version=\"3.0.0\"><shape type=\"sphere\"/></scene>", "expected a <sensor type=\"perspective\">"),
+        ("<mitsuba/>", "expected the root element <scene>"),
+        (&scene("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>"), "cannot read the mesh file"),
+    ];
+    for (text, want) in cases {
+        let (_d, r) = import_text(text);
+        let e = match r {
+            Err(e) => e.to_string(),
+            Ok(imp) => load_imported(&imp)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default(),
+        };
+        assert!(e.contains(want), "want {want:?}, got {e:?}\nfor {text}");
+        assert!(!e.contains('\n'), "{e}");
+        assert!(e.contains("scene.xml") || e.contains("missing.obj"), "{e}");
+    }
+}
+
+#[test]
+fn includes_are_spliced_and_a_cycle_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "materials.xml",
+        r#"<scene version="3.0.0"><bsdf type="diffuse" id="grey"><float name="reflectance" value="0.25"/></bsdf></scene>"#,
+    );
+    let p = write(
+        dir.path(),
+        "scene.xml",
+        &scene("<include filename=\"materials.xml\"/><shape type=\"sphere\"><ref id=\"grey\"/></shape>"),
+    );
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    assert_eq!(f(get(&imp.table, "materials.grey.rho_d")), 0.25);
+    let p = write(
+        dir.path(),
+        "loop.xml",
+        &scene("<include filename=\"loop.xml\"/>"),
+    );
+    let e = import_scene(&p, &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("includes nested more than"), "{e}");
+}
+
+#[test]
+fn heron_convert_writes_a_scene_that_renders_like_the_xml() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cornell.toml");
+    let bin = env!("CARGO_BIN_EXE_heron");
+    let r = Command::new(bin)
+        .args(["convert", "scenes/mitsuba/cornell-box.xml", "-o"])
+        .arg(&out)
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("# Converted by heron"), "{text}");
+    let converted = load_scene(&out).unwrap();
+    let direct = load_scene(&repo().join("scenes/mitsuba/cornell-box.xml")).unwrap();
+    assert_eq!(converted.shapes.len(), direct.shapes.len());
+    let (mut a, mut b) = (converted, direct);
+    a.camera = a.camera.resized(16, 16).unwrap();
+    b.camera = b.camera.resized(16, 16).unwrap();
+    assert_eq!(
+        run(&a, IntegratorKind::Path, 4, 1).xyz,
+        run(&b, IntegratorKind::Path, 4, 1).xyz
+    );
+    // Bad flags and inputs: one-line errors, nothing written.
+    let toml_scene = repo().join("scenes/cornell-box.toml");
+    let xml_scene = repo().join("scenes/mitsuba/cornell-box.xml");
+    let (t, x) = (toml_scene.to_str().unwrap(), xml_scene.to_str().unwrap());
+    for (args, want) in [
+        (vec!["convert", t, "-o", "x.toml"], "needs no conversion"),
+        (
+            vec!["render", t, "-o", "x.exr", "--strict"],
+            "apply to scenes in another renderer's format",
+        ),
+        (
+            vec!["convert", x, "-o", "x.toml", "-D", "novalue"],
+            "expected NAME=VALUE",
+        ),
+    ] {
+        let r = Command::new(bin)
+            .args(&args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(
+            !r.status.success() && err.trim().lines().count() == 1,
+            "{args:?}: {err}"
+        );
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
+    assert!(!dir.path().join("x.toml").exists());
+}
