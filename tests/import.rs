@@ -390,6 +390,28 @@ fn obj_and_ply_meshes_take_the_transform() {
         ShapeKind::Mesh(m) => assert_eq!(m.positions, b.positions),
         other => panic!("{other:?}"),
     }
+    // A transform that is not an affine 4×4 matrix is an error at its key.
+    for (rows, want) in [
+        (
+            "[[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+            "shapes[0].transform: expected four rows of four finite numbers",
+        ),
+        (
+            "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]",
+            "the last [0, 0, 0, 1]",
+        ),
+        (
+            "[[0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]",
+            "expected an invertible matrix",
+        ),
+    ] {
+        let text = format!(
+            "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [8, 8]\n[materials.m]\ntype = \"lambertian\"\nrho_d = 0.5\n[[shapes]]\ntype = \"mesh\"\nfile = \"../meshes/tet.ply\"\nmaterial = \"m\"\ntransform = {rows}\n"
+        );
+        let p = write(&out, "bad.toml", &text);
+        let e = load_scene(&p).unwrap_err().to_string();
+        assert!(e.contains(want) && e.contains("bad.toml"), "{e}");
+    }
 }
 
 #[test]
