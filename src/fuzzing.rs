@@ -60,6 +60,8 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("scene_toml", scene),
     ("obj", |d, _| obj(d)),
     ("spectral_csv", |d, _| spectral_csv(d)),
+    ("ply", |d, _| ply(d)),
+    ("mitsuba_xml", mitsuba_xml),
 ];
 
 /// Panics unless `msg` is a usable error message: non-empty and on one line.
@@ -259,20 +261,95 @@ pub fn scene(data: &[u8], fixtures: &Path) -> Outcome {
     let path = fixtures.join("scene.toml");
     match load::build(&path, file, SkyTables::Skip, String::new()) {
         Ok(scene) => {
-            assert_eq!(scene.materials.len(), scene.material_names.len());
-            for s in &scene.shapes {
-                check_shape(s, scene.materials.len());
-                assert!(
-                    s.light == crate::geometry::NO_LIGHT
-                        || matches!(scene.lights.get(s.light as usize), Some(Light::Area(_))),
-                    "a shape's light is not an area light"
-                );
-            }
-            scene.materials.iter().for_each(check_material);
-            scene.lights.iter().for_each(check_light);
-            check_camera(&scene.camera);
-            check_spectrum("background", &scene.background);
-            assert!(scene.bounds.center.is_finite() && scene.bounds.radius.is_finite());
+            check_scene(&scene);
+            Outcome::Accepted
+        }
+        Err(e) => rejected(&e.to_string()),
+    }
+}
+
+/// What every loaded scene must satisfy, whatever file it came from.
+fn check_scene(scene: &crate::scene::Scene) {
+    assert_eq!(scene.materials.len(), scene.material_names.len());
+    for s in &scene.shapes {
+        check_shape(s, scene.materials.len());
+        assert!(
+            s.light == crate::geometry::NO_LIGHT
+                || matches!(scene.lights.get(s.light as usize), Some(Light::Area(_))),
+            "a shape's light is not an area light"
+        );
+    }
+    scene.materials.iter().for_each(check_material);
+    scene.lights.iter().for_each(check_light);
+    check_camera(&scene.camera);
+    check_spectrum("background", &scene.background);
+    assert!(scene.bounds.center.is_finite() && scene.bounds.radius.is_finite());
+}
+
+/// The PLY reader on `data` as the file of a mesh entry with one material.
+pub fn ply(data: &[u8]) -> Outcome {
+    let groups = match load::ply::parse_ply(data, "fuzz") {
+        Ok(g) => g,
+        Err(msg) => return rejected(&msg),
+    };
+    for g in &groups {
+        for t in &g.indices {
+            assert!(
+                t.iter().all(|&i| (i as usize) < g.positions.len()),
+                "index out of range"
+            );
+        }
+    }
+    let entry = MeshFile {
+        file: "fuzz.ply".into(),
+        material: Some("m".into()),
+        groups: BTreeMap::new(),
+        scale: None,
+        translate: None,
+        transform: None,
+        emission: None,
+        two_sided: None,
+        medium: None,
+    };
+    match load::shapes_of_groups(
+        groups,
+        Path::new("fuzz.toml"),
+        Path::new("fuzz.ply"),
+        "shapes[0]",
+        &entry,
+        &BTreeMap::new(),
+        Some(0),
+    ) {
+        Ok(shapes) => {
+            shapes.iter().for_each(|s| check_shape(s, 1));
+            Outcome::Accepted
+        }
+        Err(e) => rejected(&e.to_string()),
+    }
+}
+
+/// The Mitsuba 3 importer on `data` as `fixtures/scene.xml`, then the scene it becomes.
+/// Files outside the fixtures folder are not read (inputs naming `..` or an absolute
+/// path are skipped).
+pub fn mitsuba_xml(data: &[u8], fixtures: &Path) -> Outcome {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Outcome::Skipped;
+    };
+    if text.contains("..") || text.contains("=\"/") || text.contains("='/") {
+        return Outcome::Skipped;
+    }
+    let path = fixtures.join("scene.xml");
+    let options = crate::scene::import::ImportOptions::default();
+    let imported = match crate::scene::import::import_mitsuba_str(text, &path, &options) {
+        Ok(i) => i,
+        Err(e) => return rejected(&e.to_string()),
+    };
+    for w in &imported.warnings {
+        check_message(&w.to_string());
+    }
+    match load::load_imported(&imported) {
+        Ok(scene) => {
+            check_scene(&scene);
             Outcome::Accepted
         }
         Err(e) => rejected(&e.to_string()),

@@ -78,6 +78,17 @@ pub fn import_scene(path: &Path, options: &ImportOptions) -> Result<Imported> {
     }
 }
 
+/// [`import_scene`] for Mitsuba 3 XML already in memory, read as if from `path`.
+pub fn import_mitsuba_str(text: &str, path: &Path, options: &ImportOptions) -> Result<Imported> {
+    let root = xml::read_document_from_str(text, path, &options.defines).map_err(error)?;
+    let c = mitsuba::convert(&root, path, options.strict).map_err(error)?;
+    Ok(Imported {
+        source: path.to_path_buf(),
+        table: c.table,
+        warnings: c.warnings,
+    })
+}
+
 impl Imported {
     /// The scene as heron's TOML, for a file in folder `out_dir` (mesh paths rewritten
     /// relative to it), opened by a comment naming the source and listing the warnings.

@@ -65,7 +65,7 @@ impl Node {
         let mut s = format!("<{}", self.tag);
         for key in ["type", "name", "id"] {
             if let Some(v) = self.attr(key) {
-                s.push_str(&format!(" {key}=\"{v}\""));
+                s.push_str(&format!(" {key}=\"{}\"", v.escape_debug()));
             }
         }
         s.push('>');
@@ -105,13 +105,35 @@ fn read_file(
     }
     let text = std::fs::read_to_string(path)
         .map_err(|e| at_from(format!("cannot read {}: {e}", path.display())))?;
+    parse_text(&text, path, params, defines, depth)
+}
+
+/// The document of `text`, read as if from `path` (includes resolve from its folder).
+pub fn read_document_from_str(
+    text: &str,
+    path: &Path,
+    defines: &BTreeMap<String, String>,
+) -> Result<Node, Diagnostic> {
+    let mut params = defines.clone();
+    parse_text(text, path, &mut params, defines, 0)
+}
+
+fn parse_text(
+    text: &str,
+    path: &Path,
+    params: &mut BTreeMap<String, String>,
+    defines: &BTreeMap<String, String>,
+    depth: usize,
+) -> Result<Node, Diagnostic> {
     let file = Arc::new(path.to_path_buf());
-    let doc = roxmltree::Document::parse(&text).map_err(|e| {
+    let doc = roxmltree::Document::parse(text).map_err(|e| {
         let pos = e.pos();
         Diagnostic {
             file: file.as_ref().clone(),
             line: pos.row,
-            message: format!("malformed XML: {e}"),
+            // roxmltree's message quotes the offending character as is (a newline
+            // too): escaped, so the error stays on one line.
+            message: format!("malformed XML: {}", e.to_string().escape_debug()),
         }
     })?;
     let root = doc.root_element();

@@ -25,7 +25,7 @@
 //! (`[sky]` to a [`crate::sky::SkySpec`]), `settings.rs` (`[render]`), `camera.rs`.
 //! [`build`] runs them in the order of the errors they report.
 pub(crate) mod obj;
-mod ply;
+pub(crate) mod ply;
 
 mod camera;
 mod errors;
@@ -39,8 +39,8 @@ mod sky;
 
 pub use materials::ior_from_value;
 pub use media::MEDIUM_DEFAULT_NODES;
-pub(crate) use shapes::mesh_shapes;
 pub use shapes::scene_bounds;
+pub(crate) use shapes::{mesh_shapes, shapes_of_groups};
 
 use super::file::SceneFile;
 use super::{Scene, SceneParts};

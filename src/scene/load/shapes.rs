@@ -491,7 +491,7 @@ pub(crate) fn mesh_shapes(
 
 /// The shapes of mesh entry `m` from its file's groups (OBJ objects and groups, or the
 /// one group of a PLY file).
-fn shapes_of_groups(
+pub(crate) fn shapes_of_groups(
     groups: Vec<obj::ObjGroup>,
     scene_path: &Path,
     mesh_path: &Path,
