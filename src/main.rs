@@ -29,7 +29,7 @@ enum Command {
     /// Render a scene file to OpenEXR (linear sRGB) and an sRGB PNG preview, or (with -o
     /// FILE.heronfilm, e.g. one shard of a render) to a film file for heron merge.
     Render(RenderArgs),
-    /// Convert a Mitsuba 3 scene (.xml) to heron's TOML: the scene heron renders from it,
+    /// Convert a Mitsuba 3 (.xml) or pbrt-v4 (.pbrt) scene to heron's TOML: the scene heron renders from it,
     /// opened by a comment listing what was not carried over as written (also printed as
     /// warnings).
     Convert(ConvertArgs),
@@ -87,7 +87,7 @@ enum Command {
 /// How a scene in another renderer's format is imported (heron render, heron convert).
 #[derive(clap::Args, Clone, Default)]
 struct ImportArgs {
-    /// Scenes in another renderer's format (.xml): fail on the first element or parameter
+    /// Scenes in another renderer's format (.xml, .pbrt): fail on the first element or parameter
     /// heron does not carry over, instead of warning.
     #[arg(long)]
     strict: bool,
@@ -119,7 +119,7 @@ fn load_any_scene(path: &Path, import: &ImportArgs) -> anyhow::Result<heron::sce
     use heron::scene::import::{import_scene, Format};
     if Format::of(path) == Format::Heron {
         if import.strict || !import.define.is_empty() {
-            anyhow::bail!("--strict and --define apply to scenes in another renderer's format (.xml), not to heron's TOML");
+            anyhow::bail!("--strict and --define apply to scenes in another renderer's format (.xml, .pbrt), not to heron's TOML");
         }
         return Ok(load_scene(path)?);
     }
@@ -132,7 +132,7 @@ fn load_any_scene(path: &Path, import: &ImportArgs) -> anyhow::Result<heron::sce
 
 #[derive(clap::Args)]
 struct ConvertArgs {
-    /// The scene: Mitsuba 3 XML (.xml).
+    /// The scene: Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
     scene: PathBuf,
     /// The TOML file to write (mesh paths are written relative to its folder).
     #[arg(short, long)]
@@ -145,7 +145,7 @@ fn cmd_convert(a: ConvertArgs) -> anyhow::Result<()> {
     use heron::scene::import::{import_scene, Format};
     if Format::of(&a.scene) == Format::Heron {
         anyhow::bail!(
-            "{}: expected a Mitsuba 3 scene (.xml); heron's TOML needs no conversion",
+            "{}: expected a Mitsuba 3 (.xml) or pbrt-v4 (.pbrt) scene; heron's TOML needs no conversion",
             a.scene.display()
         );
     }
@@ -726,7 +726,8 @@ struct DisplayCmdArgs {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// Scene file: heron's TOML, or Mitsuba 3 XML (.xml), converted as heron convert does.
+    /// Scene file: heron's TOML, or Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt), converted as
+    /// heron convert does.
     scene: PathBuf,
     #[command(flatten)]
     import: ImportArgs,

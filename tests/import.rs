@@ -560,3 +560,94 @@ fn heron_convert_writes_a_scene_that_renders_like_the_xml() {
     }
     assert!(!dir.path().join("x.toml").exists());
 }
+
+#[test]
+fn the_cornell_box_as_pbrt_v4_renders_the_pixels_of_the_mitsuba_xml() {
+    let pbrt = load_scene(&repo().join("scenes/pbrt/cornell-box.pbrt")).unwrap();
+    let xml = load_scene(&repo().join("scenes/mitsuba/cornell-box.xml")).unwrap();
+    assert_eq!(pbrt.settings.max_depth, xml.settings.max_depth);
+    assert_eq!(pbrt.shapes.len(), xml.shapes.len());
+    let (mut a, mut b) = (pbrt, xml);
+    a.camera = a.camera.resized(24, 24).unwrap();
+    b.camera = b.camera.resized(24, 24).unwrap();
+    assert_eq!(
+        run(&a, IntegratorKind::Path, 8, 3).xyz,
+        run(&b, IntegratorKind::Path, 8, 3).xyz
+    );
+}
+
+fn import_pbrt(text: &str) -> (tempfile::TempDir, heron::error::Result<Imported>) {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "scene.pbrt", text);
+    let r = import_scene(&p, &ImportOptions::default());
+    (dir, r)
+}
+
+const PBRT_CAMERA: &str = "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\nFilm \"rgb\" \"integer xresolution\" [ 40 ] \"integer yresolution\" [ 20 ]\nWorldBegin\n";
+
+#[test]
+fn pbrt_materials_lights_and_shapes_convert_with_pbrt_s_conventions() {
+    let text = format!(
+        "{PBRT_CAMERA}Material \"dielectric\" \"spectrum eta\" \"glass-BK7\" \"float roughness\" [ 0.04 ]\nShape \"sphere\" \"float radius\" 0.5\nMaterial \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"\nTranslate 2 0 0\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]\nLightSource \"point\" \"rgb I\" [ 1 2 3 ] \"point3 from\" [ 0 1 0 ]\nLightSource \"infinite\" \"rgb L\" [ 0.1 0.1 0.1 ]\n"
+    );
+    let (_d, r) = import_pbrt(&text);
+    let imp = r.unwrap();
+    let t = &imp.table;
+    // fov spans the shorter axis (here the height): tan(15°) = 0.5 / d.
+    assert!((0.5 / f(get(t, "camera.d")) - 15f64.to_radians().tan()).abs() < 1e-9);
+    assert_eq!(get(t, "materials.dielectric-1.ior").as_str(), Some("N-BK7"));
+    // pbrt remaps roughness to α = √r.
+    assert!((f(get(t, "materials.dielectric-1.roughness")) - 0.2).abs() < 1e-12);
+    assert_eq!(get(t, "materials.conductor-2.metal").as_str(), Some("Au"));
+    // The CTM moves the triangle and the light's `from` alike.
+    assert_eq!(
+        v3(&get(t, "shapes.1.vertices").as_array().unwrap()[1]),
+        DVec3::new(3.0, 0.0, 0.0)
+    );
+    assert_eq!(v3(get(t, "lights.0.position")), DVec3::new(2.0, 1.0, 0.0));
+    assert_eq!(v3(get(t, "background")), DVec3::splat(0.1));
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    load_imported(&imp).unwrap();
+
+    // Without the Scale -1 1 1, pbrt's left-handed camera mirrors the image: said.
+    let (_d, r) = import_pbrt(&format!("{}Shape \"sphere\"\n", &PBRT_CAMERA[13..]));
+    let imp = r.unwrap();
+    assert!(
+        imp.warnings
+            .iter()
+            .any(|w| w.line == 2 && w.message.contains("left-handed")),
+        "{:?}",
+        imp.warnings
+    );
+}
+
+#[test]
+fn pbrt_errors_and_warnings_name_the_line() {
+    for (body, line, want) in [
+        ("Shape \"sphere\"\nFrobnicate 1\n", 7, "unknown directive \"Frobnicate\""),
+        ("NamedMaterial \"nope\"\n", 6, "no material named \"nope\""),
+        ("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0\n", 6, "a [ is not closed"),
+        ("Translate 1 2\n", 6, "Translate: expected 3 numbers, got 2"),
+        ("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 5 ]\n", 6, "index 5 is not one of the 3 vertices"),
+    ] {
+        let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));
+        let e = r.unwrap_err().to_string();
+        assert!(e.contains(&format!("scene.pbrt: line {line}: ")) && e.contains(want), "{e}");
+    }
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"\nShape \"disk\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
+    ));
+    let imp = r.unwrap();
+    let has = |line: u32, s: &str| {
+        imp.warnings
+            .iter()
+            .any(|w| w.line == line && w.message.contains(s))
+    };
+    assert!(has(6, "Texture is not supported"), "{:?}", imp.warnings);
+    assert!(
+        has(7, "Shape \"disk\" is not supported"),
+        "{:?}",
+        imp.warnings
+    );
+    assert!(has(8, "zmin"), "{:?}", imp.warnings);
+}

@@ -163,22 +163,22 @@ fn collect_ids<'a>(n: &'a Node, ids: &mut HashMap<&'a str, &'a Node>) -> Result<
 
 /// `v` to 12 significant digits (far beyond f32's 7), so that a rotation by 90° writes
 /// 0 and 1 rather than 6e-17 and 0.9999999999999999.
-fn tidy(v: f64) -> f64 {
+pub(super) fn tidy(v: f64) -> f64 {
     if v.abs() < 1e-12 {
         return 0.0;
     }
     format!("{v:.11e}").parse().unwrap_or(v)
 }
 
-fn float(v: f64) -> Value {
+pub(super) fn float(v: f64) -> Value {
     Value::Float(tidy(v))
 }
 
-fn vec3(v: DVec3) -> Value {
+pub(super) fn vec3(v: DVec3) -> Value {
     Value::Array(v.to_array().iter().map(|x| float(*x)).collect())
 }
 
-fn table(pairs: Vec<(&str, Value)>) -> Table {
+pub(super) fn table(pairs: Vec<(&str, Value)>) -> Table {
     pairs.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }
 

@@ -4,6 +4,7 @@
 //! for editing. What heron cannot carry over is a [`Diagnostic`]: a warning naming the
 //! file, line and element, or an error with `strict`.
 mod mitsuba;
+mod pbrt;
 mod props;
 mod transform;
 mod xml;
@@ -22,12 +23,15 @@ pub enum Format {
     Heron,
     /// Mitsuba 3's XML.
     Mitsuba,
+    /// pbrt-v4's scene format (`.pbrt`).
+    Pbrt,
 }
 
 impl Format {
     pub fn of(path: &Path) -> Format {
         match path.extension().and_then(|e| e.to_str()) {
             Some(e) if e.eq_ignore_ascii_case("xml") => Format::Mitsuba,
+            Some(e) if e.eq_ignore_ascii_case("pbrt") => Format::Pbrt,
             _ => Format::Heron,
         }
     }
@@ -70,9 +74,17 @@ pub fn import_scene(path: &Path, options: &ImportOptions) -> Result<Imported> {
                 warnings: c.warnings,
             })
         }
+        Format::Pbrt => {
+            let c = pbrt::convert(path, options.strict).map_err(error)?;
+            Ok(Imported {
+                source: path.to_path_buf(),
+                table: c.table,
+                warnings: c.warnings,
+            })
+        }
         Format::Heron => Err(HeronError::Scene {
             file: path.to_path_buf(),
-            message: "expected a Mitsuba 3 scene (.xml) to convert; this is heron's own format"
+            message: "expected a Mitsuba 3 (.xml) or pbrt-v4 (.pbrt) scene to convert; this is heron's own format"
                 .into(),
         }),
     }
