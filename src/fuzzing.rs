@@ -300,17 +300,7 @@ pub fn ply(data: &[u8]) -> Outcome {
             );
         }
     }
-    let entry = MeshFile {
-        file: "fuzz.ply".into(),
-        material: Some("m".into()),
-        groups: BTreeMap::new(),
-        scale: None,
-        translate: None,
-        transform: None,
-        emission: None,
-        two_sided: None,
-        medium: None,
-    };
+    let entry = mesh_entry("fuzz.ply");
     match load::shapes_of_groups(
         groups,
         Path::new("fuzz.toml"),
@@ -356,14 +346,10 @@ pub fn mitsuba_xml(data: &[u8], fixtures: &Path) -> Outcome {
     }
 }
 
-/// The OBJ reader on `data` as the file of a mesh entry with one material, and the area
-/// light the mesh becomes when it emits.
-pub fn obj(data: &[u8]) -> Outcome {
-    let Ok(text) = std::str::from_utf8(data) else {
-        return Outcome::Skipped;
-    };
-    let entry = MeshFile {
-        file: "fuzz.obj".into(),
+/// A mesh entry of `file` with the one material "m" and nothing else set.
+fn mesh_entry(file: &str) -> MeshFile {
+    MeshFile {
+        file: file.into(),
         material: Some("m".into()),
         groups: BTreeMap::new(),
         scale: None,
@@ -372,7 +358,16 @@ pub fn obj(data: &[u8]) -> Outcome {
         emission: None,
         two_sided: None,
         medium: None,
+    }
+}
+
+/// The OBJ reader on `data` as the file of a mesh entry with one material, and the area
+/// light the mesh becomes when it emits.
+pub fn obj(data: &[u8]) -> Outcome {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Outcome::Skipped;
     };
+    let entry = mesh_entry("fuzz.obj");
     let shapes = match load::mesh_shapes(
         text,
         Path::new("fuzz.toml"),

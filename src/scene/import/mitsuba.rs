@@ -125,28 +125,46 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
                 .into(),
         });
     };
-    let mut table = Table::new();
-    table.insert("camera".into(), Value::Table(camera));
-    if !c.render.is_empty() {
-        table.insert("render".into(), Value::Table(std::mem::take(&mut c.render)));
-    }
-    if let Some(b) = c.background.take() {
-        table.insert("background".into(), b);
-    }
-    if !c.materials.is_empty() {
-        table.insert(
-            "materials".into(),
-            Value::Table(std::mem::take(&mut c.materials)),
-        );
-    }
-    table.insert("shapes".into(), Value::Array(std::mem::take(&mut c.shapes)));
-    if !c.lights.is_empty() {
-        table.insert("lights".into(), Value::Array(std::mem::take(&mut c.lights)));
-    }
+    let table = scene_table(
+        camera,
+        std::mem::take(&mut c.render),
+        c.background.take(),
+        std::mem::take(&mut c.materials),
+        std::mem::take(&mut c.shapes),
+        std::mem::take(&mut c.lights),
+    );
     Ok(Converted {
         table,
         warnings: c.warnings,
     })
+}
+
+/// heron's scene table from its parts, leaving out the empty optional ones (what both
+/// converters, this one and pbrt.rs, assemble).
+pub(super) fn scene_table(
+    camera: Table,
+    render: Table,
+    background: Option<Value>,
+    materials: Table,
+    shapes: Vec<Value>,
+    lights: Vec<Value>,
+) -> Table {
+    let mut t = Table::new();
+    t.insert("camera".into(), Value::Table(camera));
+    if !render.is_empty() {
+        t.insert("render".into(), Value::Table(render));
+    }
+    if let Some(b) = background {
+        t.insert("background".into(), b);
+    }
+    if !materials.is_empty() {
+        t.insert("materials".into(), Value::Table(materials));
+    }
+    t.insert("shapes".into(), Value::Array(shapes));
+    if !lights.is_empty() {
+        t.insert("lights".into(), Value::Array(lights));
+    }
+    t
 }
 
 fn collect_ids<'a>(n: &'a Node, ids: &mut HashMap<&'a str, &'a Node>) -> Result<(), Diagnostic> {

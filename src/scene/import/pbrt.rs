@@ -7,7 +7,7 @@
 //! scattering events as heron's `max_depth` does, and a roughness is remapped to
 //! α = √r unless `remaproughness` is false (pbrt-v4's `TrowbridgeReitzDistribution::
 //! RoughnessToAlpha`).
-use super::mitsuba::{float, relative_to, table, vec3};
+use super::mitsuba::{float, relative_to, scene_table, table, vec3, Converted};
 use super::xml::Diagnostic;
 use glam::{DMat4, DVec3};
 use std::collections::HashMap;
@@ -139,11 +139,6 @@ struct Graphics {
     reverse: bool,
 }
 
-pub struct Converted {
-    pub table: Table,
-    pub warnings: Vec<Diagnostic>,
-}
-
 struct Conv {
     base: PathBuf,
     strict: bool,
@@ -190,27 +185,14 @@ pub fn convert(path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
     };
     c.file(path, 0, None)?;
     c.finish_camera(path)?;
-    let mut t = Table::new();
-    t.insert(
-        "camera".into(),
-        Value::Table(c.camera.take().expect("finish_camera sets it")),
+    let t = scene_table(
+        c.camera.take().expect("finish_camera sets it"),
+        std::mem::take(&mut c.render),
+        c.background.take(),
+        std::mem::take(&mut c.materials),
+        std::mem::take(&mut c.shapes),
+        std::mem::take(&mut c.lights),
     );
-    if !c.render.is_empty() {
-        t.insert("render".into(), Value::Table(std::mem::take(&mut c.render)));
-    }
-    if let Some(b) = c.background.take() {
-        t.insert("background".into(), b);
-    }
-    if !c.materials.is_empty() {
-        t.insert(
-            "materials".into(),
-            Value::Table(std::mem::take(&mut c.materials)),
-        );
-    }
-    t.insert("shapes".into(), Value::Array(std::mem::take(&mut c.shapes)));
-    if !c.lights.is_empty() {
-        t.insert("lights".into(), Value::Array(std::mem::take(&mut c.lights)));
-    }
     Ok(Converted {
         table: t,
         warnings: c.warnings,
