@@ -28,6 +28,7 @@ fn glass_scene(shapes: Vec<Shape>, ior: Ior) -> Scene {
         media: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
+        envmap: None,
         settings: RenderSettings {
             spp: 1,
             max_depth: 32,

@@ -377,7 +377,11 @@ fn sky_breaks(scene: &heron::scene::Scene) -> Vec<f64> {
 #[test]
 fn chi2_environment() {
     let mut out = Vec::new();
-    let uniform = Light::Environment(EnvironmentLight::new(DenseSpectrum::constant(0.5), None));
+    let uniform = Light::Environment(EnvironmentLight::new(
+        DenseSpectrum::constant(0.5),
+        None,
+        None,
+    ));
     out.push(li_chi2(
         "environment without sky (uniform)",
         &uniform,
@@ -567,7 +571,7 @@ fn emitters() -> Vec<(&'static str, Light)> {
         ),
         (
             "environment",
-            Light::Environment(EnvironmentLight::new(ramp(0.5), None)),
+            Light::Environment(EnvironmentLight::new(ramp(0.5), None, None)),
         ),
     ]
 }
@@ -644,7 +648,11 @@ fn sampler_lights() -> Vec<Light> {
             DenseSpectrum::constant(0.5),
             0.01,
         )),
-        Light::Environment(EnvironmentLight::new(DenseSpectrum::constant(0.02), None)),
+        Light::Environment(EnvironmentLight::new(
+            DenseSpectrum::constant(0.02),
+            None,
+            None,
+        )),
     ]
 }
 

@@ -494,6 +494,7 @@ irradiance = 1.0
                 .collect(),
             background: file.background.clone(),
             sky: Some(Arc::new(sky)),
+            envmap: None,
             settings: file.settings.clone(),
             media: Vec::new(),
         })

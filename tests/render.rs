@@ -40,6 +40,7 @@ fn scene(
         media: vec![],
         background: DenseSpectrum::constant(bg),
         sky: None,
+        envmap: None,
         settings: RenderSettings {
             spp: 4,
             max_depth: 64,

@@ -15,15 +15,16 @@ use common::chi2::{
 };
 use glam::{Vec2, Vec3};
 use heron::math::warp::{
-    concentric_disk, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic, uniform_cone,
-    uniform_cone_pdf, uniform_sphere, uniform_triangle, UNIFORM_SPHERE_PDF,
+    concentric_disk, cosine_hemisphere, cosine_hemisphere_pdf, equal_area_sphere_to_square,
+    equal_area_square_to_sphere, power_heuristic, uniform_cone, uniform_cone_pdf, uniform_sphere,
+    uniform_triangle, UNIFORM_SPHERE_PDF,
 };
 use heron::math::{Distribution1D, Rng};
 use std::f64::consts::PI;
 
 /// Chi-square tests in this file (the Bonferroni divisor): the sum over the test
 /// functions, each of which checks its own count.
-const CHI2_TESTS: usize = 2 + CONE_TESTS + 2 + DISTRIBUTION_TESTS;
+const CHI2_TESTS: usize = 2 + CONE_TESTS + 2 + DISTRIBUTION_TESTS + 2;
 const CONE_TESTS: usize = 2;
 const DISTRIBUTION_TESTS: usize = 5;
 const N: usize = 1_000_000;
@@ -448,4 +449,62 @@ fn chi2_helper_rejects_wrong_densities() {
     // Integration: ∫ cos θ/π over the sphere is 1.
     let i = dom.integrate(|d| d.z.max(0.0) as f64 / PI, 1e-9);
     assert!((i - 1.0).abs() < 1e-6, "{i}");
+}
+
+/// Clarberg's equal-area map (pbrt-v4's environment-map layout): uniform on the square is
+/// uniform on the sphere, and the inverse takes every direction back to its point.
+#[test]
+fn chi2_equal_area_square_to_sphere_and_its_inverse() {
+    let mut worst = 0.0f32;
+    let o = Chi2::new("equal_area_square_to_sphere", N, CHI2_TESTS).sphere(
+        &Spherical::sphere(Vec3::new(0.2, 0.7, -0.4)),
+        |r| {
+            let u = u2(r);
+            let d = equal_area_square_to_sphere(u);
+            assert!((d.length() - 1.0).abs() < 1e-5, "{u} -> {d}");
+            worst = worst.max((equal_area_sphere_to_square(d) - u).abs().max_element());
+            Some((d, UNIFORM_SPHERE_PDF))
+        },
+        |_| (0.25 / PI) as f32,
+    );
+    o.assert_passed();
+    assert!(worst < 2e-5, "round trip off by {worst}");
+    // The layout pbrt-v4 documents: the centre is +z, the corners −z, the edges' middles
+    // the equator.
+    assert!((equal_area_square_to_sphere(Vec2::splat(0.5)) - Vec3::Z).length() < 1e-6);
+    assert!((equal_area_square_to_sphere(Vec2::ZERO) + Vec3::Z).length() < 1e-6);
+    assert!(equal_area_square_to_sphere(Vec2::new(1.0, 0.5)).z.abs() < 1e-6);
+}
+
+/// An environment map's importance sampling (src/light/envmap.rs, latlong): texels of a
+/// ramp with a 40× bright spot, 16 × 9 (8 rows of cells, whose θ edges are the
+/// quadrature's breaks), against the density the light reports.
+#[test]
+fn chi2_environment_map_latlong() {
+    use heron::light::{EnvMap, EnvMapping};
+    let (w, h) = (16usize, 9usize);
+    let rgb: Vec<[f32; 3]> = (0..w * h)
+        .map(|k| {
+            let (i, j) = (k % w, k / w);
+            let b = if (i, j) == (5, 3) { 40.0 } else { 1.0 };
+            [
+                b * (0.2 + i as f32 / w as f32),
+                b * (0.1 + j as f32 / h as f32),
+                0.3 * b,
+            ]
+        })
+        .collect();
+    let m = EnvMap::new(EnvMapping::LatLong, w, h, &rgb, 1.0, glam::Mat3::IDENTITY);
+    let dom = Spherical::sphere(Vec3::Y)
+        .with_resolution(32, 64)
+        .with_theta_breaks((1..h - 1).map(|j| PI * j as f64 / (h - 1) as f64));
+    let o = Chi2::new("envmap latlong", N, CHI2_TESTS).sphere(
+        &dom,
+        |r| {
+            let (d, pdf) = m.sample(u2(r));
+            (pdf > 0.0).then_some((d, pdf))
+        },
+        |d| m.pdf(d),
+    );
+    o.assert_passed();
 }

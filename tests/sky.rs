@@ -543,6 +543,7 @@ fn water_drop_scene() -> Scene {
         media: vec![],
         background: DenseSpectrum::constant(0.0),
         sky: None,
+        envmap: None,
         settings: RenderSettings {
             spp: 1,
             max_depth: 32,

@@ -9,6 +9,7 @@
 //! bins in u, each weighted by the larger of its two ends' radiance averaged over
 //! 360–830 nm (the table interpolates linearly between nodes, so that bound never misses
 //! light), and φ is uniform. The density is then p(ω) = p_u(cos θ)/(2π).
+use super::envmap::EnvMap;
 use super::{LightLeSample, LightLiSample, SceneBounds};
 use crate::math::warp::{uniform_sphere, UNIFORM_SPHERE_PDF};
 use crate::math::Frame;
@@ -22,6 +23,9 @@ use std::sync::Arc;
 pub struct EnvironmentLight {
     pub background: DenseSpectrum,
     pub sky: Option<Arc<SceneSky>>,
+    /// An image of the environment, in place of the background (never with a sky: the
+    /// scene loader refuses both).
+    pub map: Option<Arc<EnvMap>>,
     /// Importance sampling of the sky in u = cos θ about the antisolar axis.
     zones: Option<Zones>,
     /// ∫ L dω, averaged over wavelength.
@@ -68,12 +72,27 @@ impl Zones {
 }
 
 impl EnvironmentLight {
-    pub fn new(background: DenseSpectrum, sky: Option<Arc<SceneSky>>) -> Self {
+    pub fn new(
+        background: DenseSpectrum,
+        sky: Option<Arc<SceneSky>>,
+        map: Option<Arc<EnvMap>>,
+    ) -> Self {
+        if let Some(m) = &map {
+            let power_per_area = m.power_per_area();
+            return EnvironmentLight {
+                background,
+                sky: None,
+                map,
+                zones: None,
+                power_per_area,
+            };
+        }
         let Some(s) = &sky else {
             let power_per_area = 4.0 * PI * background.mean();
             return EnvironmentLight {
                 background,
                 sky,
+                map: None,
                 zones: None,
                 power_per_area,
             };
@@ -124,6 +143,7 @@ impl EnvironmentLight {
             return EnvironmentLight {
                 background,
                 sky,
+                map: None,
                 zones: None,
                 power_per_area: 0.0,
             };
@@ -146,6 +166,7 @@ impl EnvironmentLight {
         EnvironmentLight {
             background,
             sky,
+            map: None,
             zones: Some(zones),
             power_per_area,
         }
@@ -155,6 +176,9 @@ impl EnvironmentLight {
     /// background, or the sky model that contains it or adds to it.
     #[inline]
     pub fn le<const N: usize>(&self, dir: Vec3, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        if let Some(m) = &self.map {
+            return m.le(dir, wl);
+        }
         match &self.sky {
             None => wl.eval(&self.background),
             Some(sky) => {
@@ -176,6 +200,9 @@ impl EnvironmentLight {
 
     #[inline]
     fn sample_dir(&self, u: Vec2) -> (Vec3, f32) {
+        if let Some(m) = &self.map {
+            return m.sample(u);
+        }
         match &self.zones {
             Some(z) => z.sample(u),
             None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
@@ -206,6 +233,9 @@ impl EnvironmentLight {
 
     #[inline]
     pub fn pdf_li(&self, wi: Vec3) -> f32 {
+        if let Some(m) = &self.map {
+            return m.pdf(wi);
+        }
         match &self.zones {
             Some(z) => z.pdf(wi),
             None => UNIFORM_SPHERE_PDF,

@@ -15,6 +15,7 @@
 pub mod area;
 pub mod directional;
 pub mod environment;
+pub mod envmap;
 pub mod point;
 pub mod sampler;
 pub mod spot;
@@ -23,6 +24,7 @@ pub mod sun;
 pub use area::{AreaLight, AreaShape, SurfacePoint};
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
+pub use envmap::{EnvMap, EnvMapping};
 pub use point::PointLight;
 pub use sampler::LightSampler;
 pub use spot::SpotLight;

@@ -91,6 +91,52 @@ impl Distribution1D {
     }
 }
 
+/// A piecewise-constant 2D distribution over [0, 1)² on an nx × ny grid (pbrt-v4
+/// `PiecewiseConstant2D`, §A.5): a marginal over rows and one conditional per row, for
+/// the cells of an environment map.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution2D {
+    /// One per row (y), each over the row's nx cells (x).
+    conditional: Vec<Distribution1D>,
+    /// Over the ny rows, by each row's integral.
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// `func[y * nx + x]`, finite and ≥ 0, with `nx, ny ≥ 1`.
+    pub fn new(func: &[f32], nx: usize, ny: usize) -> Distribution2D {
+        assert!(nx >= 1 && ny >= 1 && func.len() == nx * ny);
+        let conditional: Vec<Distribution1D> =
+            func.chunks_exact(nx).map(Distribution1D::new).collect();
+        let rows: Vec<f32> = conditional.iter().map(|d| d.integral()).collect();
+        Distribution2D {
+            conditional,
+            marginal: Distribution1D::new(&rows),
+        }
+    }
+
+    /// ∫ f over [0, 1)².
+    pub fn integral(&self) -> f32 {
+        self.marginal.integral()
+    }
+
+    /// A point of [0, 1)² with density f/∫f, and that density.
+    #[inline]
+    pub fn sample(&self, u: glam::Vec2) -> (glam::Vec2, f32) {
+        let (y, py, row) = self.marginal.sample_continuous(u.y);
+        let (x, px, _) = self.conditional[row].sample_continuous(u.x);
+        (glam::Vec2::new(x, y), px * py)
+    }
+
+    /// Density of [`Self::sample`] at a point of [0, 1)².
+    #[inline]
+    pub fn pdf(&self, p: glam::Vec2) -> f32 {
+        let ny = self.conditional.len();
+        let row = bin_of(p.y, ny);
+        self.marginal.pdf(p.y) * self.conditional[row].pdf(p.x)
+    }
+}
+
 /// The bin of x among n equal bins of [0, 1): ⌊x n⌋ computed exactly (in f64, where the
 /// product of an f32 and a bin count is exact), so that x = k/n rounded to f32 falls on
 /// the side of the edge it is on.
@@ -138,5 +184,41 @@ mod tests {
         let d = Distribution1D::new(&[0.0; 8]);
         assert_eq!(d.integral(), 0.0);
         assert!((d.pdf(0.3) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn two_dimensional_density_matches_pdf_and_integrates_to_one() {
+        // 3 × 2 cells, one empty: samples land only where f > 0, with the density pdf.
+        let f = [1.0f32, 0.0, 2.0, 0.5, 3.0, 1.5];
+        let d = Distribution2D::new(&f, 3, 2);
+        assert!((d.integral() - 8.0 / 6.0).abs() < 1e-6);
+        let mut total = 0.0;
+        let mut counts = [0usize; 6];
+        // 300 points a side: a whole number of them per cell, so the midpoint sums are exact.
+        let n = 300;
+        for a in 0..n {
+            for b in 0..n {
+                let u = glam::Vec2::new((a as f32 + 0.5) / n as f32, (b as f32 + 0.5) / n as f32);
+                total += d.pdf(u) / (n * n) as f32;
+                let (p, pdf) = d.sample(u);
+                assert!((0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
+                assert!(
+                    (pdf - d.pdf(p)).abs() < 1e-4 * pdf,
+                    "{p} {pdf} {}",
+                    d.pdf(p)
+                );
+                let cell = bin_of(p.y, 2) * 3 + bin_of(p.x, 3);
+                counts[cell] += 1;
+            }
+        }
+        assert!((total - 1.0).abs() < 1e-4, "{total}");
+        assert_eq!(counts[1], 0);
+        for (c, &fv) in counts.iter().zip(&f) {
+            let expect = (fv / 8.0) as f64 * (n * n) as f64;
+            assert!(
+                (*c as f64 - expect).abs() <= 0.01 * (n * n) as f64,
+                "{counts:?}"
+            );
+        }
     }
 }

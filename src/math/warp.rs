@@ -93,3 +93,44 @@ pub fn power_heuristic(pf: f32, pg: f32) -> f32 {
     }
     (f / (f + g)) as f32
 }
+
+/// The equal-area octahedral map of [0, 1]² onto the unit sphere (Clarberg 2008, "Fast
+/// Equal-Area Mapping of the (Hemi)Sphere using SIMD", J. Graphics Tools 13(3); pbrt-v4's
+/// `EqualAreaSquareToSphere`, the layout of its image environment maps): the square's
+/// centre is +z, its corners −z, and every cell of the square covers the same solid
+/// angle, so the density is 1/(4π) per unit area of the square.
+#[inline]
+pub fn equal_area_square_to_sphere(p: Vec2) -> Vec3 {
+    let (u, v) = (2.0 * p.x - 1.0, 2.0 * p.y - 1.0);
+    let (up, vp) = (u.abs(), v.abs());
+    // The signed distance from the diagonal |u| + |v| = 1 (the equator) sets the radius.
+    let signed = 1.0 - (up + vp);
+    let r = 1.0 - signed.abs();
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * FRAC_PI_4;
+    let z = (1.0 - r * r).copysign(signed);
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    Vec3::new(phi.cos().copysign(u) * s, phi.sin().copysign(v) * s, z)
+}
+
+/// The inverse of [`equal_area_square_to_sphere`] for a unit vector (with the exact
+/// arctangent where pbrt-v4 uses a polynomial fit of it, 1e-5 away).
+#[inline]
+pub fn equal_area_sphere_to_square(d: Vec3) -> Vec2 {
+    let (x, y, z) = (d.x.abs(), d.y.abs(), d.z.abs());
+    let r = (1.0 - z).max(0.0).sqrt();
+    let (a, b) = (x.max(y), x.min(y));
+    let b = if a == 0.0 { 0.0 } else { b / a };
+    let mut phi = b.atan() * 2.0 * FRAC_1_PI;
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut v = phi * r;
+    let mut u = r - v;
+    if d.z < 0.0 {
+        // The southern hemisphere folds onto the square's corners.
+        std::mem::swap(&mut u, &mut v);
+        u = 1.0 - u;
+        v = 1.0 - v;
+    }
+    Vec2::new(0.5 * (u.copysign(d.x) + 1.0), 0.5 * (v.copysign(d.y) + 1.0))
+}

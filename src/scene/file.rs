@@ -79,6 +79,32 @@ pub struct SceneFile {
     /// A rainbow sky over the background; needs a `sun` light.
     #[serde(default)]
     pub sky: Option<SkyFile>,
+    /// An environment map in place of the background.
+    #[serde(default)]
+    pub environment: Option<EnvironmentFile>,
+}
+
+/// `[environment]`: radiance at infinity from an image (src/light/envmap.rs), e.g.
+/// `map = "sky.exr"`, importance-sampled by its texels.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentFile {
+    /// The image, relative to the scene file: OpenEXR (`.exr`, its R, G, B channels),
+    /// Radiance HDR (`.hdr`) or PNG (`.png`, sRGB-encoded, decoded to linear), linear
+    /// sRGB primaries.
+    pub map: String,
+    /// `latlong` (default; Mitsuba's equirectangular layout, +y up) or `equal-area`
+    /// (pbrt-v4's octahedral square).
+    #[serde(default)]
+    pub mapping: Option<String>,
+    /// Multiplies the image's radiance; default 1.
+    #[serde(default)]
+    pub scale: Option<NonNegativeNumber>,
+    /// The map's orientation: a 4 × 4 affine matrix (rows) whose 3 × 3 part is
+    /// orthogonal (a rotation, or a mirror); the translation is ignored (the map is at
+    /// infinity). Default the identity.
+    #[serde(default)]
+    pub transform: Option<Vec<Vec<f64>>>,
 }
 
 /// `[sky]`: a sky model seen by rays that leave the scene (src/sky).

@@ -47,6 +47,8 @@ pub struct Scene {
     pub background: DenseSpectrum,
     /// A rainbow sky, when the scene has one.
     pub sky: Option<std::sync::Arc<crate::sky::SceneSky>>,
+    /// An environment map (`[environment]`), in place of the background.
+    pub envmap: Option<std::sync::Arc<crate::light::EnvMap>>,
     pub settings: RenderSettings,
     /// The bounding sphere of the shapes.
     pub bounds: SceneBounds,
@@ -77,6 +79,8 @@ pub struct SceneParts {
     pub lights: Vec<Light>,
     pub background: DenseSpectrum,
     pub sky: Option<std::sync::Arc<crate::sky::SceneSky>>,
+    /// An environment map, in place of the background (never with a sky).
+    pub envmap: Option<std::sync::Arc<crate::light::EnvMap>>,
     pub settings: RenderSettings,
     /// The media the shapes enclose.
     pub media: Vec<crate::medium::Medium>,
@@ -88,10 +92,12 @@ impl Scene {
     /// shapes and builds the light sampler.
     pub fn from_parts(p: SceneParts) -> Scene {
         let mut lights = p.lights;
-        let environment = if p.sky.is_some() || p.background.max_value() > 0.0 {
+        let map_emits = p.envmap.as_ref().is_some_and(|m| m.power_per_area() > 0.0);
+        let environment = if p.sky.is_some() || p.background.max_value() > 0.0 || map_emits {
             lights.push(Light::Environment(crate::light::EnvironmentLight::new(
                 p.background.clone(),
                 p.sky.clone(),
+                p.envmap.clone(),
             )));
             Some(lights.len() as u32 - 1)
         } else {
@@ -131,6 +137,7 @@ impl Scene {
             infinite_lights,
             background: p.background,
             sky: p.sky,
+            envmap: p.envmap,
             settings: p.settings,
             bounds,
             light_sampler,

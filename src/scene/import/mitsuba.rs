@@ -76,6 +76,8 @@ struct Converter<'a> {
     shapes: Vec<Value>,
     lights: Vec<Value>,
     background: Option<Value>,
+    /// `[environment]` from an `envmap` emitter.
+    environment: Option<Value>,
     camera: Option<Table>,
     render: Table,
 }
@@ -95,6 +97,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         shapes: Vec::new(),
         lights: Vec::new(),
         background: None,
+        environment: None,
         camera: None,
         render: Table::new(),
     };
@@ -125,7 +128,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
                 .into(),
         });
     };
-    let table = scene_table(
+    let mut table = scene_table(
         camera,
         std::mem::take(&mut c.render),
         c.background.take(),
@@ -133,6 +136,9 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         std::mem::take(&mut c.shapes),
         std::mem::take(&mut c.lights),
     );
+    if let Some(e) = c.environment.take() {
+        table.insert("environment".into(), e);
+    }
     Ok(Converted {
         table,
         warnings: c.warnings,
@@ -1012,18 +1018,54 @@ impl<'a> Converter<'a> {
             }
             ("constant", None) => {
                 let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
-                if self.background.is_some() {
+                if self.background.is_some() || self.environment.is_some() {
                     self.warn(n.diag(
-                        "a second constant emitter; heron's background is the first, ignored",
+                        "a second environment emitter (constant or envmap); heron's environment is the first, ignored",
                     ))?;
                 } else {
                     self.background = Some(l.to_toml());
                 }
                 None
             }
+            ("envmap", None) => {
+                let Some(file) = p.string("filename")? else {
+                    return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
+                };
+                let folder = n.file.parent().unwrap_or(Path::new(""));
+                let rel = relative_to(&folder.join(file), &self.base);
+                let scale = p.float("scale")?.unwrap_or(1.0);
+                if !(scale >= 0.0) {
+                    return Err(n.diag(format!("scale: expected a number ≥ 0, got {scale}")));
+                }
+                let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+                // Only how the map is sampled, not what it shows: heron's own sampling.
+                p.get("mis_compensation");
+                let mut t = table(vec![
+                    (
+                        "map",
+                        Value::String(rel.to_string_lossy().replace('\\', "/")),
+                    ),
+                    ("scale", float(scale)),
+                ]);
+                if to_world != DMat4::IDENTITY {
+                    // The map is at infinity: its translation does not matter.
+                    let mut m = to_world;
+                    m.w_axis = glam::DVec4::W;
+                    let rows: Vec<Value> = (0..4).map(|r| vec_row(m.row(r).to_array())).collect();
+                    t.insert("transform".into(), Value::Array(rows));
+                }
+                if self.environment.is_some() || self.background.is_some() {
+                    self.warn(n.diag(
+                        "a second environment emitter (envmap or constant); heron's environment is the first, ignored",
+                    ))?;
+                } else {
+                    self.environment = Some(Value::Table(t));
+                }
+                None
+            }
             (other, None) => {
                 self.warn(n.diag(format!(
-                    "emitter {other:?} is not supported yet (area, point, spot, directional, constant are), ignored: the image lacks its light"
+                    "emitter {other:?} is not supported yet (area, point, spot, directional, constant, envmap are), ignored: the image lacks its light"
                 )))?;
                 return Ok(None);
             }

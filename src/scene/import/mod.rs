@@ -115,6 +115,12 @@ impl Imported {
                 }
             }
         }
+        if let Some(toml::Value::String(f)) =
+            table.get_mut("environment").and_then(|e| e.get_mut("map"))
+        {
+            let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
+            *f = rel.to_string_lossy().replace('\\', "/");
+        }
         let mut out = format!(
             "# Converted by heron {} from {}.\n",
             env!("CARGO_PKG_VERSION"),

@@ -22,13 +22,16 @@
 //! (stages 1 and 2's messages, key paths, `scene_error`), `materials.rs`, `shapes.rs`
 //! (spheres, triangles, planes, quads, meshes; `obj.rs` reads OBJ text), `media.rs`,
 //! `lights.rs` (the file's lights and the area lights of emitting shapes), `sky.rs`
-//! (`[sky]` to a [`crate::sky::SkySpec`]), `settings.rs` (`[render]`), `camera.rs`.
+//! (`[sky]` to a [`crate::sky::SkySpec`]), `environment.rs` (`[environment]`, its image
+//! read by `image.rs`), `settings.rs` (`[render]`), `camera.rs`.
 //! [`build`] runs them in the order of the errors they report.
 pub(crate) mod obj;
 pub(crate) mod ply;
 
 mod camera;
+mod environment;
 mod errors;
+pub(crate) mod image;
 pub mod lens;
 mod lights;
 mod materials;
@@ -156,6 +159,22 @@ pub(crate) fn build(
         }
         None => None,
     };
+    let envmap = match &file.environment {
+        Some(env) => {
+            if file.background.is_some() {
+                return Err(err(
+                    "environment: a scene has a background or an [environment] map, not both (the map is the background)".into(),
+                ));
+            }
+            if file.sky.is_some() {
+                return Err(err(
+                    "environment: a scene has a [sky] or an [environment] map, not both".into(),
+                ));
+            }
+            Some(environment::build_envmap(env, &base_dir, &mut inputs).map_err(err)?)
+        }
+        None => None,
+    };
     let camera = camera::build_camera(&file.camera, &base_dir, &mut inputs).map_err(err)?;
     let inputs = crate::files::hash_inputs(&base_dir, inputs).map_err(err)?;
     Ok(Scene::from_parts(SceneParts {
@@ -169,6 +188,7 @@ pub(crate) fn build(
         lights,
         background,
         sky,
+        envmap,
         settings,
         media,
     }))
