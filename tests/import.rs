@@ -628,6 +628,7 @@ fn pbrt_errors_and_warnings_name_the_line() {
         ("NamedMaterial \"nope\"\n", 6, "no material named \"nope\""),
         ("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0\n", 6, "a [ is not closed"),
         ("Translate 1 2\n", 6, "Translate: expected 3 numbers, got 2"),
+        ("Shape \"plymesh\" \"string filename\" \"a\rb.ply\"\n", 6, "a string holds the control character U+000D"),
         ("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 5 ]\n", 6, "index 5 is not one of the 3 vertices"),
     ] {
         let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));

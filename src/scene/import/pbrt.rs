@@ -76,6 +76,18 @@ fn tokenize(text: &str, file: &Path) -> Result<Vec<Token>, Diagnostic> {
                 if b[i] == b'\n' {
                     return Err(err(line, "a string runs past the end of its line".into()));
                 }
+                // pbrt-v4's tokenizer keeps them, but a name or file name holding a
+                // carriage return or another control character is a damaged file, and
+                // it would break the one-line messages that quote the name.
+                if b[i].is_ascii_control() && b[i] != b'\t' {
+                    return Err(err(
+                        line,
+                        format!(
+                            "a string holds the control character U+{:04X}; names and file names cannot",
+                            b[i]
+                        ),
+                    ));
+                }
                 i += 1;
             }
             if i >= b.len() {
