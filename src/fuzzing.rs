@@ -62,6 +62,7 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("spectral_csv", |d, _| spectral_csv(d)),
     ("ply", |d, _| ply(d)),
     ("mitsuba_xml", mitsuba_xml),
+    ("pbrt", pbrt),
 ];
 
 /// Panics unless `msg` is a usable error message: non-empty and on one line.
@@ -331,6 +332,34 @@ pub fn mitsuba_xml(data: &[u8], fixtures: &Path) -> Outcome {
     let path = fixtures.join("scene.xml");
     let options = crate::scene::import::ImportOptions::default();
     let imported = match crate::scene::import::import_mitsuba_str(text, &path, &options) {
+        Ok(i) => i,
+        Err(e) => return rejected(&e.to_string()),
+    };
+    for w in &imported.warnings {
+        check_message(&w.to_string());
+    }
+    match load::load_imported(&imported) {
+        Ok(scene) => {
+            check_scene(&scene);
+            Outcome::Accepted
+        }
+        Err(e) => rejected(&e.to_string()),
+    }
+}
+
+/// The pbrt-v4 importer on `data` as `fixtures/scene.pbrt`, then the scene it becomes.
+/// Files outside the fixtures folder are not read (inputs naming `..` or an absolute
+/// path are skipped).
+pub fn pbrt(data: &[u8], fixtures: &Path) -> Outcome {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Outcome::Skipped;
+    };
+    if text.contains("..") || text.contains("\"/") {
+        return Outcome::Skipped;
+    }
+    let path = fixtures.join("scene.pbrt");
+    let options = crate::scene::import::ImportOptions::default();
+    let imported = match crate::scene::import::import_pbrt_str(text, &path, &options) {
         Ok(i) => i,
         Err(e) => return rejected(&e.to_string()),
     };

@@ -628,6 +628,7 @@ fn pbrt_errors_and_warnings_name_the_line() {
         ("NamedMaterial \"nope\"\n", 6, "no material named \"nope\""),
         ("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0\n", 6, "a [ is not closed"),
         ("Translate 1 2\n", 6, "Translate: expected 3 numbers, got 2"),
+        ("Shape \"plymesh\" \"string filename\" \"a\rb.ply\"\n", 6, "a string holds the control character U+000D"),
         ("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 5 ]\n", 6, "index 5 is not one of the 3 vertices"),
     ] {
         let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));
@@ -650,4 +651,325 @@ fn pbrt_errors_and_warnings_name_the_line() {
         imp.warnings
     );
     assert!(has(8, "zmin"), "{:?}", imp.warnings);
+}
+
+/// The heron shape tables of a converted scene.
+fn shapes(t: &toml::Table) -> &Vec<toml::Value> {
+    get(t, "shapes").as_array().unwrap()
+}
+
+fn vertices(s: &toml::Value) -> Vec<DVec3> {
+    s["vertices"].as_array().unwrap().iter().map(v3).collect()
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-12
+}
+
+#[test]
+fn pbrt_object_instances_are_flattened_with_pbrt_v4_s_transforms_and_materials() {
+    // pbrt-v4 (src/pbrt/scene.cpp): a shape in a definition keeps the CTM at its Shape,
+    // an instance the CTM at its ObjectInstance, and a copy is placed by their product;
+    // the copy has the definition's material; ObjectBegin/End save and restore the state.
+    let body = "AttributeBegin
+Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"
+Translate 0 0 -1
+ObjectBegin \"thing\"
+Translate 0 1 0
+Shape \"sphere\" \"float radius\" 0.5
+Material \"dielectric\" \"float eta\" 1.33
+Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]
+ObjectEnd
+Shape \"sphere\" \"float radius\" 0.25
+AttributeEnd
+Material \"diffuse\"
+AttributeBegin
+Translate 2 0 0
+ObjectInstance \"thing\"
+AttributeEnd
+AttributeBegin
+Rotate 90 0 0 1
+Scale 2 2 2
+ObjectInstance \"thing\"
+AttributeEnd
+Scale -1 1 1
+ObjectInstance \"thing\"
+";
+    let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));
+    let imp = r.unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    let sh = shapes(&imp.table);
+    // The definition itself gives no shape; the world's sphere after it has the CTM
+    // and material of before ObjectBegin (the definition's Translate and Material end
+    // at ObjectEnd); then two shapes per instance, in the instances' order.
+    assert_eq!(sh.len(), 7, "{sh:#?}");
+    let material = |i: usize| sh[i]["material"].as_str().unwrap();
+    let sphere = |i: usize| (v3(&sh[i]["center"]), f(&sh[i]["radius"]));
+    assert_eq!(sphere(0), (DVec3::new(0.0, 0.0, -1.0), 0.25));
+    assert_eq!(material(0), "conductor-1");
+    // The copies keep the material current at their Shape, not the instance's diffuse.
+    for i in [1, 3, 5] {
+        assert_eq!(material(i), "conductor-1");
+        assert_eq!(sh[i]["type"].as_str(), Some("sphere"));
+    }
+    for i in [2, 4, 6] {
+        assert_eq!(material(i), "dielectric-2");
+        assert_eq!(sh[i]["type"].as_str(), Some("triangle"));
+    }
+    assert!(sh.iter().all(|s| s.get("emission").is_none()));
+    // Instance 1: T(2,0,0) · T(0,0,-1) · T(0,1,0).
+    let (c, r) = sphere(1);
+    assert!(close(c, DVec3::new(2.0, 1.0, -1.0)) && r == 0.5, "{c} {r}");
+    let want = [
+        DVec3::new(2.0, 1.0, -1.0),
+        DVec3::new(3.0, 1.0, -1.0),
+        DVec3::new(2.0, 2.0, -1.0),
+    ];
+    assert!(
+        vertices(&sh[2]).iter().zip(want).all(|(a, b)| close(*a, b)),
+        "{:?}",
+        vertices(&sh[2])
+    );
+    // Instance 2: Rz(90°) · S(2) · T(0,0,-1) · T(0,1,0): (x, y, z) → (−2y, 2x, 2z).
+    let (c, r) = sphere(3);
+    assert!(
+        close(c, DVec3::new(-2.0, 0.0, -2.0)) && (r - 1.0).abs() < 1e-12,
+        "{c} {r}"
+    );
+    let want = [
+        DVec3::new(-2.0, 0.0, -2.0),
+        DVec3::new(-2.0, 2.0, -2.0),
+        DVec3::new(-4.0, 0.0, -2.0),
+    ];
+    assert!(
+        vertices(&sh[4]).iter().zip(want).all(|(a, b)| close(*a, b)),
+        "{:?}",
+        vertices(&sh[4])
+    );
+    // Instance 3 mirrors (Scale −1 1 1): the winding is reversed so the normal is the
+    // mirrored one, as pbrt-v4's transformed normal.
+    let (c, r) = sphere(5);
+    assert!(close(c, DVec3::new(0.0, 1.0, -1.0)) && r == 0.5, "{c} {r}");
+    let want = [
+        DVec3::new(0.0, 1.0, -1.0),
+        DVec3::new(0.0, 2.0, -1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+    ];
+    assert!(
+        vertices(&sh[6]).iter().zip(want).all(|(a, b)| close(*a, b)),
+        "{:?}",
+        vertices(&sh[6])
+    );
+    let scene = load_imported(&imp).unwrap();
+    assert_eq!(scene.shapes.len(), 7);
+
+    // An instance may come before its definition (pbrt-v4 resolves the names after
+    // parsing); an empty object gives nothing; a mesh's copies take the product as
+    // their `transform`.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("scenes/meshes/prism60.ply"),
+        dir.path().join("prism60.ply"),
+    )
+    .unwrap();
+    let body = "Translate 1 2 3
+ObjectInstance \"prism\"
+Identity
+ObjectBegin \"empty\"
+ObjectEnd
+ObjectInstance \"empty\"
+ObjectBegin \"prism\"
+Scale 2 2 2
+Shape \"plymesh\" \"string filename\" \"prism60.ply\"
+ObjectEnd
+";
+    let p = write(dir.path(), "scene.pbrt", &format!("{PBRT_CAMERA}{body}"));
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    let sh = shapes(&imp.table);
+    assert_eq!(sh.len(), 1, "{sh:#?}");
+    assert_eq!(sh[0]["file"].as_str(), Some("prism60.ply"));
+    let rows: Vec<Vec<f64>> = sh[0]["transform"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r.as_array().unwrap().iter().map(f).collect())
+        .collect();
+    assert_eq!(
+        rows,
+        vec![
+            vec![2.0, 0.0, 0.0, 1.0],
+            vec![0.0, 2.0, 0.0, 2.0],
+            vec![0.0, 0.0, 2.0, 3.0],
+            vec![0.0, 0.0, 0.0, 1.0],
+        ]
+    );
+    load_imported(&imp).unwrap();
+}
+
+#[test]
+fn a_pbrt_object_instanced_once_in_place_converts_to_the_shapes_written_inline() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("scenes/meshes/prism60.ply"),
+        dir.path().join("prism60.ply"),
+    )
+    .unwrap();
+    let shapes = "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.5 0.8 ]
+Translate 0 -0.5 0
+Shape \"sphere\" \"float radius\" 0.5
+Shape \"bilinearmesh\" \"point3 P\" [ -2 -1 -2  2 -1 -2  -2 -1 2  2 -1 2 ]
+Rotate 20 0 1 0
+Shape \"plymesh\" \"string filename\" \"prism60.ply\"
+ReverseOrientation
+Shape \"trianglemesh\" \"point3 P\" [ -1 0 -1  1 0 -1  0 1 -1 ] \"integer indices\" [ 0 1 2 ]
+";
+    let lights = "LightSource \"point\" \"rgb I\" [ 4 4 4 ] \"point3 from\" [ 1 2 3 ]\n";
+    let inline = write(
+        dir.path(),
+        "inline.pbrt",
+        &format!("{PBRT_CAMERA}{lights}AttributeBegin\n{shapes}AttributeEnd\n"),
+    );
+    let instanced = write(
+        dir.path(),
+        "instanced.pbrt",
+        &format!(
+            "{PBRT_CAMERA}{lights}ObjectBegin \"o\"\n{shapes}ObjectEnd\nObjectInstance \"o\"\n"
+        ),
+    );
+    let a = import_scene(&inline, &ImportOptions::default()).unwrap();
+    let b = import_scene(&instanced, &ImportOptions::default()).unwrap();
+    assert!(
+        a.warnings.is_empty() && b.warnings.is_empty(),
+        "{:?} {:?}",
+        a.warnings,
+        b.warnings
+    );
+    assert_eq!(shapes_len(&a), 4);
+    assert_eq!(a.table, b.table);
+    // The TOML `heron convert` writes is the same but for the comment naming the source.
+    let body = |i: &Imported| {
+        i.to_toml(dir.path())
+            .split_once('\n')
+            .unwrap()
+            .1
+            .to_string()
+    };
+    assert_eq!(body(&a), body(&b));
+    // And so are the pixels.
+    let (mut sa, mut sb) = (load_imported(&a).unwrap(), load_imported(&b).unwrap());
+    sa.camera = sa.camera.resized(16, 8).unwrap();
+    sb.camera = sb.camera.resized(16, 8).unwrap();
+    let (fa, fb) = (
+        run(&sa, IntegratorKind::Path, 4, 1),
+        run(&sb, IntegratorKind::Path, 4, 1),
+    );
+    assert!(fa.xyz.iter().filter(|p| p[1] > 0.0).count() > 16);
+    assert_eq!(fa.xyz, fb.xyz);
+}
+
+fn shapes_len(i: &Imported) -> usize {
+    shapes(&i.table).len()
+}
+
+#[test]
+fn pbrt_object_errors_name_the_file_and_line() {
+    for (body, line, want) in [
+        ("ObjectInstance \"nope\"\n", 6, "ObjectInstance: no object named \"nope\" was defined"),
+        ("ObjectBegin \"a\"\nAttributeBegin\nObjectBegin \"b\"\n", 8, "ObjectBegin \"b\": inside the definition of ObjectBegin \"a\" (line 6); object definitions do not nest"),
+        ("ObjectEnd\n", 6, "ObjectEnd without a matching ObjectBegin"),
+        ("ObjectBegin \"a\"\nAttributeBegin\nAttributeEnd\n", 6, "ObjectBegin \"a\" is not closed by an ObjectEnd before the end of the file"),
+        ("ObjectBegin \"a\"\nShape \"sphere\"\n", 6, "ObjectBegin \"a\" is not closed by an ObjectEnd before the end of the file"),
+        ("ObjectBegin \"a\"\nObjectInstance \"a\"\n", 7, "ObjectInstance \"a\": inside the definition of ObjectBegin \"a\" (line 6)"),
+        ("ObjectBegin \"a\"\nObjectEnd\nObjectBegin \"a\"\n", 8, "ObjectBegin \"a\": an object of that name was defined before (line 6)"),
+        ("ObjectBegin \"a\"\nAttributeBegin\nObjectEnd\n", 8, "ObjectEnd: AttributeBegin (line 7) is still open"),
+        ("ObjectBegin \"a\"\nShape \"sphere\"\nObjectEnd\nScale 1 2 1\nObjectInstance \"a\"\n", 10, "ObjectInstance \"a\", the shape of line 7: Shape \"sphere\": heron's spheres take a uniform scale only"),
+    ] {
+        let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));
+        let e = r.unwrap_err().to_string();
+        assert!(!e.contains('\n'), "{e}");
+        assert!(e.contains(&format!("scene.pbrt: line {line}: ")) && e.contains(want), "{body}: {e}");
+    }
+    // The AttributeEnd case reports the block it meets first: the open definition.
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}AttributeBegin\nObjectBegin \"a\"\nAttributeEnd\n"
+    ));
+    let e = r.unwrap_err().to_string();
+    assert!(
+        e.contains("scene.pbrt: line 8: AttributeEnd: ObjectBegin \"a\" (line 7) is still open"),
+        "{e}"
+    );
+
+    // A definition may span an Include (spliced as text) but not an Import (pbrt-v4
+    // parses an imported file with a builder of its own).
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "part.pbrt", "Shape \"sphere\"\nObjectEnd\n");
+    write(
+        dir.path(),
+        "open.pbrt",
+        "ObjectBegin \"b\"\nShape \"sphere\"\n",
+    );
+    let main = |how: &str| {
+        format!("{PBRT_CAMERA}ObjectBegin \"a\"\n{how} \"part.pbrt\"\nObjectInstance \"a\"\n")
+    };
+    let p = write(dir.path(), "scene.pbrt", &main("Include"));
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    assert_eq!(shapes_len(&imp), 1);
+    let p = write(dir.path(), "scene.pbrt", &main("Import"));
+    let e = import_scene(&p, &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("part.pbrt: line 2: ObjectEnd: ObjectBegin \"a\" (line 6 of ")
+            && e.contains("was opened outside this imported file"),
+        "{e}"
+    );
+    let p = write(
+        dir.path(),
+        "scene.pbrt",
+        &format!("{PBRT_CAMERA}Import \"open.pbrt\"\n"),
+    );
+    let e = import_scene(&p, &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("open.pbrt: line 1: ObjectBegin \"b\" is not closed by an ObjectEnd before the end of the imported file"), "{e}");
+}
+
+#[test]
+fn pbrt_area_lights_in_an_object_warn_and_do_not_emit() {
+    let body = "AreaLightSource \"diffuse\" \"rgb L\" [ 4 4 4 ]
+ObjectBegin \"lamp\"
+Shape \"sphere\" \"float radius\" 0.1
+ObjectEnd
+ObjectInstance \"lamp\"
+Shape \"sphere\" \"float radius\" 0.2
+";
+    let text = format!("{PBRT_CAMERA}{body}");
+    let (_d, r) = import_pbrt(&text);
+    let imp = r.unwrap();
+    assert_eq!(imp.warnings.len(), 1, "{:?}", imp.warnings);
+    let w = imp.warnings[0].to_string();
+    assert!(
+        w.contains("scene.pbrt")
+            && w.contains("line 8")
+            && w.contains("area lights are not supported in object instances")
+            && !w.contains('\n'),
+        "{w}"
+    );
+    let sh = shapes(&imp.table);
+    assert_eq!(sh.len(), 2);
+    assert!(sh[0].get("emission").is_none());
+    // The area light still applies outside the definition.
+    assert!(sh[1].get("emission").is_some());
+    // --strict makes it an error.
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "scene.pbrt", &text);
+    let strict = ImportOptions {
+        strict: true,
+        ..Default::default()
+    };
+    let e = import_scene(&p, &strict).unwrap_err().to_string();
+    assert!(
+        e.contains("scene.pbrt: line 8: ") && e.contains("area lights"),
+        "{e}"
+    );
 }

@@ -1,5 +1,6 @@
 //! Scenes written for other renderers, converted to the TOML heron renders: Mitsuba 3's
-//! XML (`xml.rs` reads the document, `mitsuba.rs` converts its objects). `heron render
+//! XML (`xml.rs` reads the document, `mitsuba.rs` converts its objects) and pbrt-v4's
+//! scene files (`pbrt.rs`). `heron render
 //! scene.xml` renders the conversion; `heron convert scene.xml -o scene.toml` writes it
 //! for editing. What heron cannot carry over is a [`Diagnostic`]: a warning naming the
 //! file, line and element, or an error with `strict`.
@@ -94,6 +95,17 @@ pub fn import_scene(path: &Path, options: &ImportOptions) -> Result<Imported> {
 pub fn import_mitsuba_str(text: &str, path: &Path, options: &ImportOptions) -> Result<Imported> {
     let root = xml::read_document_from_str(text, path, &options.defines).map_err(error)?;
     let c = mitsuba::convert(&root, path, options.strict).map_err(error)?;
+    Ok(Imported {
+        source: path.to_path_buf(),
+        table: c.table,
+        warnings: c.warnings,
+    })
+}
+
+/// [`import_scene`] for a pbrt-v4 file already in memory, read as if from `path` (its
+/// `Include`s and meshes from `path`'s folder).
+pub fn import_pbrt_str(text: &str, path: &Path, options: &ImportOptions) -> Result<Imported> {
+    let c = pbrt::convert_str(text, path, options.strict).map_err(error)?;
     Ok(Imported {
         source: path.to_path_buf(),
         table: c.table,

@@ -7,6 +7,17 @@
 //! scattering events as heron's `max_depth` does, and a roughness is remapped to
 //! α = √r unless `remaproughness` is false (pbrt-v4's `TrowbridgeReitzDistribution::
 //! RoughnessToAlpha`).
+//!
+//! Object instancing (`ObjectBegin`/`ObjectEnd`/`ObjectInstance`) is flattened: every
+//! `ObjectInstance` emits a copy of the object's shapes. The composition is pbrt-v4's
+//! (`src/pbrt/scene.cpp`, `BasicSceneBuilder::Shape` and `::ObjectInstance`, and
+//! `BasicScene::CreateAggregate`, which wraps the definition in a `TransformedPrimitive`):
+//! a shape inside a definition keeps the CTM current at its `Shape` (render-from-object),
+//! the instance the CTM current at its `ObjectInstance` (render-from-instance, the world
+//! transform `renderFromWorld` cancelling between the two), so a copy's world-from-shape
+//! matrix is CTM(instance) · CTM(shape). Everything else a copy has (material, reverse
+//! orientation) is the definition's; instances may come before their definition (pbrt-v4
+//! resolves them after parsing), and area lights in a definition do not emit.
 use super::mitsuba::{float, relative_to, scene_table, table, vec3, Converted};
 use super::xml::Diagnostic;
 use glam::{DMat4, DVec3};
@@ -64,6 +75,18 @@ fn tokenize(text: &str, file: &Path) -> Result<Vec<Token>, Diagnostic> {
             while i < b.len() && b[i] != b'"' {
                 if b[i] == b'\n' {
                     return Err(err(line, "a string runs past the end of its line".into()));
+                }
+                // pbrt-v4's tokenizer keeps them, but a name or file name holding a
+                // carriage return or another control character is a damaged file, and
+                // it would break the one-line messages that quote the name.
+                if b[i].is_ascii_control() && b[i] != b'\t' {
+                    return Err(err(
+                        line,
+                        format!(
+                            "a string holds the control character U+{:04X}; names and file names cannot",
+                            b[i]
+                        ),
+                    ));
                 }
                 i += 1;
             }
@@ -139,13 +162,83 @@ struct Graphics {
     reverse: bool,
 }
 
+/// A shape as its `Shape` directive gave it, in its own (object) space: what
+/// [`Conv::emit`] places with a matrix, once for a shape in the world and once per
+/// `ObjectInstance` for a shape in an object definition.
+#[derive(Clone, Debug)]
+enum Geom {
+    Sphere {
+        radius: f64,
+    },
+    /// `trianglemesh` (3 indices a face) or `bilinearmesh` (4, pbrt's p00 p10 p01 p11).
+    Mesh {
+        kind: &'static str,
+        points: Vec<DVec3>,
+        faces: Vec<Vec<usize>>,
+    },
+    /// A PLY file, its path relative to the scene's folder.
+    Ply {
+        file: String,
+    },
+}
+
+/// A `Shape` with the graphics state current at it (pbrt-v4's `ShapeSceneEntity`: the
+/// render-from-object transform, reverse orientation, material and area light).
+#[derive(Clone, Debug)]
+struct ShapeDef {
+    geom: Geom,
+    ctm: DMat4,
+    reverse: bool,
+    material: String,
+    area: Option<(Value, bool)>,
+    file: PathBuf,
+    line: u32,
+}
+
+/// An `ObjectBegin` … `ObjectEnd` definition.
+#[derive(Clone, Debug)]
+struct ObjectDef {
+    name: String,
+    file: PathBuf,
+    line: u32,
+    /// How many `Import`s deep it was opened: pbrt-v4 parses an imported file with a
+    /// builder of its own, so a definition does not span an `Import`'s boundary
+    /// (`BasicSceneBuilder::ObjectEnd`, `::MergeImported`).
+    import_depth: usize,
+    shapes: Vec<ShapeDef>,
+}
+
+/// What the shapes list holds until the end of the files: shapes, and instances to be
+/// resolved then (pbrt-v4 resolves `ObjectInstance` names after parsing, so an instance
+/// may come first), each in file order.
+#[derive(Clone, Debug)]
+enum Slot {
+    Shape(Value),
+    Instance {
+        name: String,
+        ctm: DMat4,
+        file: PathBuf,
+        line: u32,
+    },
+}
+
+/// One open `AttributeBegin`, `TransformBegin` or `ObjectBegin`: the graphics state it
+/// saved, and where it was opened (pbrt-v4's `pushedGraphicsStates` and `pushStack`).
+#[derive(Clone)]
+struct Pushed {
+    g: Graphics,
+    what: &'static str,
+    file: PathBuf,
+    line: u32,
+}
+
 struct Conv {
     base: PathBuf,
     strict: bool,
     warnings: Vec<Diagnostic>,
     materials: Table,
     named: HashMap<String, String>,
-    shapes: Vec<Value>,
+    shapes: Vec<Slot>,
     lights: Vec<Value>,
     background: Option<Value>,
     camera: Option<Table>,
@@ -153,50 +246,123 @@ struct Conv {
     resolution: (i64, i64),
     render: Table,
     g: Graphics,
-    stack: Vec<Graphics>,
+    stack: Vec<Pushed>,
     n_material: usize,
     default_material: Option<String>,
+    /// The object being defined (between `ObjectBegin` and `ObjectEnd`).
+    object: Option<ObjectDef>,
+    objects: HashMap<String, ObjectDef>,
+    import_depth: usize,
 }
 
 /// Converts the pbrt-v4 file `path`.
 pub fn convert(path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
-    let mut c = Conv {
-        base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
-        strict,
-        warnings: Vec::new(),
-        materials: Table::new(),
-        named: HashMap::new(),
-        shapes: Vec::new(),
-        lights: Vec::new(),
-        background: None,
-        camera: None,
-        camera_from_world: None,
-        resolution: (1280, 720),
-        render: Table::new(),
-        g: Graphics {
-            ctm: DMat4::IDENTITY,
-            material: None,
-            area: None,
-            reverse: false,
-        },
-        stack: Vec::new(),
-        n_material: 0,
-        default_material: None,
-    };
+    let mut c = Conv::new(path, strict);
     c.file(path, 0, None)?;
-    c.finish_camera(path)?;
-    let t = scene_table(
-        c.camera.take().expect("finish_camera sets it"),
-        std::mem::take(&mut c.render),
-        c.background.take(),
-        std::mem::take(&mut c.materials),
-        std::mem::take(&mut c.shapes),
-        std::mem::take(&mut c.lights),
-    );
-    Ok(Converted {
-        table: t,
-        warnings: c.warnings,
-    })
+    c.finish(path)
+}
+
+/// Converts pbrt-v4 text already in memory, read as if from `path` (its `Include`s and
+/// meshes are read from `path`'s folder).
+pub fn convert_str(text: &str, path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
+    let mut c = Conv::new(path, strict);
+    c.text(text, path, 0)?;
+    c.finish(path)
+}
+
+impl Conv {
+    fn new(path: &Path, strict: bool) -> Conv {
+        Conv {
+            base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+            strict,
+            warnings: Vec::new(),
+            materials: Table::new(),
+            named: HashMap::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+            background: None,
+            camera: None,
+            camera_from_world: None,
+            resolution: (1280, 720),
+            render: Table::new(),
+            g: Graphics {
+                ctm: DMat4::IDENTITY,
+                material: None,
+                area: None,
+                reverse: false,
+            },
+            stack: Vec::new(),
+            n_material: 0,
+            default_material: None,
+            object: None,
+            objects: HashMap::new(),
+            import_depth: 0,
+        }
+    }
+
+    /// After the last file: the open definition is an error, the instances become
+    /// shapes, and the camera and tables are put together.
+    fn finish(mut self, path: &Path) -> Result<Converted, Diagnostic> {
+        if let Some(o) = &self.object {
+            return Err(self.diag(
+                &o.file,
+                o.line,
+                format!(
+                    "ObjectBegin {:?} is not closed by an ObjectEnd before the end of the file",
+                    o.name
+                ),
+            ));
+        }
+        let shapes = self.instantiate()?;
+        self.finish_camera(path)?;
+        let t = scene_table(
+            self.camera.take().expect("finish_camera sets it"),
+            std::mem::take(&mut self.render),
+            self.background.take(),
+            std::mem::take(&mut self.materials),
+            shapes,
+            std::mem::take(&mut self.lights),
+        );
+        Ok(Converted {
+            table: t,
+            warnings: self.warnings,
+        })
+    }
+
+    /// The shapes list with each `ObjectInstance` replaced by copies of its object's
+    /// shapes, each placed by CTM(instance) · CTM(shape) (pbrt-v4 `src/pbrt/scene.cpp`:
+    /// `renderFromInstance = RenderFromObject(0) * worldFromRender` applied on top of the
+    /// shapes' own `renderFromObject`). An unknown name is an error at the instance, as
+    /// in pbrt-v4's `CreateAggregate` ("object instance not defined"); an empty object
+    /// gives nothing.
+    fn instantiate(&mut self) -> Result<Vec<Value>, Diagnostic> {
+        let slots = std::mem::take(&mut self.shapes);
+        let objects = std::mem::take(&mut self.objects);
+        let mut out = Vec::with_capacity(slots.len());
+        for slot in slots {
+            match slot {
+                Slot::Shape(v) => out.push(v),
+                Slot::Instance {
+                    name,
+                    ctm,
+                    file,
+                    line,
+                } => {
+                    let Some(o) = objects.get(&name) else {
+                        return Err(self.diag(
+                            &file,
+                            line,
+                            format!("ObjectInstance: no object named {name:?} was defined (ObjectBegin {name:?} … ObjectEnd)"),
+                        ));
+                    };
+                    for sd in &o.shapes {
+                        out.extend(self.emit(sd, Some((&name, ctm, &file, line)))?);
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
 }
 
 fn s(v: &str) -> Value {
@@ -239,7 +405,12 @@ impl Conv {
         }
         let text = std::fs::read_to_string(path)
             .map_err(|e| self.diag(ff, fl, format!("cannot read {}: {e}", path.display())))?;
-        let toks = tokenize(&text, path)?;
+        self.text(&text, path, depth)
+    }
+
+    /// The directives of `text`, the contents of `path`.
+    fn text(&mut self, text: &str, path: &Path, depth: usize) -> Result<(), Diagnostic> {
+        let toks = tokenize(text, path)?;
         let mut i = 0;
         while i < toks.len() {
             let line = toks[i].line;
@@ -534,16 +705,47 @@ impl Conv {
             "WorldBegin" => {
                 self.g.ctm = DMat4::IDENTITY;
             }
-            "AttributeBegin" | "TransformBegin" => self.stack.push(self.g.clone()),
+            "AttributeBegin" => self.push("AttributeBegin", path, line),
+            "TransformBegin" => self.push("TransformBegin", path, line),
             "AttributeEnd" | "TransformEnd" => {
-                let Some(g) = self.stack.pop() else {
+                let Some(top) = self.stack.last() else {
                     return Err(self.diag(path, line, format!("{d} without a matching begin")));
                 };
+                // pbrt-v4 (`BasicSceneBuilder::AttributeEnd`, which TransformEnd calls):
+                // "Mismatched nesting: open ObjectBegin … at AttributeEnd".
+                if top.what == "ObjectBegin" {
+                    let m = format!(
+                        "{d}: ObjectBegin {:?} ({}) is still open; close it with ObjectEnd first",
+                        self.object.as_ref().map_or("", |o| o.name.as_str()),
+                        at(&top.file, top.line, path)
+                    );
+                    return Err(self.diag(path, line, m));
+                }
+                let g = self.stack.pop().expect("checked above").g;
                 if d == "TransformEnd" {
                     self.g.ctm = g.ctm;
                 } else {
                     self.g = g;
                 }
+            }
+            "ObjectBegin" => self.object_begin(path, line, &name())?,
+            "ObjectEnd" => self.object_end(path, line)?,
+            "ObjectInstance" => {
+                if let Some(o) = &self.object {
+                    let m = format!(
+                        "ObjectInstance {:?}: inside the definition of ObjectBegin {:?} ({}); pbrt-v4 does not allow instances in an object",
+                        name(),
+                        o.name,
+                        at(&o.file, o.line, path)
+                    );
+                    return Err(self.diag(path, line, m));
+                }
+                self.shapes.push(Slot::Instance {
+                    name: name(),
+                    ctm: self.g.ctm,
+                    file: path.to_path_buf(),
+                    line,
+                });
             }
             "ReverseOrientation" => self.g.reverse = !self.g.reverse,
             "Material" => {
@@ -573,14 +775,32 @@ impl Conv {
             }
             "LightSource" => self.light(path, line, &name(), p)?,
             "Shape" => self.shape(path, line, &name(), p)?,
-            "Include" | "Import" => {
+            "Include" => {
                 let f = self.base_of(path).join(name());
                 self.file(&f, depth + 1, Some((path, line)))?;
             }
+            "Import" => {
+                let f = self.base_of(path).join(name());
+                self.import_depth += 1;
+                let r = self.file(&f, depth + 1, Some((path, line)));
+                self.import_depth -= 1;
+                r?;
+                // An imported file is parsed by a builder of its own in pbrt-v4, whose
+                // open blocks are errors at its end (`BasicSceneBuilder::MergeImported`).
+                if let Some(o) = &self.object {
+                    if o.import_depth > self.import_depth {
+                        return Err(self.diag(
+                            &o.file,
+                            o.line,
+                            format!("ObjectBegin {:?} is not closed by an ObjectEnd before the end of the imported file", o.name),
+                        ));
+                    }
+                }
+            }
             "WorldEnd" | "OptionBool" | "ColorSpace" | "Option" => {}
-            "Texture" | "MakeNamedMedium" | "MediumInterface" | "ObjectBegin" | "ObjectEnd"
-            | "ObjectInstance" | "CoordinateSystem" | "CoordSysTransform" | "Attribute"
-            | "PixelFilter" | "Accelerator" | "ActiveTransform" | "TransformTimes" => {
+            "Texture" | "MakeNamedMedium" | "MediumInterface" | "CoordinateSystem"
+            | "CoordSysTransform" | "Attribute" | "PixelFilter" | "Accelerator"
+            | "ActiveTransform" | "TransformTimes" => {
                 for q in &p.0 {
                     q.used.set(true);
                 }
@@ -597,6 +817,80 @@ impl Conv {
 
     fn base_of(&self, path: &Path) -> PathBuf {
         path.parent().unwrap_or(Path::new("")).to_path_buf()
+    }
+
+    fn push(&mut self, what: &'static str, path: &Path, line: u32) {
+        self.stack.push(Pushed {
+            g: self.g.clone(),
+            what,
+            file: path.to_path_buf(),
+            line,
+        });
+    }
+
+    /// pbrt-v4's `BasicSceneBuilder::ObjectBegin`: it saves the graphics state as
+    /// `AttributeBegin` does (so what the definition changes ends at its `ObjectEnd`),
+    /// and refuses a definition inside another and a name defined before.
+    fn object_begin(&mut self, path: &Path, line: u32, name: &str) -> Result<(), Diagnostic> {
+        if let Some(o) = &self.object {
+            let m = format!(
+                "ObjectBegin {name:?}: inside the definition of ObjectBegin {:?} ({}); object definitions do not nest",
+                o.name,
+                at(&o.file, o.line, path)
+            );
+            return Err(self.diag(path, line, m));
+        }
+        if let Some(o) = self.objects.get(name) {
+            let m = format!(
+                "ObjectBegin {name:?}: an object of that name was defined before ({}); pbrt-v4 does not redefine one",
+                at(&o.file, o.line, path)
+            );
+            return Err(self.diag(path, line, m));
+        }
+        self.push("ObjectBegin", path, line);
+        self.object = Some(ObjectDef {
+            name: name.to_string(),
+            file: path.to_path_buf(),
+            line,
+            import_depth: self.import_depth,
+            shapes: Vec::new(),
+        });
+        Ok(())
+    }
+
+    /// pbrt-v4's `BasicSceneBuilder::ObjectEnd`: the graphics state saved by its
+    /// `ObjectBegin` comes back; an `AttributeBegin` still open inside the definition,
+    /// or a definition opened outside the `Import`ed file being read, is an error.
+    fn object_end(&mut self, path: &Path, line: u32) -> Result<(), Diagnostic> {
+        let Some(o) = &self.object else {
+            return Err(self.diag(path, line, "ObjectEnd without a matching ObjectBegin"));
+        };
+        if o.import_depth != self.import_depth {
+            let m = format!(
+                "ObjectEnd: ObjectBegin {:?} ({}) was opened outside this imported file, and pbrt-v4 does not close it inside one",
+                o.name,
+                at(&o.file, o.line, path)
+            );
+            return Err(self.diag(path, line, m));
+        }
+        match self.stack.last() {
+            Some(top) if top.what == "ObjectBegin" => {}
+            Some(top) => {
+                let m = format!(
+                    "ObjectEnd: {} ({}) is still open; close it first",
+                    top.what,
+                    at(&top.file, top.line, path)
+                );
+                return Err(self.diag(path, line, m));
+            }
+            // ObjectBegin pushed the state and no End pops it while it is on top.
+            None => return Err(self.diag(path, line, "ObjectEnd without a matching ObjectBegin")),
+        }
+        if let (Some(top), Some(o)) = (self.stack.pop(), self.object.take()) {
+            self.g = top.g;
+            self.objects.insert(o.name.clone(), o);
+        }
+        Ok(())
     }
 
     /// A colour parameter: "rgb" or a constant "spectrum"/"float"; named spectra warn.
@@ -814,43 +1108,83 @@ impl Conv {
         Ok(())
     }
 
+    /// A `Shape` directive: its geometry read once, then placed now (a shape in the
+    /// world) or kept with the graphics state for each `ObjectInstance` (a shape in an
+    /// object definition; pbrt-v4 `BasicSceneBuilder::Shape` keeps the CTM, reverse
+    /// orientation and material current here, so a copy has the definition's material).
     fn shape(&mut self, path: &Path, line: u32, kind: &str, p: &Params) -> Result<(), Diagnostic> {
-        let m = self.g.ctm;
-        let flip = self.g.reverse ^ (m.determinant() < 0.0);
-        let mut entries: Vec<Table> = Vec::new();
-        match kind {
-            "sphere" => {
-                let r = p.float("radius").unwrap_or(1.0);
-                let m3 = glam::DMat3::from_mat4(m);
-                let sc = [m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length()];
-                if (sc[0] - sc[1]).abs() > 1e-6 * sc[0] || (sc[0] - sc[2]).abs() > 1e-6 * sc[0] {
-                    return Err(self.diag(
-                        path,
-                        line,
-                        "Shape \"sphere\": heron's spheres take a uniform scale only",
-                    ));
+        let Some(geom) = self.geometry(path, line, kind, p)? else {
+            return Ok(());
+        };
+        let material = match self.g.material.clone() {
+            Some(mm) => mm,
+            None => self.default_material(),
+        };
+        let mut area = self.g.area.clone();
+        if let Some(o) = &self.object {
+            if area.is_some() {
+                // pbrt-v4 warns "Area lights not supported with object instancing" and
+                // makes the lights of the world's shapes only (`BasicScene::CreateLights`),
+                // so an instance's copies do not emit.
+                let m = format!("Shape {kind:?} inside ObjectBegin {:?}: area lights are not supported in object instances (as in pbrt-v4), so its copies do not emit", o.name);
+                self.warn(self.diag(path, line, m))?;
+                area = None;
+            }
+        }
+        let sd = ShapeDef {
+            geom,
+            ctm: self.g.ctm,
+            reverse: self.g.reverse,
+            material,
+            area,
+            file: path.to_path_buf(),
+            line,
+        };
+        match &mut self.object {
+            Some(o) => o.shapes.push(sd),
+            None => {
+                for v in self.emit(&sd, None)? {
+                    self.shapes.push(Slot::Shape(v));
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// A shape's geometry in its own space, its parameters checked; `None` (and a
+    /// warning) for a shape heron does not have.
+    fn geometry(
+        &mut self,
+        path: &Path,
+        line: u32,
+        kind: &str,
+        p: &Params,
+    ) -> Result<Option<Geom>, Diagnostic> {
+        Ok(Some(match kind {
+            "sphere" => {
+                let radius = p.float("radius").unwrap_or(1.0);
                 for k in ["zmin", "zmax", "phimax"] {
                     if p.get(k).is_some() {
                         self.warn(self.diag(path, line, format!("Shape \"sphere\": {k} (a partial sphere) is not supported, the whole sphere is used")))?;
                     }
                 }
-                entries.push(table(vec![
-                    ("type", s("sphere")),
-                    ("center", vec3(m.transform_point3(DVec3::ZERO))),
-                    ("radius", float(r * sc[0])),
-                ]));
+                Geom::Sphere { radius }
             }
             "trianglemesh" | "bilinearmesh" => {
+                let kind = if kind == "trianglemesh" {
+                    "trianglemesh"
+                } else {
+                    "bilinearmesh"
+                };
                 let pts = p.get("P").map(|q| q.nums.clone()).unwrap_or_default();
                 let idx = p.get("indices").map(|q| q.nums.clone());
                 if pts.len() % 3 != 0 || pts.is_empty() {
                     return Err(self.diag(path, line, format!("Shape {kind:?}: expected \"point3 P\" with a multiple of 3 numbers, got {}", pts.len())));
                 }
                 let n = pts.len() / 3;
-                let verts: Vec<DVec3> = pts
+                let points: Vec<DVec3> = pts
                     .chunks(3)
-                    .map(|c| m.transform_point3(DVec3::new(c[0], c[1], c[2])))
+                    .map(|c| DVec3::new(c[0], c[1], c[2]))
                     .collect();
                 let per = if kind == "trianglemesh" { 3 } else { 4 };
                 let idx = idx.unwrap_or_else(|| {
@@ -867,8 +1201,9 @@ impl Conv {
                         format!("Shape {kind:?}: expected \"integer indices\", {per} per face"),
                     ));
                 }
+                let mut faces = Vec::with_capacity(idx.len() / per);
                 for f in idx.chunks(per) {
-                    let mut ix = Vec::new();
+                    let mut ix = Vec::with_capacity(per);
                     for &v in f {
                         if !(v >= 0.0 && (v as usize) < n && v.fract() == 0.0) {
                             return Err(self.diag(
@@ -879,41 +1214,15 @@ impl Conv {
                         }
                         ix.push(v as usize);
                     }
-                    // A flat parallelogram patch (p00, p10, p01, p11) is heron's quad,
-                    // normal (p10 − p00) × (p01 − p00) as pbrt's; others two triangles.
-                    if per == 4 {
-                        let (o, a, b, c) = (verts[ix[0]], verts[ix[1]], verts[ix[2]], verts[ix[3]]);
-                        let scale = (a - o).length().max((b - o).length());
-                        if (c - (a + b - o)).length() <= 1e-9 * scale {
-                            let (e1, e2) = if flip { (b - o, a - o) } else { (a - o, b - o) };
-                            entries.push(table(vec![
-                                ("type", s("quad")),
-                                ("origin", vec3(o)),
-                                ("edge1", vec3(e1)),
-                                ("edge2", vec3(e2)),
-                            ]));
-                            continue;
-                        }
-                    }
-                    // pbrt's bilinear patch (p00, p10, p01, p11) as two triangles.
-                    let tris: Vec<[usize; 3]> = if per == 3 {
-                        vec![[ix[0], ix[1], ix[2]]]
-                    } else {
-                        vec![[ix[0], ix[1], ix[3]], [ix[0], ix[3], ix[2]]]
-                    };
-                    for t in tris {
-                        let t = if flip { [t[0], t[2], t[1]] } else { t };
-                        entries.push(table(vec![
-                            ("type", s("triangle")),
-                            (
-                                "vertices",
-                                Value::Array(t.iter().map(|&k| vec3(verts[k])).collect()),
-                            ),
-                        ]));
-                    }
+                    faces.push(ix);
                 }
                 for k in ["N", "uv", "S", "faceIndices"] {
                     p.get(k);
+                }
+                Geom::Mesh {
+                    kind,
+                    points,
+                    faces,
                 }
             }
             "plymesh" => {
@@ -933,13 +1242,120 @@ impl Conv {
                 }
                 let full = self.base_of(path).join(&f);
                 let rel = relative_to(&full, &self.base);
-                if flip {
-                    self.warn(self.diag(path, line, "Shape \"plymesh\": ReverseOrientation or a mirroring transform on a mesh is not supported, ignored"))?;
+                for k in ["displacement", "edgelength"] {
+                    if p.get(k).is_some() {
+                        self.warn(self.diag(
+                            path,
+                            line,
+                            format!("Shape \"plymesh\": {k} is not supported, ignored"),
+                        ))?;
+                    }
                 }
-                let mut t = table(vec![
-                    ("type", s("mesh")),
-                    ("file", s(&rel.to_string_lossy().replace('\\', "/"))),
-                ]);
+                Geom::Ply {
+                    file: rel.to_string_lossy().replace('\\', "/"),
+                }
+            }
+            other => {
+                for q in &p.0 {
+                    q.used.set(true);
+                }
+                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
+                return Ok(None);
+            }
+        }))
+    }
+
+    /// The heron shape tables of `sd` placed by its CTM, or for an `ObjectInstance`
+    /// (`inst`: the object's name, the instance's CTM, file and line) by CTM(instance) ·
+    /// CTM(shape). What depends on the whole matrix (a sphere's uniform scale, a mirror
+    /// flipping the winding) is decided here, a copy's message naming the instance.
+    fn emit(
+        &mut self,
+        sd: &ShapeDef,
+        inst: Option<(&str, DMat4, &Path, u32)>,
+    ) -> Result<Vec<Value>, Diagnostic> {
+        let m = match inst {
+            Some((_, ctm, _, _)) => ctm * sd.ctm,
+            None => sd.ctm,
+        };
+        // Where a message about the placed shape points: the shape, or the instance
+        // (whose transform is the one to fix), naming the shape's line.
+        let (file, line, ctx) = match inst {
+            Some((name, _, f, l)) => (
+                f.to_path_buf(),
+                l,
+                format!(
+                    "ObjectInstance {name:?}, the shape of {}: ",
+                    at(&sd.file, sd.line, f)
+                ),
+            ),
+            None => (sd.file.clone(), sd.line, String::new()),
+        };
+        let flip = sd.reverse ^ (m.determinant() < 0.0);
+        let mut entries: Vec<Table> = Vec::new();
+        match &sd.geom {
+            Geom::Sphere { radius } => {
+                let m3 = glam::DMat3::from_mat4(m);
+                let sc = [m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length()];
+                if (sc[0] - sc[1]).abs() > 1e-6 * sc[0] || (sc[0] - sc[2]).abs() > 1e-6 * sc[0] {
+                    return Err(self.diag(
+                        &file,
+                        line,
+                        format!("{ctx}Shape \"sphere\": heron's spheres take a uniform scale only"),
+                    ));
+                }
+                entries.push(table(vec![
+                    ("type", s("sphere")),
+                    ("center", vec3(m.transform_point3(DVec3::ZERO))),
+                    ("radius", float(radius * sc[0])),
+                ]));
+            }
+            Geom::Mesh {
+                kind,
+                points,
+                faces,
+            } => {
+                let verts: Vec<DVec3> = points.iter().map(|&q| m.transform_point3(q)).collect();
+                for ix in faces {
+                    // A flat parallelogram patch (p00, p10, p01, p11) is heron's quad,
+                    // normal (p10 − p00) × (p01 − p00) as pbrt's; others two triangles.
+                    if *kind == "bilinearmesh" {
+                        let (o, a, b, c) = (verts[ix[0]], verts[ix[1]], verts[ix[2]], verts[ix[3]]);
+                        let scale = (a - o).length().max((b - o).length());
+                        if (c - (a + b - o)).length() <= 1e-9 * scale {
+                            let (e1, e2) = if flip { (b - o, a - o) } else { (a - o, b - o) };
+                            entries.push(table(vec![
+                                ("type", s("quad")),
+                                ("origin", vec3(o)),
+                                ("edge1", vec3(e1)),
+                                ("edge2", vec3(e2)),
+                            ]));
+                            continue;
+                        }
+                    }
+                    // pbrt's bilinear patch (p00, p10, p01, p11) as two triangles.
+                    let tris: Vec<[usize; 3]> = if *kind == "trianglemesh" {
+                        vec![[ix[0], ix[1], ix[2]]]
+                    } else {
+                        vec![[ix[0], ix[1], ix[3]], [ix[0], ix[3], ix[2]]]
+                    };
+                    for t in tris {
+                        let t = if flip { [t[0], t[2], t[1]] } else { t };
+                        entries.push(table(vec![
+                            ("type", s("triangle")),
+                            (
+                                "vertices",
+                                Value::Array(t.iter().map(|&k| vec3(verts[k])).collect()),
+                            ),
+                        ]));
+                    }
+                }
+            }
+            Geom::Ply { file: f } => {
+                if flip {
+                    self.warn(self.diag(&file, line, format!("{ctx}Shape \"plymesh\": ReverseOrientation or a mirroring transform on a mesh is not supported, ignored")))?;
+                }
+                let mut t = table(vec![("type", s("mesh")), ("file", s(f))]);
                 if m != DMat4::IDENTITY {
                     t.insert(
                         "transform".into(),
@@ -954,39 +1370,22 @@ impl Conv {
                         ),
                     );
                 }
-                for k in ["displacement", "edgelength"] {
-                    if p.get(k).is_some() {
-                        self.warn(self.diag(
-                            path,
-                            line,
-                            format!("Shape \"plymesh\": {k} is not supported, ignored"),
-                        ))?;
-                    }
-                }
                 entries.push(t);
             }
-            other => {
-                for q in &p.0 {
-                    q.used.set(true);
-                }
-                return self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, trianglemesh, bilinearmesh, plymesh are), ignored")));
-            }
         }
-        let material = match self.g.material.clone() {
-            Some(mm) => mm,
-            None => self.default_material(),
-        };
-        for mut e in entries {
-            e.insert("material".into(), s(&material));
-            if let Some((l, two)) = &self.g.area {
-                e.insert("emission".into(), l.clone());
-                if *two {
-                    e.insert("two_sided".into(), Value::Boolean(true));
+        Ok(entries
+            .into_iter()
+            .map(|mut e| {
+                e.insert("material".into(), s(&sd.material));
+                if let Some((l, two)) = &sd.area {
+                    e.insert("emission".into(), l.clone());
+                    if *two {
+                        e.insert("two_sided".into(), Value::Boolean(true));
+                    }
                 }
-            }
-            self.shapes.push(Value::Table(e));
-        }
-        Ok(())
+                Value::Table(e)
+            })
+            .collect())
     }
 
     fn finish_camera(&mut self, path: &Path) -> Result<(), Diagnostic> {
@@ -1018,6 +1417,16 @@ impl Conv {
             ),
         ]));
         Ok(())
+    }
+}
+
+/// "line N", or "line N of FILE" when `file` is not `here`, for a message about a place
+/// that an error elsewhere refers to.
+fn at(file: &Path, line: u32, here: &Path) -> String {
+    if file == here {
+        format!("line {line}")
+    } else {
+        format!("line {line} of {}", file.display())
     }
 }
 
