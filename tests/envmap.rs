@@ -248,3 +248,53 @@ fn a_mitsuba_envmap_converts_to_an_environment_table() {
     let b = run(&load_scene(&toml_path).unwrap(), IntegratorKind::Path, 4, 3);
     assert_eq!(a.xyz, b.xyz);
 }
+
+/// pbrt-v4's image `infinite` light becomes an `equal-area` map in the light's frame:
+/// the square's centre is the light's +z, which `Rotate -90 1 0 0` (pbrt's usual turn of
+/// a z-up map into a y-up scene) points straight up.
+#[test]
+fn a_pbrt_image_infinite_light_is_an_equal_area_map_in_its_frame() {
+    use heron::scene::import::{import_scene, ImportOptions};
+    use heron::scene::load::load_imported;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Bright within the square's central disk (light-space directions near +z).
+    write_exr(&d.join("sky.exr"), 32, 32, |i, j| {
+        let (x, y) = (i as f32 - 15.5, j as f32 - 15.5);
+        if x * x + y * y < 16.0 {
+            [4.0; 3]
+        } else {
+            [0.0; 3]
+        }
+    });
+    let view = |look: &str, light: &str| {
+        let up = if look == "0 1 0" { "0 0 1" } else { "0 1 0" };
+        let text = format!(
+            "Scale -1 1 1\nLookAt 0 0 0  {look}  {up}\nCamera \"perspective\" \"float fov\" [ 10 ]\nFilm \"rgb\" \"integer xresolution\" [ 5 ] \"integer yresolution\" [ 5 ]\nWorldBegin\n{light}\n"
+        );
+        let p = d.join("scene.pbrt");
+        std::fs::write(&p, text).unwrap();
+        let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+        assert!(
+            imp.warnings.iter().all(|w| !w.message.contains("infinite")),
+            "{:?}",
+            imp.warnings
+        );
+        let env = imp.table["environment"].as_table().unwrap().clone();
+        let film = run(&load_imported(&imp).unwrap(), IntegratorKind::Path, 4, 1);
+        (env, film.xyz[12][1])
+    };
+    let (env, up) = view("0 1 0", "AttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" [ 0.5 ]\nAttributeEnd");
+    assert_eq!(env["mapping"].as_str(), Some("equal-area"));
+    assert_eq!(env["scale"].as_float(), Some(0.5));
+    assert!((up - 2.0).abs() < 1e-2, "looking up: Y {up}");
+    let (_, ahead) = view("0 0 -1", "AttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\nAttributeEnd");
+    assert_eq!(ahead, 0.0);
+    // Unturned, the bright disk is along +z.
+    let (env, plus_z) = view(
+        "0 0 1",
+        "LightSource \"infinite\" \"string filename\" \"sky.exr\"",
+    );
+    assert!(env.get("transform").is_none());
+    assert!((plus_z - 4.0).abs() < 2e-2, "along +z: Y {plus_z}");
+}

@@ -420,7 +420,7 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
     <shape type="sphere">
         <bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="wood.png"/></texture></bsdf>
     </shape>
-    <emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>
+    <emitter type="sunsky"/>
     <shape type="cylinder"/>
     <shape type="sphere"><float name="nonsense" value="1"/></shape>
 "#;
@@ -433,7 +433,7 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
         .collect();
     let has = |line: u32, s: &str| lines.iter().any(|(l, m)| *l == line && m.contains(s));
     assert!(has(9, "textures are not supported"), "{lines:#?}");
-    assert!(has(11, "emitter \"envmap\" is not supported"), "{lines:#?}");
+    assert!(has(11, "emitter \"sunsky\" is not supported"), "{lines:#?}");
     assert!(has(12, "shape \"cylinder\" is not supported"), "{lines:#?}");
     assert!(has(13, "parameter \"nonsense\""), "{lines:#?}");
     assert!(imp.warnings[0]
@@ -465,6 +465,11 @@ fn malformed_files_are_one_line_errors_with_file_and_line() {
         ("<scene version=\"3.0.0\"><shape type=\"sphere\"/></scene>", "expected a <sensor type=\"perspective\">"),
         ("<mitsuba/>", "expected the root element <scene>"),
         (&scene("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>"), "cannot read the mesh file"),
+        (&scene("<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.2, 380:0.5\"/></bsdf></shape>"), "line 7: <spectrum name=\"reflectance\">: value: expected increasing wavelengths, got 380 nm after 400 nm"),
+        (&scene("<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.2, 500\"/></bsdf></shape>"), "value: expected wavelength:value pairs, got \"500\""),
+        (&scene("<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" filename=\"missing.spd\"/></bsdf></shape>"), "cannot read the spectrum file"),
+        (&scene("<shape type=\"sphere\"><emitter type=\"area\"><spectrum type=\"blackbody\" name=\"radiance\"><float name=\"temperature\" value=\"-5\"/></spectrum></emitter></shape>"), "temperature: expected kelvin within [100, 1000000], got -5"),
+        (&scene("<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum type=\"blackbody\" name=\"reflectance\"><float name=\"temperature\" value=\"3000\"/></spectrum></bsdf></shape>"), "a blackbody is an emission spectrum"),
     ];
     for (text, want) in cases {
         let (_d, r) = import_text(text);
@@ -972,4 +977,159 @@ Shape \"sphere\" \"float radius\" 0.2
         e.contains("scene.pbrt: line 8: ") && e.contains("area lights"),
         "{e}"
     );
+}
+
+/// Mitsuba's spectra: a blackbody (absolute W m⁻² sr⁻¹ nm⁻¹) becomes heron's
+/// unit-luminance blackbody times its luminance, so the loaded spectrum is Planck's law
+/// itself; `λ:v` pairs and `.spd` files become `samples`, zero beyond their ends as
+/// Mitsuba's irregular spectra are.
+#[test]
+fn blackbody_tabulated_and_file_spectra_convert_to_the_same_spectra() {
+    use heron::spectrum::blackbody::planck;
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "leaf.spd",
+        "# a leaf\n450 0.1\n550\t0.4\n650 0.2\n",
+    );
+    let body = r#"
+    <shape type="sphere"><float name="radius" value="0.1"/><point name="center" x="0" y="3" z="0"/>
+        <emitter type="area"><spectrum type="blackbody" name="radiance"><float name="temperature" value="4000"/></spectrum></emitter>
+    </shape>
+    <shape type="sphere"><bsdf type="diffuse"><spectrum name="reflectance" filename="leaf.spd"/></bsdf></shape>
+    <shape type="sphere"><point name="center" x="2" y="0" z="0"/><bsdf type="diffuse"><spectrum name="reflectance" value="400:0.3, 700:0.9"/></bsdf></shape>"#;
+    let p = write(dir.path(), "scene.xml", &scene(body));
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    assert_eq!(f(get(&imp.table, "shapes.0.emission.blackbody")), 4000.0);
+    let s = load_imported(&imp).unwrap();
+    let heron::light::Light::Area(light) = &s.lights[0] else {
+        panic!("{:?}", s.lights[0]);
+    };
+    let wl = heron::spectrum::SampledWavelengths::<4>::new([420.0, 500.0, 600.0, 780.0], [1.0; 4]);
+    let l = wl.eval(&light.emission);
+    for (k, &lambda) in wl.lambda.iter().enumerate() {
+        let want = planck(lambda as f64, 4000.0) as f32;
+        assert!(
+            (l.0[k] / want - 1.0).abs() < 2e-3,
+            "{lambda}: {} vs {want}",
+            l.0[k]
+        );
+    }
+    let rho = |i: usize| match &s.materials[i] {
+        heron::bsdf::Material::Lambertian(m) => m.rho_d.clone(),
+        other => panic!("{other:?}"),
+    };
+    // Materials are sorted by name; find each by its values.
+    let (a, b) = (rho(0), rho(1));
+    let (file, inline) = if (a.eval(550.0) - 0.4).abs() < 1e-6 {
+        (a, b)
+    } else {
+        (b, a)
+    };
+    for (l, want) in [
+        (450.0, 0.1),
+        (500.0, 0.25),
+        (550.0, 0.4),
+        (650.0, 0.2),
+        (440.0, 0.0),
+        (700.0, 0.0),
+    ] {
+        assert!(
+            (file.eval(l) - want).abs() < 1e-5,
+            "file {l}: {}",
+            file.eval(l)
+        );
+    }
+    for (l, want) in [
+        (400.0, 0.3),
+        (550.0, 0.6),
+        (700.0, 0.9),
+        (380.0, 0.0),
+        (720.0, 0.0),
+    ] {
+        assert!(
+            (inline.eval(l) - want).abs() < 1e-5,
+            "inline {l}: {}",
+            inline.eval(l)
+        );
+    }
+}
+
+/// pbrt-v4's spectra: lights are scaled to luminance 1 (`SpectrumToPhotometric`), so a
+/// blackbody or a table as `L` is heron's unit-luminance spectrum times `scale`;
+/// reflectances are used as given, zero beyond their ends; a blackbody reflectance is
+/// an error.
+#[test]
+fn pbrt_spectra_convert_as_pbrt_normalises_them() {
+    use heron::spectrum::cie::spectrum_to_xyz;
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "warm.spd",
+        "400 0.2\n500 0.6\n600 1.0\n700 1.2\n",
+    );
+    let text = format!(
+        "{PBRT_CAMERA}AttributeBegin\nAreaLightSource \"diffuse\" \"blackbody L\" [ 3000 ] \"float scale\" [ 2 ]\nShape \"sphere\" \"float radius\" 0.1\nAttributeEnd\n\
+         AttributeBegin\nTranslate 1 0 0\nAreaLightSource \"diffuse\" \"spectrum L\" \"warm.spd\"\nShape \"sphere\" \"float radius\" 0.1\nAttributeEnd\n\
+         Material \"diffuse\" \"spectrum reflectance\" [ 400 0.1 700 0.7 ]\nTranslate 0 2 0\nShape \"sphere\" \"float radius\" 0.5\n"
+    );
+    let p = write(dir.path(), "scene.pbrt", &text);
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    let t = &imp.table;
+    assert_eq!(f(get(t, "shapes.0.emission.blackbody")), 3000.0);
+    assert_eq!(f(get(t, "shapes.0.emission.scale")), 2.0);
+    let s = load_imported(&imp).unwrap();
+    let emission = |i: usize| match &s.lights[i] {
+        heron::light::Light::Area(a) => a.emission.clone(),
+        other => panic!("{other:?}"),
+    };
+    let y = |d: &heron::spectrum::DenseSpectrum| spectrum_to_xyz(d)[1];
+    assert!((y(&emission(0)) - 2.0).abs() < 1e-4, "{}", y(&emission(0)));
+    assert!((y(&emission(1)) - 1.0).abs() < 1e-4, "{}", y(&emission(1)));
+    // The table keeps its shape: 600 nm is 5 × 400 nm.
+    let e = emission(1);
+    assert!((e.eval(600.0) / e.eval(400.0) - 5.0).abs() < 1e-4);
+    let heron::bsdf::Material::Lambertian(m) = &s.materials[0] else {
+        panic!("{:?}", s.materials);
+    };
+    for (l, want) in [
+        (400.0, 0.1),
+        (550.0, 0.4),
+        (700.0, 0.7),
+        (380.0, 0.0),
+        (720.0, 0.0),
+    ] {
+        assert!(
+            (m.rho_d.eval(l) - want).abs() < 1e-5,
+            "{l}: {}",
+            m.rho_d.eval(l)
+        );
+    }
+    for (body, want) in [
+        (
+            "Material \"diffuse\" \"blackbody reflectance\" [ 3000 ]\n",
+            "a blackbody is an emission spectrum",
+        ),
+        (
+            "Material \"diffuse\" \"spectrum reflectance\" [ 500 0.1 400 0.7 ]\n",
+            "wavelengths increasing",
+        ),
+        (
+            "AreaLightSource \"diffuse\" \"spectrum L\" \"missing.spd\"\n",
+            "cannot read the spectrum file",
+        ),
+        (
+            "LightSource \"infinite\" \"string filename\" \"sky.exr\" \"rgb L\" [ 1 1 1 ]\n",
+            "both \"L\" and \"filename\"",
+        ),
+    ] {
+        let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));
+        let e = r.unwrap_err().to_string();
+        assert!(
+            e.contains("scene.pbrt: line 6: ") && e.contains(want),
+            "{e}"
+        );
+    }
 }

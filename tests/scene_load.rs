@@ -388,6 +388,24 @@ const BAD: &[(&str, &str, &[&str])] = &[
      &["materials.x.rho_d: expected a reflectance in [0, 1] at every wavelength", "D65"]),
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { spectrum = \"D50\" }\n",
      &["materials.x.rho_d: unknown spectrum \"D50\", expected one of E, D65"]),
+    ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { blackbody = 3000 }\n",
+     &["materials.x.rho_d: expected a reflectance", "a blackbody is an emission spectrum"]),
+    ("background = { blackbody = 50 }\n", "",
+     &["background: expected blackbody = a temperature in kelvin within [100, 1000000], got 50"]),
+    ("background = { blackbody = 5000, spectrum = \"E\" }\n", "",
+     &["background: expected one of the keys spectrum, blackbody, samples in a colour"]),
+    ("background = { blackbody = 5000, kelvin = 2 }\n", "",
+     &["background: unknown key \"kelvin\" in a blackbody colour (expected one of blackbody, scale)"]),
+    ("background = { scale = 2 }\n", "",
+     &["background: expected a colour", "none of the keys spectrum, blackbody, samples is given"]),
+    ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { samples = [[500, 0.2], [450, 0.4]] }\n",
+     &["materials.x.rho_d: expected samples with strictly increasing wavelengths, got 450 nm after 500 nm"]),
+    ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { samples = [[500, 0.2]] }\n",
+     &["materials.x.rho_d: expected samples = [[wavelength_nm, value], ...]"]),
+    ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { samples = [[400, 0.2], [700, -0.1]] }\n",
+     &["materials.x.rho_d: expected samples = [[wavelength_nm, value], ...]"]),
+    ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { samples = [[400, 0.2], [700, 0.9]], scale = 2 }\n",
+     &["materials.x.rho_d: expected a reflectance in [0, 1] at every wavelength", "whose maximum is 1.8"]),
     ("", "[materials.x]\ntype = \"mirror\"\nrho_s = 1.5\n",
      &["materials.x.rho_s: expected a reflectance"]),
     ("background = [-1, 0, 0]\n", "",
@@ -1361,5 +1379,44 @@ waves = [
     for t in &m.indices {
         let [a, b, c] = t.map(|i| m.positions[i as usize]);
         assert!((b - a).cross(c - a).y > 0.0, "a triangle faces down");
+    }
+}
+
+/// `{ blackbody = T }` is Planck's law at T scaled to luminance 1 (times `scale`), and
+/// `{ samples = [...] }` a table linear between its rows and held beyond them.
+#[test]
+fn blackbody_and_tabulated_colours_load_as_their_spectra() {
+    use heron::spectrum::blackbody::{blackbody, blackbody_luminance};
+    use heron::spectrum::cie::spectrum_to_xyz;
+    let dir = Dir::new();
+    let p = dir.write(
+        "scene.toml",
+        &format!(
+            "background = {{ blackbody = 2700, scale = 3 }}\n{CAMERA}\
+             [materials.x]\ntype = \"lambertian\"\nrho_d = {{ samples = [[450, 0.2], [650, 0.8]], scale = 0.5 }}\n\
+             [[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"x\"\n"
+        ),
+    );
+    let s = load_scene(&p).unwrap();
+    let y = spectrum_to_xyz(&s.background)[1];
+    assert!((y - 3.0).abs() < 1e-4, "{y}");
+    let abs = blackbody(2700.0);
+    let k = 3.0 / blackbody_luminance(2700.0) as f32;
+    for l in [400.0f32, 555.0, 700.0] {
+        let (a, b) = (s.background.eval(l), k * abs.eval(l));
+        assert!((a / b - 1.0).abs() < 1e-4, "{l}: {a} vs {b}");
+    }
+    let heron::bsdf::Material::Lambertian(m) = &s.materials[0] else {
+        panic!("{:?}", s.materials[0]);
+    };
+    for (l, want) in [
+        (400.0f32, 0.1f32),
+        (450.0, 0.1),
+        (550.0, 0.25),
+        (650.0, 0.4),
+        (800.0, 0.4),
+    ] {
+        let v = m.rho_d.eval(l);
+        assert!((v - want).abs() < 1e-6, "{l}: {v} vs {want}");
     }
 }

@@ -2,6 +2,7 @@
 //! for everything a scene defines, the CIE observer, and RGB uplift.
 //!
 //! Units: wavelengths are in nanometres in this API.
+pub mod blackbody;
 pub mod cie;
 pub mod color;
 pub mod csv;

@@ -701,17 +701,10 @@ impl<'a> Converter<'a> {
                 self.warn(n.diag(format!(
                     "{kind} is mapped to heron's glossy (modified Phong) material: ρd = diffuse_reflectance, ρs = Fresnel at normal incidence {f0:.4}, shininess {shininess:.0} from α = {alpha}; Mitsuba's coating (Fresnel-weighted, with internal reflections) differs"
                 )))?;
-                let scale = match rho {
-                    ColourValue::Grey(g) => g,
-                    ColourValue::Rgb(c) => c[0].max(c[1]).max(c[2]),
-                };
+                let scale = rho.max();
                 // heron requires ρd + ρs ≤ 1 (energy).
                 let rho = if scale + f0 > 1.0 {
-                    let s = (1.0 - f0) / scale;
-                    match rho {
-                        ColourValue::Grey(g) => ColourValue::Grey(g * s),
-                        ColourValue::Rgb(c) => ColourValue::Rgb(c.map(|x| x * s)),
-                    }
+                    rho.scaled((1.0 - f0) / scale)
                 } else {
                     rho
                 };
@@ -1075,7 +1068,7 @@ impl<'a> Converter<'a> {
     }
 }
 
-fn vec_row(r: [f64; 4]) -> Value {
+pub(super) fn vec_row(r: [f64; 4]) -> Value {
     Value::Array(r.iter().map(|x| float(*x)).collect())
 }
 

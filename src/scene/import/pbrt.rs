@@ -241,6 +241,8 @@ struct Conv {
     shapes: Vec<Slot>,
     lights: Vec<Value>,
     background: Option<Value>,
+    /// `[environment]` from an image `infinite` light.
+    environment: Option<Value>,
     camera: Option<Table>,
     camera_from_world: Option<(DMat4, u32, PathBuf, f64)>,
     resolution: (i64, i64),
@@ -281,6 +283,7 @@ impl Conv {
             shapes: Vec::new(),
             lights: Vec::new(),
             background: None,
+            environment: None,
             camera: None,
             camera_from_world: None,
             resolution: (1280, 720),
@@ -315,7 +318,7 @@ impl Conv {
         }
         let shapes = self.instantiate()?;
         self.finish_camera(path)?;
-        let t = scene_table(
+        let mut t = scene_table(
             self.camera.take().expect("finish_camera sets it"),
             std::mem::take(&mut self.render),
             self.background.take(),
@@ -323,6 +326,9 @@ impl Conv {
             shapes,
             std::mem::take(&mut self.lights),
         );
+        if let Some(e) = self.environment.take() {
+            t.insert("environment".into(), e);
+        }
         Ok(Converted {
             table: t,
             warnings: self.warnings,
@@ -768,7 +774,7 @@ impl Conv {
                 self.g.material = Some(m);
             }
             "AreaLightSource" => {
-                let l = self.colour(path, p, "L", 1.0)?;
+                let l = self.emission(path, p, "L", 1.0)?;
                 let scale = p.float("scale").unwrap_or(1.0);
                 let two = p.string("twosided") == Some("true");
                 self.g.area = Some((scaled(l, scale), two));
@@ -893,7 +899,7 @@ impl Conv {
         Ok(())
     }
 
-    /// A colour parameter: "rgb" or a constant "spectrum"/"float"; named spectra warn.
+    /// A reflectance parameter ([`Self::colour_as`] for a reflectance).
     fn colour(
         &mut self,
         path: &Path,
@@ -901,21 +907,106 @@ impl Conv {
         name: &str,
         default: f64,
     ) -> Result<Value, Diagnostic> {
+        self.colour_as(path, p, name, default, false)
+    }
+
+    /// A light's spectrum ([`Self::colour_as`] for an emission).
+    fn emission(
+        &mut self,
+        path: &Path,
+        p: &Params,
+        name: &str,
+        default: f64,
+    ) -> Result<Value, Diagnostic> {
+        self.colour_as(path, p, name, default, true)
+    }
+
+    /// A colour parameter: "rgb", a "spectrum" (one number, λ value pairs, a file of
+    /// them, or the named illuminants stdillum-D65 and stdillum-A), a "blackbody"
+    /// temperature, or a "float". For a light (`emission`), pbrt-v4 scales every
+    /// spectrum to luminance 1 (`scale /= SpectrumToPhotometric(L)` in each light's
+    /// `Create`; for RGB only the colour space's illuminant counts), which heron's
+    /// blackbody and named illuminants already are and a table is given as a `scale`.
+    /// pbrt-v4's `PiecewiseLinearSpectrum` is zero beyond its ends, as Mitsuba's is.
+    fn colour_as(
+        &mut self,
+        path: &Path,
+        p: &Params,
+        name: &str,
+        default: f64,
+        emission: bool,
+    ) -> Result<Value, Diagnostic> {
+        use super::props::{mitsuba_samples, read_spd, ColourValue};
         let Some(q) = p.get(name) else {
             return Ok(float(default));
         };
-        match (q.ty.as_str(), q.nums.as_slice()) {
-            ("rgb", [r, g, b]) => Ok(Value::Array(vec![float(*r), float(*g), float(*b)])),
-            ("spectrum" | "float", [v]) => Ok(float(*v)),
-            ("blackbody", _) | ("spectrum", _) | ("texture", _) => {
-                self.warn(self.diag(path, q.line, format!("\"{} {name}\": named, tabulated and blackbody spectra and textures are not supported yet; {default} is used", q.ty)))?;
+        let bad =
+            |this: &Self, m: String| this.diag(path, q.line, format!("\"{} {name}\": {m}", q.ty));
+        let table_colour = |pairs: Vec<(f64, f64)>| {
+            let samples = mitsuba_samples(&pairs);
+            let scale = if emission {
+                let dense = crate::spectrum::DenseSpectrum::from_samples(
+                    &samples
+                        .iter()
+                        .map(|&(l, v)| (l as f32, v as f32))
+                        .collect::<Vec<_>>(),
+                );
+                let y = crate::spectrum::cie::spectrum_to_xyz(&dense)[1] as f64;
+                if y > 0.0 {
+                    1.0 / y
+                } else {
+                    1.0
+                }
+            } else {
+                1.0
+            };
+            ColourValue::Samples { samples, scale }.to_toml()
+        };
+        match (q.ty.as_str(), q.nums.as_slice(), q.strs.as_slice()) {
+            ("rgb", [r, g, b], _) => Ok(Value::Array(vec![float(*r), float(*g), float(*b)])),
+            ("spectrum" | "float", [v], []) => Ok(float(*v)),
+            ("blackbody", [k], _) => {
+                if !emission {
+                    return Err(bad(self, "a blackbody is an emission spectrum".into()));
+                }
+                let (lo, hi) = crate::spectrum::blackbody::KELVIN_RANGE;
+                if !(lo..=hi).contains(k) {
+                    return Err(bad(self, format!("expected kelvin within [{lo}, {hi}], got {k}")));
+                }
+                Ok(ColourValue::Blackbody { kelvin: *k, scale: 1.0 }.to_toml())
+            }
+            ("spectrum", nums, []) if nums.len() >= 4 && nums.len() % 2 == 0 => {
+                let pairs: Vec<(f64, f64)> = nums.chunks(2).map(|c| (c[0], c[1])).collect();
+                if pairs.windows(2).any(|w| !(w[1].0 > w[0].0)) || pairs.iter().any(|(_, v)| !(*v >= 0.0)) {
+                    return Err(bad(self, "expected wavelength value pairs, wavelengths increasing, values ≥ 0".into()));
+                }
+                Ok(table_colour(pairs))
+            }
+            ("spectrum", [], [n]) if n == "stdillum-D65" || n == "stdillum-A" => {
+                let name = if n == "stdillum-A" { "A" } else { "D65" };
+                let mut t = Table::new();
+                t.insert("spectrum".into(), Value::String(name.into()));
+                if !emission {
+                    // A reflectance must stay within [0, 1]: the named illuminants are
+                    // scaled to luminance 1, so only as lights.
+                    return Err(bad(self, "a named illuminant is an emission spectrum".into()));
+                }
+                Ok(Value::Table(t))
+            }
+            ("spectrum", [], [f]) if !f.starts_with("metal-") && !f.starts_with("glass-") && !f.contains("illum") && !f.starts_with("canon") && !f.starts_with("nikon") && !f.starts_with("sony") => {
+                let full = self.base_of(path).join(f);
+                let pairs = read_spd(&full).map_err(|e| bad(self, e))?;
+                Ok(table_colour(pairs))
+            }
+            ("spectrum", _, _) | ("texture", _, _) => {
+                self.warn(self.diag(path, q.line, format!("\"{} {name}\": this named spectrum or texture is not supported yet (rgb, blackbody, λ value pairs, .spd files, stdillum-D65 and stdillum-A are); {default} is used", q.ty)))?;
                 Ok(float(default))
             }
             _ => Err(self.diag(
                 path,
                 q.line,
                 format!(
-                    "\"{} {name}\": expected three rgb values or one number",
+                    "\"{} {name}\": expected three rgb values, one number, wavelength value pairs, a spectrum file or a blackbody temperature",
                     q.ty
                 ),
             )),
@@ -1062,7 +1153,7 @@ impl Conv {
         match kind {
             "point" => {
                 let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
-                let i = self.colour(path, p, "I", 1.0)?;
+                let i = self.emission(path, p, "I", 1.0)?;
                 self.lights.push(Value::Table(table(vec![
                     ("type", s("point")),
                     ("position", vec3(m.transform_point3(from))),
@@ -1072,7 +1163,7 @@ impl Conv {
             "spot" => {
                 let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
                 let to = p.get("to").map_or(DVec3::Z, |q| v3(&q.nums));
-                let i = self.colour(path, p, "I", 1.0)?;
+                let i = self.emission(path, p, "I", 1.0)?;
                 let cone = p.float("coneangle").unwrap_or(30.0);
                 let delta = p.float("conedelta").unwrap_or(5.0);
                 self.lights.push(Value::Table(table(vec![
@@ -1087,7 +1178,7 @@ impl Conv {
             "distant" => {
                 let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
                 let to = p.get("to").map_or(DVec3::Z, |q| v3(&q.nums));
-                let l = self.colour(path, p, "L", 1.0)?;
+                let l = self.emission(path, p, "L", 1.0)?;
                 self.lights.push(Value::Table(table(vec![
                     ("type", s("directional")),
                     ("direction", vec3(m.transform_vector3(to - from))),
@@ -1095,14 +1186,64 @@ impl Conv {
                 ])));
             }
             "infinite" if p.get("filename").is_none() => {
-                let l = self.colour(path, p, "L", 1.0)?;
+                let l = self.emission(path, p, "L", 1.0)?;
                 self.background = Some(scaled(l, scale));
+            }
+            "infinite" => {
+                // pbrt-v4's ImageInfiniteLight: a square image on the equal-area
+                // octahedral map, in the light's frame (the CTM), looked up nearest.
+                let f = p.string("filename").unwrap_or_default().to_string();
+                if p.get("L").is_some() {
+                    return Err(self.diag(path, line, "LightSource \"infinite\": both \"L\" and \"filename\" are given (pbrt-v4 refuses that too)"));
+                }
+                if p.get("illuminance").is_some() {
+                    self.warn(self.diag(path, line, "LightSource \"infinite\": \"illuminance\" (rescaling the map to an illuminance) is not supported, ignored"))?;
+                }
+                if p.get("portal").is_some() {
+                    for q in &p.0 {
+                        q.used.set(true);
+                    }
+                    // PortalImageInfiniteLight lays the image out in the portal's frame,
+                    // not on the equal-area square.
+                    self.warn(self.diag(path, line, "LightSource \"infinite\" with a \"portal\" is not supported yet, ignored: the image lacks its light"))?;
+                    return Ok(());
+                }
+                let full = self.base_of(path).join(&f);
+                let rel = relative_to(&full, &self.base);
+                // The rotation of the CTM (a uniform scale divided out: pbrt normalises
+                // the direction), without its translation.
+                let lin = glam::DMat3::from_mat4(m);
+                let s3 = lin.determinant().abs().cbrt();
+                let lin = if s3 > 0.0 { lin * (1.0 / s3) } else { lin };
+                let mut rows = Vec::new();
+                for r in 0..3 {
+                    let row = lin.row(r);
+                    rows.push(super::mitsuba::vec_row([row.x, row.y, row.z, 0.0]));
+                }
+                rows.push(super::mitsuba::vec_row([0.0, 0.0, 0.0, 1.0]));
+                let mut t = table(vec![
+                    ("map", s(&rel.to_string_lossy().replace('\\', "/"))),
+                    ("mapping", s("equal-area")),
+                    ("scale", float(scale)),
+                ]);
+                if lin != glam::DMat3::IDENTITY {
+                    t.insert("transform".into(), Value::Array(rows));
+                }
+                if self.environment.is_some() || self.background.is_some() {
+                    self.warn(self.diag(
+                        path,
+                        line,
+                        "a second infinite light; heron's environment is the first, ignored",
+                    ))?;
+                } else {
+                    self.environment = Some(Value::Table(t));
+                }
             }
             other => {
                 for q in &p.0 {
                     q.used.set(true);
                 }
-                self.warn(self.diag(path, line, format!("LightSource {other:?} is not supported yet (point, spot, distant, constant infinite are), ignored: the image lacks its light")))?;
+                self.warn(self.diag(path, line, format!("LightSource {other:?} is not supported yet (point, spot, distant, infinite are), ignored: the image lacks its light")))?;
             }
         }
         Ok(())
@@ -1442,6 +1583,11 @@ fn scaled(v: Value, k: f64) -> Value {
         return v;
     }
     match v {
+        Value::Table(mut t) => {
+            let s0 = t.get("scale").and_then(Value::as_float).unwrap_or(1.0);
+            t.insert("scale".into(), float(s0 * k));
+            Value::Table(t)
+        }
         Value::Float(x) => float(x * k),
         Value::Array(a) => Value::Array(
             a.into_iter()

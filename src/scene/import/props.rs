@@ -25,22 +25,192 @@ pub struct Props<'a> {
     used: Vec<Cell<bool>>,
 }
 
-/// A colour property as heron's scene files write colours: grey, or RGB.
+/// A colour property as heron's scene files write colours: grey, RGB, a tabulated
+/// spectrum or a blackbody (see [`crate::scene::file::Colour`]).
 #[derive(Clone, Debug, PartialEq)]
 pub enum ColourValue {
     Grey(f64),
     Rgb([f64; 3]),
+    /// (nm, value) pairs, linear between them, and `scale`.
+    Samples {
+        samples: Vec<(f64, f64)>,
+        scale: f64,
+    },
+    /// heron's unit-luminance blackbody at `kelvin`, times `scale`.
+    Blackbody {
+        kelvin: f64,
+        scale: f64,
+    },
 }
 
 impl ColourValue {
     pub fn to_toml(&self) -> toml::Value {
+        use toml::Value;
+        let table = |k: &str, v: Value, scale: f64| {
+            let mut t = toml::Table::new();
+            t.insert(k.into(), v);
+            if scale != 1.0 {
+                t.insert("scale".into(), Value::Float(scale));
+            }
+            Value::Table(t)
+        };
         match self {
-            ColourValue::Grey(g) => toml::Value::Float(*g),
-            ColourValue::Rgb(c) => {
-                toml::Value::Array(c.iter().map(|x| toml::Value::Float(*x)).collect())
+            ColourValue::Grey(g) => Value::Float(*g),
+            ColourValue::Rgb(c) => Value::Array(c.iter().map(|x| Value::Float(*x)).collect()),
+            ColourValue::Samples { samples, scale } => table(
+                "samples",
+                Value::Array(
+                    samples
+                        .iter()
+                        .map(|(l, v)| Value::Array(vec![Value::Float(*l), Value::Float(*v)]))
+                        .collect(),
+                ),
+                *scale,
+            ),
+            ColourValue::Blackbody { kelvin, scale } => {
+                table("blackbody", Value::Float(*kelvin), *scale)
             }
         }
     }
+
+    /// The largest value over channels or wavelengths (for a blackbody, its scale: the
+    /// unit blackbody's own peak is not needed where this is used, for reflectances).
+    pub fn max(&self) -> f64 {
+        match self {
+            ColourValue::Grey(g) => *g,
+            ColourValue::Rgb(c) => c[0].max(c[1]).max(c[2]),
+            ColourValue::Samples { samples, scale } => {
+                scale * samples.iter().fold(0.0f64, |a, (_, v)| a.max(*v))
+            }
+            ColourValue::Blackbody { scale, .. } => *scale,
+        }
+    }
+
+    /// The colour times `k`.
+    pub fn scaled(&self, k: f64) -> ColourValue {
+        match self {
+            ColourValue::Grey(g) => ColourValue::Grey(g * k),
+            ColourValue::Rgb(c) => ColourValue::Rgb(c.map(|x| x * k)),
+            ColourValue::Samples { samples, scale } => ColourValue::Samples {
+                samples: samples.clone(),
+                scale: scale * k,
+            },
+            ColourValue::Blackbody { kelvin, scale } => ColourValue::Blackbody {
+                kelvin: *kelvin,
+                scale: scale * k,
+            },
+        }
+    }
+}
+
+/// Mitsuba's tabulated spectrum (`value="λ:v, λ:v, …"` or a file's rows) as heron
+/// samples: Mitsuba's irregular spectrum is linear between its rows and zero beyond
+/// them, heron's holds the end values, so a zero is added 1e-3 nm beyond each end.
+pub fn mitsuba_samples(pairs: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(pairs.len() + 2);
+    let (first, last) = (pairs[0], pairs[pairs.len() - 1]);
+    if first.1 != 0.0 {
+        out.push((first.0 - 1e-3, 0.0));
+    }
+    out.extend_from_slice(pairs);
+    if last.1 != 0.0 {
+        out.push((last.0 + 1e-3, 0.0));
+    }
+    out
+}
+
+/// `λ:v, λ:v, …` (Mitsuba's inline tabulated spectrum): at least two pairs, wavelengths
+/// increasing, values finite and ≥ 0.
+fn parse_pairs(text: &str) -> Result<Vec<(f64, f64)>, String> {
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for item in text.split(',') {
+        let item = item.trim();
+        let (l, v) = item
+            .split_once(':')
+            .ok_or_else(|| format!("expected wavelength:value pairs, got {item:?}"))?;
+        let (l, v) = match (l.trim().parse::<f64>(), v.trim().parse::<f64>()) {
+            (Ok(l), Ok(v)) if l.is_finite() && v.is_finite() && v >= 0.0 => (l, v),
+            _ => {
+                return Err(format!(
+                    "expected wavelength:value with finite numbers, value ≥ 0, got {item:?}"
+                ))
+            }
+        };
+        check_increasing(&out, l)?;
+        out.push((l, v));
+    }
+    if out.len() < 2 {
+        return Err("expected at least two wavelength:value pairs".into());
+    }
+    Ok(out)
+}
+
+fn check_increasing(out: &[(f64, f64)], l: f64) -> Result<(), String> {
+    match out.last() {
+        Some(&(prev, _)) if !(l > prev) => Err(format!(
+            "expected increasing wavelengths, got {l} nm after {prev} nm"
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// A Mitsuba spectrum file (`.spd`): rows `wavelength value` (spaces or tabs; a comma
+/// is accepted too), `#` comments and blank lines skipped. The error names the line.
+pub fn read_spd(path: &std::path::Path) -> Result<Vec<(f64, f64)>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read the spectrum file {}: {e}", path.display()))?;
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let nums: Vec<f64> = line
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|t| !t.is_empty())
+            .map(|t| t.parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| {
+                format!(
+                    "{}: line {}: expected two numbers, got {line:?}",
+                    path.display(),
+                    i + 1
+                )
+            })?;
+        match nums.as_slice() {
+            [l, v] if l.is_finite() && v.is_finite() && *v >= 0.0 => {
+                check_increasing(&out, *l)
+                    .map_err(|e| format!("{}: line {}: {e}", path.display(), i + 1))?;
+                out.push((*l, *v));
+            }
+            _ => {
+                return Err(format!(
+                    "{}: line {}: expected a wavelength and a value ≥ 0, got {line:?}",
+                    path.display(),
+                    i + 1
+                ))
+            }
+        }
+    }
+    if out.len() < 2 {
+        return Err(format!("{}: expected at least two rows", path.display()));
+    }
+    Ok(out)
+}
+
+/// Mitsuba's blackbody (absolute W m⁻² sr⁻¹ nm⁻¹) as heron's unit-luminance one times
+/// its luminance.
+fn blackbody(n: &Node, kelvin: f64) -> Result<ColourValue, ColourError> {
+    let (lo, hi) = crate::spectrum::blackbody::KELVIN_RANGE;
+    if !(lo..=hi).contains(&kelvin) {
+        return Err(ColourError::Bad(n.diag(format!(
+            "temperature: expected kelvin within [{lo}, {hi}], got {kelvin}"
+        ))));
+    }
+    Ok(ColourValue::Blackbody {
+        kelvin,
+        scale: crate::spectrum::blackbody::blackbody_luminance(kelvin),
+    })
 }
 
 impl<'a> Props<'a> {
@@ -154,29 +324,58 @@ impl<'a> Props<'a> {
         parse_transform(n).map(Some)
     }
 
-    /// A colour: `<rgb>`, a constant `<spectrum>` or a `<float>`. Tabulated and file
-    /// spectra, blackbodies and textures are unsupported input, reported as the error
-    /// returned in `Err(Unsupported)` so the caller can warn and fall back to the
-    /// default it documents.
+    /// A colour: `<rgb>`, a `<spectrum>` (one value, `λ:v` pairs, a `filename`, or
+    /// `type="blackbody"` with its `temperature`), a `<blackbody>` (Mitsuba 0.6's form),
+    /// or a `<float>`. Textures are unsupported input, reported as the error returned in
+    /// `Err(Unsupported)` so the caller can warn and fall back to the default it
+    /// documents.
     pub fn colour(&self, name: &str) -> Result<Option<ColourValue>, ColourError> {
         let Some(n) = self.get(name) else {
             return Ok(None);
         };
         let bad = |m: String| ColourError::Bad(n.diag(m));
         match n.tag.as_str() {
-            "float" | "rgb" | "spectrum" => {
-                if n.tag == "spectrum" && n.attr("filename").is_some() {
-                    return Err(ColourError::Unsupported(n.diag(
-                        "spectra read from a file are not supported by heron's import yet",
-                    )));
+            "spectrum" if n.attr("type") == Some("blackbody") => {
+                let t = n
+                    .children
+                    .iter()
+                    .find(|c| c.attr("name") == Some("temperature"))
+                    .ok_or_else(|| bad("expected <float name=\"temperature\" value=\"…\"/>".into()))?;
+                let v = t.attr("value").unwrap_or("");
+                match numbers(v).as_deref() {
+                    Some([k]) => blackbody(n, *k).map(Some),
+                    _ => Err(bad(format!("temperature: expected a number, got {v:?}"))),
                 }
+            }
+            "blackbody" => {
+                let v = n.attr("temperature").unwrap_or("");
+                match numbers(v).as_deref() {
+                    Some([k]) => blackbody(n, *k).map(Some),
+                    _ => Err(bad(format!("temperature: expected a number, got {v:?}"))),
+                }
+            }
+            "spectrum" if n.attr("filename").is_some() => {
+                let f = n.attr("filename").unwrap_or("");
+                let folder = n.file.parent().unwrap_or(std::path::Path::new(""));
+                let pairs = read_spd(&folder.join(f)).map_err(bad)?;
+                Ok(Some(ColourValue::Samples {
+                    samples: mitsuba_samples(&pairs),
+                    scale: 1.0,
+                }))
+            }
+            "spectrum" if n.attr("type").is_some() => Err(ColourError::Unsupported(n.diag(
+                "spectrum plugins other than blackbody (and inline or file tables) are not supported by heron's import",
+            ))),
+            "float" | "rgb" | "spectrum" => {
                 let v = n
                     .attr("value")
                     .ok_or_else(|| bad("expected the attribute value".into()))?;
                 if n.tag == "spectrum" && v.contains(':') {
-                    return Err(ColourError::Unsupported(n.diag(
-                        "tabulated spectra (wavelength:value pairs) are not supported by heron's import yet",
-                    )));
+                    let pairs = parse_pairs(v).map_err(|e| bad(format!("value: {e}")))?;
+                    return Ok(Some(ColourValue::Samples {
+                        samples: mitsuba_samples(&pairs),
+                        scale: 1.0,
+                    }));
                 }
                 match numbers(v).as_deref() {
                     Some([g]) if *g >= 0.0 => Ok(Some(ColourValue::Grey(*g))),
@@ -195,9 +394,6 @@ impl<'a> Props<'a> {
             }
             "texture" | "ref" => Err(ColourError::Unsupported(
                 n.diag("textures are not supported by heron's import yet"),
-            )),
-            "blackbody" => Err(ColourError::Unsupported(
-                n.diag("blackbody spectra are not supported by heron's import yet"),
             )),
             _ => Err(bad(format!("expected <rgb name=\"{name}\" value=\"…\"/>"))),
         }

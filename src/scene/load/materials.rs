@@ -6,7 +6,7 @@ use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
     Conductor, Dielectric, Glossy, Lambertian, Material, Mirror, RoughConductor, RoughDielectric,
 };
-use crate::scene::file::{Colour, IorSpec, MaterialFile, MetalSpec, SceneFile};
+use crate::scene::file::{IorSpec, MaterialFile, MetalSpec, SceneFile};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::DenseSpectrum;
@@ -228,13 +228,7 @@ fn build_material(
                 None => g.rho_d.0.max_value() + rho_s,
             };
             if sum_max > 1.0 + 1e-6 {
-                let rho_d = match &g.rho_d.0 {
-                    Colour::Grey(x) => format!("{x}"),
-                    Colour::Rgb(c) => format!("[{}, {}, {}]", c[0], c[1], c[2]),
-                    Colour::Named { spectrum, scale } => {
-                        format!("{{ spectrum = {spectrum:?}, scale = {scale} }}")
-                    }
-                };
+                let rho_d = g.rho_d.0.describe();
                 return Err(format!(
                     "{at}: expected rho_d + rho_s <= 1 in every channel (energy conservation), got rho_d = {rho_d} and rho_s = {rho_s} (sum up to {sum_max})"
                 ));
