@@ -1123,7 +1123,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         integrator: args.integrator.as_deref(),
         sampler: args.sampler.as_deref(),
         wavelengths: Some(&args.wavelengths),
-        spectral_bins: Some(args.spectral_bins.map_or(0, i64::from)),
+        // Absent, the scene's `[render] spectral_bins` (default none) stands.
+        spectral_bins: args.spectral_bins.map(i64::from),
         max_depth: args.max_depth.map(i64::from),
         offset: args.offset.as_deref(),
         kernel: Some(&args.kernel),

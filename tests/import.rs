@@ -1133,3 +1133,44 @@ fn pbrt_spectra_convert_as_pbrt_normalises_them() {
         );
     }
 }
+
+/// pbrt-v4's spectral film becomes heron's spectral bins (`[render] spectral_bins`): its
+/// 16 buckets over 360–830 nm by default are heron's bins exactly; another range warns.
+#[test]
+fn a_pbrt_spectral_film_sets_heron_s_spectral_bins() {
+    let cam = PBRT_CAMERA.replace("Film \"rgb\"", "Film \"spectral\"");
+    let (_d, r) = import_pbrt(&format!("{cam}Shape \"sphere\"\n"));
+    let imp = r.unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    assert_eq!(
+        get(&imp.table, "render.spectral_bins").as_integer(),
+        Some(16)
+    );
+    assert_eq!(load_imported(&imp).unwrap().settings.spectral_bins, 16);
+    let cam = PBRT_CAMERA.replace(
+        "Film \"rgb\"",
+        "Film \"spectral\" \"integer nbuckets\" [ 8 ] \"float lambdamin\" [ 400 ]",
+    );
+    let (_d, r) = import_pbrt(&format!("{cam}Shape \"sphere\"\n"));
+    let imp = r.unwrap();
+    assert_eq!(
+        get(&imp.table, "render.spectral_bins").as_integer(),
+        Some(8)
+    );
+    assert!(
+        imp.warnings
+            .iter()
+            .any(|w| w.message.contains("not 400–830 nm")),
+        "{:?}",
+        imp.warnings
+    );
+    let cam = PBRT_CAMERA.replace(
+        "Film \"rgb\"",
+        "Film \"spectral\" \"integer nbuckets\" [ 0 ]",
+    );
+    let (_d, r) = import_pbrt(&format!("{cam}Shape \"sphere\"\n"));
+    assert!(r
+        .unwrap_err()
+        .to_string()
+        .contains("nbuckets: expected a whole number from 1 to 470, got 0"));
+}

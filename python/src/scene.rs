@@ -181,7 +181,7 @@ impl Scene {
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=0, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
@@ -192,7 +192,7 @@ impl Scene {
         integrator: Option<&str>,
         wavelengths: &str,
         threads: i64,
-        spectral_bins: i64,
+        spectral_bins: Option<i64>,
         sampler: Option<&str>,
         max_depth: Option<i64>,
         offset: Option<&str>,
@@ -221,7 +221,7 @@ impl Scene {
                     integrator,
                     sampler,
                     wavelengths: Some(wavelengths),
-                    spectral_bins: Some(spectral_bins),
+                    spectral_bins,
                     max_depth,
                     offset,
                     kernel: None,

@@ -231,6 +231,10 @@ pub struct RenderFile {
     /// SPPM: the initial gather radius in scene units (0: automatic).
     #[serde(default)]
     pub sppm_radius: Option<f64>,
+    /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
+    /// (0, the default: none); `--spectral-bins` overrides it.
+    #[serde(default)]
+    pub spectral_bins: Option<i64>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.
@@ -1284,20 +1288,21 @@ fn colour(v: &toml::Value) -> Result<Colour, String> {
                 .into_iter()
                 .filter(|k| t.contains_key(*k))
                 .collect::<Vec<_>>();
-            let kind =
-                match kind.as_slice() {
-                    [k] => *k,
-                    [] => {
-                        return Err(format!(
-                            "{}; none of the keys spectrum, blackbody, samples is given",
-                            shape_err()
-                        ))
-                    }
-                    _ => return Err(format!(
+            let kind = match kind.as_slice() {
+                [k] => *k,
+                [] => {
+                    return Err(format!(
+                        "{}; none of the keys spectrum, blackbody, samples is given",
+                        shape_err()
+                    ))
+                }
+                _ => {
+                    return Err(format!(
                         "expected one of the keys spectrum, blackbody, samples in a colour, got {}",
                         kind.join(" and ")
-                    )),
-                };
+                    ))
+                }
+            };
             for k in t.keys() {
                 if k != kind && k != "scale" {
                     return Err(format!(

@@ -670,8 +670,22 @@ impl Conv {
                 }
                 self.resolution = (w as i64, h as i64);
                 if name() == "spectral" {
+                    // pbrt-v4's SpectralFilm: nbuckets equal buckets over [lambdamin,
+                    // lambdamax] (16 over 360–830 nm by default); heron's bins span
+                    // 360–830 nm.
                     let n = p.float("nbuckets").unwrap_or(16.0);
-                    self.warn(self.diag(path, line, format!("Film \"spectral\": heron's spectral bins are a render flag (--spectral-bins {n}); not set by the scene")))?;
+                    let (lo, hi) = (
+                        p.float("lambdamin").unwrap_or(360.0),
+                        p.float("lambdamax").unwrap_or(830.0),
+                    );
+                    if !(n >= 1.0 && n <= 470.0 && n.fract() == 0.0) {
+                        return Err(self.diag(path, line, format!("Film \"spectral\": nbuckets: expected a whole number from 1 to 470, got {n}")));
+                    }
+                    if (lo, hi) != (360.0, 830.0) {
+                        self.warn(self.diag(path, line, format!("Film \"spectral\": heron's spectral bins span 360–830 nm, not {lo}–{hi} nm; {n} bins over 360–830 nm are used")))?;
+                    }
+                    self.render
+                        .insert("spectral_bins".into(), Value::Integer(n as i64));
                 }
             }
             "Sampler" => {

@@ -56,5 +56,13 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
         settings.sppm.radius =
             parse_sppm_radius(v).map_err(|e| format!("render.sppm_radius: {e}"))?;
     }
+    if let Some(b) = r.spectral_bins {
+        if !(0..=470).contains(&b) {
+            return Err(format!(
+                "render.spectral_bins: expected 0 (none) or 1 to 470 bins, got {b}"
+            ));
+        }
+        settings.spectral_bins = b as usize;
+    }
     Ok(settings)
 }
