@@ -678,7 +678,7 @@ impl Conv {
                         p.float("lambdamin").unwrap_or(360.0),
                         p.float("lambdamax").unwrap_or(830.0),
                     );
-                    if !(n >= 1.0 && n <= 470.0 && n.fract() == 0.0) {
+                    if !((1.0..=470.0).contains(&n) && n.fract() == 0.0) {
                         return Err(self.diag(path, line, format!("Film \"spectral\": nbuckets: expected a whole number from 1 to 470, got {n}")));
                     }
                     if (lo, hi) != (360.0, 830.0) {
