@@ -137,6 +137,10 @@ fn check_material(m: &Material) {
     };
     match m {
         Material::Lambertian(l) => reflectance("rho_d", &l.rho_d),
+        Material::TexturedDiffuse(t) => {
+            let (w, h) = t.texture.size();
+            assert!(w >= 1 && h >= 1);
+        }
         Material::Mirror(mi) => reflectance("rho_s", &mi.rho_s),
         Material::Dielectric(d) => dielectric(d),
         Material::RoughDielectric(d) => {
@@ -232,8 +236,12 @@ fn stays_in_folder(f: &SceneFile) -> bool {
                 metal: MetalSpec::Table(t),
                 ..
             }) => files.push(t),
+            MaterialFile::Lambertian(l) => files.extend(l.texture.as_deref()),
             _ => {}
         }
+    }
+    if let Some(e) = &f.environment {
+        files.push(&e.map);
     }
     for s in &f.shapes {
         if let ShapeFile::Mesh(m) = s {

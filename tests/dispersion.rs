@@ -63,6 +63,7 @@ fn prism() -> Shape {
                 [2, 0, 3],
                 [2, 3, 5],
             ],
+            uvs: Vec::new(),
         }),
         0,
     )
@@ -308,6 +309,7 @@ fn ending_secondary_wavelengths_is_unbiased() {
                         Vec3::new(-5.0, -1.0, 5.0),
                     ],
                     indices: vec![[0, 2, 1], [0, 3, 2]],
+                    uvs: Vec::new(),
                 }),
                 1,
             ),

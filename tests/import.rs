@@ -418,7 +418,7 @@ fn obj_and_ply_meshes_take_the_transform() {
 fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
     let body = r#"
     <shape type="sphere">
-        <bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="wood.png"/></texture></bsdf>
+        <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf>
     </shape>
     <emitter type="sunsky"/>
     <shape type="cylinder"/>
@@ -432,7 +432,7 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
         .map(|w| (w.line, w.message.as_str()))
         .collect();
     let has = |line: u32, s: &str| lines.iter().any(|(l, m)| *l == line && m.contains(s));
-    assert!(has(9, "textures are not supported"), "{lines:#?}");
+    assert!(has(9, "textures other than a bitmap"), "{lines:#?}");
     assert!(has(11, "emitter \"sunsky\" is not supported"), "{lines:#?}");
     assert!(has(12, "shape \"cylinder\" is not supported"), "{lines:#?}");
     assert!(has(13, "parameter \"nonsense\""), "{lines:#?}");
@@ -1173,4 +1173,43 @@ fn a_pbrt_spectral_film_sets_heron_s_spectral_bins() {
         .unwrap_err()
         .to_string()
         .contains("nbuckets: expected a whole number from 1 to 470, got 0"));
+}
+
+/// Mitsuba's `bitmap` as a diffuse reflectance (nested or by `ref`) becomes a textured
+/// `lambertian`, its file relative to the converted TOML; settings heron does not share
+/// warn.
+#[test]
+fn a_mitsuba_bitmap_reflectance_converts_to_a_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("tex")).unwrap();
+    image::RgbImage::from_pixel(4, 2, image::Rgb([128, 64, 32]))
+        .save(dir.path().join("tex/wood.png"))
+        .unwrap();
+    let body = r#"
+    <texture type="bitmap" id="wood"><string name="filename" value="tex/wood.png"/><string name="wrap_mode" value="mirror"/></texture>
+    <shape type="rectangle"><bsdf type="diffuse"><ref id="wood" name="reflectance"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="tex/wood.png"/>
+        <transform name="to_uv"><scale x="2"/></transform></texture></bsdf></shape>"#;
+    let p = write(dir.path(), "scene.xml", &scene(body));
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    let textured: Vec<&str> = get(&imp.table, "materials")
+        .as_table()
+        .unwrap()
+        .values()
+        .filter_map(|m| m.get("texture").and_then(|t| t.as_str()))
+        .collect();
+    assert_eq!(textured, ["tex/wood.png", "tex/wood.png"]);
+    let has = |s: &str| imp.warnings.iter().any(|w| w.message.contains(s));
+    assert!(
+        has("wrap_mode \"mirror\": heron's textures are repeat"),
+        "{:?}",
+        imp.warnings
+    );
+    assert!(has("to_uv is not supported"), "{:?}", imp.warnings);
+    let s = load_imported(&imp).unwrap();
+    assert!(s.materials.iter().all(|m| m.is_textured()));
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let t = imp.to_toml(&out);
+    assert!(t.contains("texture = \"../tex/wood.png\""), "{t}");
 }

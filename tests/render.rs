@@ -56,6 +56,7 @@ fn quad(origin: Vec3, e1: Vec3, e2: Vec3, material: u32) -> Shape {
         ShapeKind::Mesh(Mesh {
             positions: vec![origin, origin + e1, origin + e1 + e2, origin + e2],
             indices: vec![[0, 1, 2], [0, 2, 3]],
+            uvs: Vec::new(),
         }),
         material,
     )

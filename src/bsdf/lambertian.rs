@@ -5,7 +5,7 @@
 //! and viewer on the same side of the surface, either side.
 use super::{same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
 use crate::math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use crate::spectrum::{DenseSpectrum, SampledWavelengths};
+use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -15,7 +15,7 @@ pub struct Lambertian {
     pub rho_d: DenseSpectrum,
 }
 
-const LOBE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
+pub(super) const LOBE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
 
 impl BsdfModel for Lambertian {
     #[inline]
@@ -31,10 +31,7 @@ impl BsdfModel for Lambertian {
         wl: &SampledWavelengths<N>,
         _: &BsdfContext,
     ) -> BsdfEval<N> {
-        if !same_hemisphere(wo, wi) {
-            return BsdfEval::zero();
-        }
-        BsdfEval::keep(wl.eval(&self.rho_d) * FRAC_1_PI)
+        diffuse_eval(wo, wi, || wl.eval(&self.rho_d))
     }
 
     #[inline]
@@ -46,25 +43,7 @@ impl BsdfModel for Lambertian {
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
-        if !ctx.lobes.allows(LOBE) {
-            return None;
-        }
-        let mut wi = cosine_hemisphere(u);
-        if wo.z < 0.0 {
-            wi.z = -wi.z;
-        }
-        let pdf = cosine_hemisphere_pdf(wi.z.abs());
-        if pdf == 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: wl.eval(&self.rho_d) * FRAC_1_PI,
-            pdf,
-            flags: LOBE,
-            eta: 1.0,
-            ended_companions: false,
-        })
+        diffuse_sample(wo, u, ctx, || wl.eval(&self.rho_d))
     }
 
     #[inline]
@@ -75,9 +54,58 @@ impl BsdfModel for Lambertian {
         _: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> f32 {
-        if !ctx.lobes.allows(LOBE) || !same_hemisphere(wo, wi) {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(wi.z.abs())
+        diffuse_pdf(wo, wi, ctx)
     }
+}
+
+/// f = ρ/π on the side of ωo ([`Lambertian`] and the textured diffuse reflector, whose
+/// ρ comes from an image); `rho` is only evaluated when f is not zero.
+#[inline(always)]
+pub(super) fn diffuse_eval<const N: usize>(
+    wo: Vec3,
+    wi: Vec3,
+    rho: impl FnOnce() -> SampledSpectrum<N>,
+) -> BsdfEval<N> {
+    if !same_hemisphere(wo, wi) {
+        return BsdfEval::zero();
+    }
+    BsdfEval::keep(rho() * FRAC_1_PI)
+}
+
+/// A cosine-weighted ωi on the side of ωo, f = ρ/π.
+#[inline(always)]
+pub(super) fn diffuse_sample<const N: usize>(
+    wo: Vec3,
+    u: Vec2,
+    ctx: &BsdfContext,
+    rho: impl FnOnce() -> SampledSpectrum<N>,
+) -> Option<BsdfSample<N>> {
+    if !ctx.lobes.allows(LOBE) {
+        return None;
+    }
+    let mut wi = cosine_hemisphere(u);
+    if wo.z < 0.0 {
+        wi.z = -wi.z;
+    }
+    let pdf = cosine_hemisphere_pdf(wi.z.abs());
+    if pdf == 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f: rho() * FRAC_1_PI,
+        pdf,
+        flags: LOBE,
+        eta: 1.0,
+        ended_companions: false,
+    })
+}
+
+/// The density of [`diffuse_sample`].
+#[inline(always)]
+pub(super) fn diffuse_pdf(wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f32 {
+    if !ctx.lobes.allows(LOBE) || !same_hemisphere(wo, wi) {
+        return 0.0;
+    }
+    cosine_hemisphere_pdf(wi.z.abs())
 }

@@ -35,6 +35,8 @@ pub mod mirror;
 pub mod phong;
 pub mod rough_conductor;
 pub mod rough_dielectric;
+pub mod texture;
+pub mod textured_diffuse;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
@@ -43,6 +45,8 @@ pub use mirror::Mirror;
 pub use phong::Glossy;
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
+pub use texture::ImageTexture;
+pub use textured_diffuse::TexturedDiffuse;
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -137,7 +141,7 @@ impl std::ops::BitOr for LobeFlags {
 }
 
 /// How a BSDF query is made.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BsdfContext {
     pub mode: TransportMode,
     /// False once a wavelength-dependent event has ended the companion lanes on this
@@ -145,6 +149,10 @@ pub struct BsdfContext {
     pub companions_alive: bool,
     /// Lobes `sample` may choose; the pdf it returns is conditioned on this choice.
     pub lobes: LobeFlags,
+    /// The hit's texture coordinates ([`crate::geometry::Interaction::uv`]), for the
+    /// materials whose reflectance is an image (pbrt-v4's `MaterialEvalContext::uv`).
+    /// Integrators set it at each surface vertex; only textured materials read it.
+    pub uv: Vec2,
 }
 
 impl BsdfContext {
@@ -154,7 +162,15 @@ impl BsdfContext {
             mode: TransportMode::Radiance,
             companions_alive: N > 1,
             lobes: LobeFlags::ALL,
+            uv: Vec2::ZERO,
         }
+    }
+
+    /// The context at a hit whose texture coordinates are `uv`.
+    #[inline]
+    pub fn at(mut self, uv: Vec2) -> BsdfContext {
+        self.uv = uv;
+        self
     }
 
     pub fn with_lobes(mut self, lobes: LobeFlags) -> BsdfContext {
@@ -334,6 +350,8 @@ pub enum Material {
     RoughConductor(RoughConductor),
     /// A Trowbridge–Reitz (GGX) microfacet dielectric interface.
     RoughDielectric(RoughDielectric),
+    /// A diffuse reflector whose ρd is an image over the surface's uv.
+    TexturedDiffuse(TexturedDiffuse),
 }
 
 /// `match` over the models, the same call in every arm.
@@ -341,6 +359,7 @@ macro_rules! dispatch {
     ($self:expr, $m:ident => $call:expr) => {
         match $self {
             Material::Lambertian($m) => $call,
+            Material::TexturedDiffuse($m) => $call,
             Material::Mirror($m) => $call,
             Material::Dielectric($m) => $call,
             Material::Glossy($m) => $call,
@@ -352,6 +371,13 @@ macro_rules! dispatch {
 }
 
 impl Material {
+    /// Whether the material reads the hit's uv ([`BsdfContext::uv`]), so that the
+    /// scene computes it at a hit (only then: a sphere's uv costs two arctangents).
+    #[inline]
+    pub fn is_textured(&self) -> bool {
+        matches!(self, Material::TexturedDiffuse(_))
+    }
+
     /// Every lobe this material may scatter into.
     #[inline]
     pub fn flags(&self) -> LobeFlags {

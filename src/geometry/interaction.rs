@@ -32,6 +32,9 @@ pub struct Interaction {
     pub material: u32,
     /// The shape hit (its Embree geometry ID).
     pub shape: u32,
+    /// Texture coordinates, computed only for a textured material (zero otherwise;
+    /// [`Shape::uv`]).
+    pub uv: glam::Vec2,
 }
 
 impl Interaction {
@@ -78,6 +81,7 @@ impl Interaction {
             front_face,
             material: shape.material,
             shape: hit.geom_id,
+            uv: glam::Vec2::ZERO,
         }
     }
 

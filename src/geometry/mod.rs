@@ -17,6 +17,10 @@ use std::collections::HashMap;
 pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub indices: Vec<[u32; 3]>,
+    /// Texture coordinates of each triangle's three corners (image textures), or empty:
+    /// a triangle then has the barycentric coordinates (b1, b2) as its uv, as Mitsuba 3
+    /// gives a mesh without them. Per corner, so that a seam needs no split vertices.
+    pub uvs: Vec<[glam::Vec2; 3]>,
 }
 
 impl Mesh {
@@ -29,6 +33,16 @@ impl Mesh {
             self.positions[b as usize],
             self.positions[c as usize],
         ]
+    }
+
+    /// The texture coordinates at barycentrics (b1, b2) of triangle `prim`.
+    #[inline]
+    pub fn uv(&self, prim: u32, b1: f32, b2: f32) -> glam::Vec2 {
+        if self.uvs.is_empty() {
+            return glam::Vec2::new(b1, b2);
+        }
+        let [ta, tb, tc] = self.uvs[prim as usize];
+        ta * (1.0 - b1 - b2) + tb * b1 + tc * b2
     }
 }
 
@@ -69,6 +83,29 @@ impl Shape {
             light: NO_LIGHT,
             medium: NO_MEDIUM,
             interface: false,
+        }
+    }
+
+    /// The texture coordinates at point `p` of the shape (on it), barycentrics (b1, b2)
+    /// of triangle `prim` for a mesh: a mesh's own uvs ([`Mesh::uv`]); for a sphere
+    /// Mitsuba 3's (φ/2π, θ/π) about +z, φ = atan2(y, x) in [0, 2π), θ from +z
+    /// (`src/shapes/sphere.cpp`).
+    #[inline]
+    pub fn uv(&self, p: Vec3, prim: u32, b1: f32, b2: f32) -> glam::Vec2 {
+        match &self.kind {
+            ShapeKind::Sphere { center, .. } => {
+                let d = (p - *center).normalize_or_zero();
+                let mut phi = d.y.atan2(d.x);
+                if phi < 0.0 {
+                    phi += 2.0 * std::f32::consts::PI;
+                }
+                let theta = d.x.hypot(d.y).atan2(d.z);
+                glam::Vec2::new(
+                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
+                    theta * std::f32::consts::FRAC_1_PI,
+                )
+            }
+            ShapeKind::Mesh(m) => m.uv(prim, b1, b2),
         }
     }
 

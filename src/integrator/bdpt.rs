@@ -43,7 +43,7 @@ use crate::sampler::Sampler;
 use crate::scene::{Scene, NO_LIGHT};
 use crate::settings::Packets;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Vertices per subpath.
 pub const MAX_VERTICES: usize = 24;
@@ -71,6 +71,8 @@ struct Vertex<const N: usize> {
     wo: Vec3,
     frame: Frame,
     material: u32,
+    /// Texture coordinates of a surface vertex (for a textured material).
+    uv: Vec2,
     /// The light of a light vertex, or of an emitting surface; NO_LIGHT otherwise.
     light: u32,
     /// A light at infinity (or all of them, for an escaped camera path).
@@ -97,6 +99,7 @@ impl<const N: usize> Vertex<N> {
             n: Vec3::Z,
         },
         material: 0,
+        uv: Vec2::ZERO,
         light: NO_LIGHT,
         infinite: false,
         delta: false,
@@ -220,6 +223,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             mode,
             companions_alive: alive,
             lobes: LobeFlags::ALL,
+            uv: v.uv,
         };
         let e = material.eval(wo_l, wi_l, self.wl, &ctx);
         (e.f, e.ended_companions)
@@ -343,6 +347,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             v.wo = -ray.dir;
             v.frame = it.frame();
             v.material = it.material;
+            v.uv = it.uv;
             v.light = scene.shapes[hit.geom_id as usize].light;
             v.ended = ended;
             v.pdf_fwd = convert_density(pdf_fwd, &path[bounces], &v);
@@ -354,7 +359,8 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             let u_lobe = sampler.get_1d();
             let u_dir = sampler.get_2d();
             let wo_l = v.frame.to_local(v.wo);
-            let Some(bs) = material.sample(wo_l, u_lobe, u_dir, self.wl, &bsdf_ctx) else {
+            let Some(bs) = material.sample(wo_l, u_lobe, u_dir, self.wl, &bsdf_ctx.at(it.uv))
+            else {
                 break;
             };
             beta *= bs.weight();

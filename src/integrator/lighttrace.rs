@@ -98,6 +98,7 @@ pub fn radiance<const N: usize>(
     let mut depth = 0u32;
     while let Some(hit) = next_hit(ctx, &ray, &mut None, counters) {
         let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
+        bsdf_ctx.uv = it.uv;
         // The path has scattered `depth` times before this vertex; scattering here
         // toward the camera is one more.
         if depth == settings.max_depth {

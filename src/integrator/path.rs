@@ -598,6 +598,8 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
 ) -> bool {
     let scene = ctx.scene;
     let (it, material) = scene.interaction(ray, hit, ctx.offset.is_robust());
+    // Every query of this vertex's material sees its uv (zero unless textured).
+    s.bsdf_ctx.uv = it.uv;
     let wo = -ray.dir;
 
     // Emission of an area light the path has reached.

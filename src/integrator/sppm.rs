@@ -154,6 +154,7 @@ pub fn camera_path<const N: usize>(
             return out;
         };
         let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
+        bsdf_ctx.uv = it.uv;
         out.length += hit.t * ray.dir.length();
         let emitter = scene.shapes[hit.geom_id as usize].light;
         if emitter != NO_LIGHT {
@@ -549,6 +550,7 @@ pub fn trace_photon<const N: usize>(
             return;
         };
         let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
+        bsdf_ctx.uv = it.uv;
         let u_lobe = sampler.get_1d();
         let u_dir = sampler.get_2d();
         let u_rr = sampler.get_1d();

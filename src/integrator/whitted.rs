@@ -103,6 +103,7 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
         return false;
     };
     let (it, material) = scene.interaction(ray, &hit, ctx.offset.is_robust());
+    s.bsdf_ctx.uv = it.uv;
     let wo = -ray.dir;
     if on(K, EMITTERS) {
         let emitter = scene.shapes[hit.geom_id as usize].light;

@@ -192,14 +192,14 @@ mod tests {
         let f = [1.0f32, 0.0, 2.0, 0.5, 3.0, 1.5];
         let d = Distribution2D::new(&f, 3, 2);
         assert!((d.integral() - 8.0 / 6.0).abs() < 1e-6);
-        let mut total = 0.0;
+        let mut total = 0.0f64;
         let mut counts = [0usize; 6];
         // 300 points a side: a whole number of them per cell, so the midpoint sums are exact.
         let n = 300;
         for a in 0..n {
             for b in 0..n {
                 let u = glam::Vec2::new((a as f32 + 0.5) / n as f32, (b as f32 + 0.5) / n as f32);
-                total += d.pdf(u) / (n * n) as f32;
+                total += d.pdf(u) as f64 / (n * n) as f64;
                 let (p, pdf) = d.sample(u);
                 assert!((0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
                 assert!(

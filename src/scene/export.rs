@@ -27,6 +27,10 @@ pub fn spectra_json(scene: &Scene) -> Value {
     for (name, m) in scene.material_names.iter().zip(&scene.materials) {
         let v = match m {
             Material::Lambertian(l) => json!({"type": "lambertian", "rho_d": values(&l.rho_d)}),
+            Material::TexturedDiffuse(t) => {
+                let (w, h) = t.texture.size();
+                json!({"type": "lambertian", "texture": {"width": w, "height": h}})
+            }
             Material::Mirror(l) => json!({"type": "mirror", "rho_s": values(&l.rho_s)}),
             Material::Dielectric(d) => json!({"type": "dielectric", "ior": ior_values(&d.ior),
                 "outside_ior": ior_values(&d.outside), "fresnel": d.fresnel, "alpha": 0.0}),

@@ -258,7 +258,14 @@ impl MaterialFile {
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LambertianFile {
-    pub rho_d: Reflectance,
+    /// ρd; or, instead, `texture`.
+    #[serde(default)]
+    pub rho_d: Option<Reflectance>,
+    /// An image of ρd over the surface's uv (src/bsdf/texture.rs), relative to the scene
+    /// file: PNG (sRGB-decoded), OpenEXR or Radiance HDR (linear); linear sRGB,
+    /// components clamped to [0, 1].
+    #[serde(default)]
+    pub texture: Option<String>,
 }
 
 #[derive(Debug, serde::Deserialize)]

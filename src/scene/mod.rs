@@ -153,7 +153,11 @@ impl Scene {
     pub fn interaction(&self, ray: &Ray, hit: &Hit, robust: bool) -> (Interaction, &Material) {
         let shape = &self.shapes[hit.geom_id as usize];
         let material = &self.materials[shape.material as usize];
-        (Interaction::new(ray, hit, shape, robust), material)
+        let mut it = Interaction::new(ray, hit, shape, robust);
+        if material.is_textured() {
+            it.uv = shape.uv(it.position, hit.prim_id, hit.u, hit.v);
+        }
+        (it, material)
     }
 
     /// Radiance arriving along a ray that leaves the scene in direction `dir`: the

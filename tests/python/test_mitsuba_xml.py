@@ -21,6 +21,10 @@ as wavelength:value pairs, reflectances from a .spd file and from inline pairs; 
 256 spp): no RGB uplift anywhere, so the two agree more closely (largest region 1.0%),
 and the whole image's mean differs by 0.13%, the films' own difference (FILM_FLOOR).
 
+textures.xml (an 8-bit sRGB bitmap, scenes/textures/tiles.png, on a rectangle and a
+sphere; 160×96, 256 spp): largest region 0.6%; the same file with the image turned
+upside down on heron's side fails (test_a_flipped_texture_fails_the_comparison).
+
 Unlike test_mitsuba.py, which gives Mitsuba heron's own spectra, each renderer here
 uplifts the file's RGB reflectances and radiance to spectra with its own fitted table of
 Jakob and Hanika's 2019 model, so the images differ by the metamerism of the two
@@ -53,6 +57,8 @@ SCENES = {
                {"width": "160", "height": "96"}, 256),
     "spectra": (REPO / "scenes" / "mitsuba" / "spectra.xml",
                 {"width": "160", "height": "96"}, 256),
+    "textures": (REPO / "scenes" / "mitsuba" / "textures.xml",
+                 {"width": "160", "height": "96"}, 256),
 }
 
 
@@ -155,4 +161,23 @@ def test_a_turned_envmap_fails_the_comparison(tmp_path):
     b = render_mitsuba(xml, params, spp)
     z, worst = agreement(a, b)
     print(f"map turned the other way: whole-image z {z}, largest region difference {worst:.2%}")
+    assert not same(z, worst), (z, worst)
+
+
+def test_a_flipped_texture_fails_the_comparison(tmp_path):
+    """The textures scene with heron given the bitmap upside down."""
+    from PIL import Image
+
+    xml, params, spp = SCENES["textures"]
+    png = (xml.parent / ".." / "textures" / "tiles.png").resolve()
+    flipped = tmp_path / "tiles-flipped.png"
+    Image.open(png).transpose(Image.Transpose.FLIP_TOP_BOTTOM).save(flipped)
+    text = xml.read_text().replace('value="../textures/tiles.png"', f'value="{flipped}"')
+    assert text.count(str(flipped)) == 2
+    changed = tmp_path / "textures-flipped.xml"
+    changed.write_text(text)
+    a = render_heron(changed, tmp_path, params, spp)
+    b = render_mitsuba(xml, params, spp)
+    z, worst = agreement(a, b)
+    print(f"texture upside down: whole-image z {z}, largest region difference {worst:.2%}")
     assert not same(z, worst), (z, worst)

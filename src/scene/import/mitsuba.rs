@@ -246,6 +246,55 @@ impl<'a> Converter<'a> {
             .ok_or_else(|| n.diag(format!("no element has the id {id:?}")))
     }
 
+    /// The image file of parameter `name` when it is a `bitmap` texture (nested or by
+    /// `ref`), relative to the top-level file's folder, as heron's `texture` reads it
+    /// (bilinear, repeating, 8-bit images sRGB-decoded: Mitsuba's defaults). Its other
+    /// settings warn where heron differs.
+    fn bitmap(&mut self, p: &Props<'a>, name: &str) -> Result<Option<String>, Diagnostic> {
+        let Some(n) = p
+            .node
+            .children
+            .iter()
+            .find(|c| c.attr("name") == Some(name))
+        else {
+            return Ok(None);
+        };
+        let t = self.resolve(n)?;
+        if t.tag != "texture" || t.attr("type") != Some("bitmap") {
+            return Ok(None);
+        }
+        p.get(name);
+        let tp = Props::new(t);
+        let Some(file) = tp.string("filename")? else {
+            return Err(t.diag("expected <string name=\"filename\" value=\"…\"/>"));
+        };
+        let folder = t.file.parent().unwrap_or(Path::new(""));
+        let rel = relative_to(&folder.join(file), &self.base);
+        for (key, default) in [("filter_type", "bilinear"), ("wrap_mode", "repeat")] {
+            if let Some(v) = tp.string(key)? {
+                if v != default {
+                    self.warn(t.diag(format!(
+                        "{key} {v:?}: heron's textures are {default}, which is used"
+                    )))?;
+                }
+            }
+        }
+        if tp.boolean("raw")? == Some(true) {
+            self.warn(t.diag(
+                "raw: heron decodes an 8-bit image's sRGB curve regardless (Mitsuba's spectral variants refuse a raw reflectance)",
+            ))?;
+        }
+        if let Some(m) = tp.transform("to_uv")? {
+            if m != DMat4::IDENTITY {
+                self.warn(t.diag("to_uv is not supported, ignored: the texture is not moved"))?;
+            }
+        }
+        for w in tp.unread() {
+            self.warn(w)?;
+        }
+        Ok(Some(rel.to_string_lossy().replace('\\', "/")))
+    }
+
     /// A colour, or `default` when absent; unsupported forms warn and use `default`.
     fn colour(
         &mut self,
@@ -583,11 +632,18 @@ impl<'a> Converter<'a> {
                 };
             }
             "diffuse" => {
-                let rho = self.colour(&p, "reflectance", ColourValue::Grey(0.5))?;
-                table(vec![
-                    ("type", Value::String("lambertian".into())),
-                    ("rho_d", rho.to_toml()),
-                ])
+                if let Some(file) = self.bitmap(&p, "reflectance")? {
+                    table(vec![
+                        ("type", Value::String("lambertian".into())),
+                        ("texture", Value::String(file)),
+                    ])
+                } else {
+                    let rho = self.colour(&p, "reflectance", ColourValue::Grey(0.5))?;
+                    table(vec![
+                        ("type", Value::String("lambertian".into())),
+                        ("rho_d", rho.to_toml()),
+                    ])
+                }
             }
             "dielectric" | "roughdielectric" | "thindielectric" => {
                 if kind == "thindielectric" {

@@ -127,6 +127,16 @@ impl Imported {
                 }
             }
         }
+        if let Some(toml::Value::Table(materials)) = table.get_mut("materials") {
+            for (_, m) in materials.iter_mut() {
+                if let Some(toml::Value::String(f)) =
+                    m.as_table_mut().and_then(|t| t.get_mut("texture"))
+                {
+                    let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
+                    *f = rel.to_string_lossy().replace('\\', "/");
+                }
+            }
+        }
         if let Some(toml::Value::String(f)) =
             table.get_mut("environment").and_then(|e| e.get_mut("map"))
         {

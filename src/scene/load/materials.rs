@@ -4,7 +4,8 @@
 use super::errors::key;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    Conductor, Dielectric, Glossy, Lambertian, Material, Mirror, RoughConductor, RoughDielectric,
+    Conductor, Dielectric, Glossy, ImageTexture, Lambertian, Material, Mirror, RoughConductor,
+    RoughDielectric, TexturedDiffuse,
 };
 use crate::scene::file::{IorSpec, MaterialFile, MetalSpec, SceneFile};
 use crate::spectrum::ior::Ior;
@@ -170,9 +171,33 @@ fn build_material(
     inputs: &mut Vec<String>,
 ) -> std::result::Result<Material, String> {
     Ok(match m {
-        MaterialFile::Lambertian(l) => Material::Lambertian(Lambertian {
-            rho_d: l.rho_d.spectrum(),
-        }),
+        MaterialFile::Lambertian(l) => match (&l.rho_d, &l.texture) {
+            (Some(rho), None) => Material::Lambertian(Lambertian {
+                rho_d: rho.spectrum(),
+            }),
+            (None, Some(file)) => {
+                let img = super::image::read_rgb(&base_dir.join(file))
+                    .map_err(|e| format!("{at}.texture: {e}"))?;
+                inputs.push(file.clone());
+                Material::TexturedDiffuse(TexturedDiffuse {
+                    texture: std::sync::Arc::new(ImageTexture::new(
+                        img.width,
+                        img.height,
+                        &img.pixels,
+                    )),
+                })
+            }
+            (Some(_), Some(_)) => {
+                return Err(format!(
+                    "{at}: expected rho_d or texture, not both (the texture is the reflectance)"
+                ))
+            }
+            (None, None) => {
+                return Err(format!(
+                    "{at}: expected rho_d (a reflectance) or texture (an image file)"
+                ))
+            }
+        },
         MaterialFile::Mirror(mi) => Material::Mirror(Mirror {
             // Left out: the lecture's ideal mirror, exactly 1 at every wavelength.
             rho_s: mi

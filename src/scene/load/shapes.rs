@@ -10,7 +10,7 @@ use crate::geometry::{Mesh, Shape, ShapeKind, MIN_RELATIVE_RADIUS};
 use crate::scene::file::{
     fmt_f32, MeshFile, PlaneFile, QuadFile, ShapeFile, SphereFile, TriangleFile, WavesFile,
 };
-use glam::{DMat4, Vec3};
+use glam::{DMat4, Vec2, Vec3};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -147,7 +147,14 @@ fn plane(at: &str, p: &PlaneFile) -> std::result::Result<ShapeKind, String> {
             "{at}.size: expected a size whose square has finite corners, got {size}"
         ));
     }
-    Ok(mesh(v, vec![[0, 1, 2], [0, 2, 3]]))
+    // uv = (s, t) at origin + s edge1 + t edge2: Mitsuba 3's rectangle, whose local
+    // (−1, −1) corner is uv (0, 0) and the converter's origin.
+    let (c0, c1, c2, c3) = (Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y);
+    Ok(ShapeKind::Mesh(Mesh {
+        positions: v,
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        uvs: vec![[c0, c1, c2], [c0, c2, c3]],
+    }))
 }
 
 /// A quad entry at key path `at`: a parallelogram of two triangles.
@@ -173,7 +180,14 @@ fn quad(at: &str, q: &QuadFile) -> std::result::Result<ShapeKind, String> {
             fmt_points(&[e2])
         ));
     }
-    Ok(mesh(v, vec![[0, 1, 2], [0, 2, 3]]))
+    // uv = (s, t) at origin + s edge1 + t edge2: Mitsuba 3's rectangle, whose local
+    // (−1, −1) corner is uv (0, 0) and the converter's origin.
+    let (c0, c1, c2, c3) = (Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y);
+    Ok(ShapeKind::Mesh(Mesh {
+        positions: v,
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        uvs: vec![[c0, c1, c2], [c0, c2, c3]],
+    }))
 }
 
 /// The most triangles a `waves` entry may make (2 per cell).
@@ -339,7 +353,11 @@ fn box_sphere((lo, hi): Box3) -> crate::light::SceneBounds {
 
 /// A triangle mesh.
 fn mesh(positions: Vec<Vec3>, indices: Vec<[u32; 3]>) -> ShapeKind {
-    ShapeKind::Mesh(Mesh { positions, indices })
+    ShapeKind::Mesh(Mesh {
+        positions,
+        indices,
+        uvs: Vec::new(),
+    })
 }
 
 /// Whether the cross product of the edges b − a and c − a (twice the area, and the normal

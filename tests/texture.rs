@@ -1,0 +1,191 @@
+//! Image textures of reflectance (`type = "lambertian"` with `texture = "file"`,
+//! src/bsdf/texture.rs): a textured square facing the camera under a uniform white
+//! environment sends back ρ(uv) times the environment (it sees nothing but the sky), so
+//! the image is the texture itself, texel for texel, under every integrator that sees
+//! the environment; the layout of uv on a quad and a sphere; the loader's errors.
+mod common;
+
+use common::render::run;
+use heron::scene::load_scene;
+use heron::settings::IntegratorKind;
+use std::path::Path;
+
+fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) {
+    use exr::prelude::*;
+    let img = Image::from_channels(
+        (w, h),
+        SpecificChannels::rgb(|p: Vec2<usize>| {
+            let c = f(p.x(), p.y());
+            (c[0], c[1], c[2])
+        }),
+    );
+    img.write().to_file(path).unwrap();
+}
+
+/// 4 × 2 texels of distinct, moderately saturated colours.
+const TEXELS: [[f32; 3]; 8] = [
+    [0.7, 0.2, 0.1],
+    [0.2, 0.6, 0.2],
+    [0.1, 0.2, 0.7],
+    [0.5, 0.5, 0.5],
+    [0.6, 0.6, 0.1],
+    [0.1, 0.5, 0.6],
+    [0.6, 0.1, 0.5],
+    [0.3, 0.3, 0.3],
+];
+
+/// A 2 × 1 square at z = 0 facing +z, origin at its lower left (−1, −0.5), edge1 along
+/// +x, edge2 along +y; the camera at z = 4 sees it fill a 64 × 32 image.
+fn scene(dir: &Path, material: &str) -> std::path::PathBuf {
+    let text = format!(
+        r#"background = 1.0
+[camera]
+eye = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+d = 4.0
+resolution = [64, 32]
+[render]
+max_depth = 4
+[materials.m]
+{material}
+[[shapes]]
+type = "quad"
+origin = [-1.0, -0.5, 0.0]
+edge1 = [2.0, 0.0, 0.0]
+edge2 = [0.0, 1.0, 0.0]
+material = "m"
+"#
+    );
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn a_textured_square_under_a_white_sky_renders_its_texels_with_every_integrator() {
+    let dir = tempfile::tempdir().unwrap();
+    // Each colour is a 2 × 2 block of texels, so that around a block's centre the
+    // bilinear lookup blends only equal texels and the colour is exact there.
+    write_exr(&dir.path().join("t.exr"), 8, 4, |i, j| {
+        TEXELS[(j / 2) * 4 + i / 2]
+    });
+    let s = load_scene(&scene(
+        dir.path(),
+        "type = \"lambertian\"\ntexture = \"t.exr\"",
+    ))
+    .unwrap();
+    // The camera's d = 4 at distance 4 makes the image plane (height 1, width 2) the
+    // square itself; its pixel (x, y) from the top sees uv = ((x + ½)/64, 1 − (y + ½)/32).
+    for (kind, spp, tol) in [
+        (IntegratorKind::Path, 64, 0.005),
+        (IntegratorKind::Bdpt, 64, 0.005),
+        // Light tracing reaches the camera through the square by chance: at 4096 samples
+        // a pixel group is within 3% (256 leave it 8% off).
+        (IntegratorKind::LightTrace, 4096, 0.03),
+        (IntegratorKind::Sppm, 64, 0.005),
+    ] {
+        let film = run(&s, kind, spp, 5);
+        let img = film.linear_srgb();
+        for (k, want) in TEXELS.iter().enumerate() {
+            let (i, j) = (k % 4, k / 4);
+            // Block (i, j)'s centre: uv ((i + ½)/4, (j + ½)/2); v = 0 is the image's top
+            // row and the quad's edge1 side (the bottom of the picture).
+            let px = i * 16 + 8;
+            let py = 32 - (j * 16 + 8);
+            // The mean over the 4 × 4 pixels around the centre.
+            let mut rgb = [0.0f64; 3];
+            for dy in 0..4 {
+                for dx in 0..4 {
+                    let c = img[(py - 2 + dy) * 64 + px - 2 + dx];
+                    for ch in 0..3 {
+                        rgb[ch] += c[ch] as f64 / 16.0;
+                    }
+                }
+            }
+            for ch in 0..3 {
+                // The texel's uplift (the fitted table's lookup, unpolished) and the
+                // estimator's noise.
+                assert!(
+                    (rgb[ch] - want[ch] as f64).abs() < tol,
+                    "{kind:?}: texel ({i}, {j}) channel {ch}: {} vs {}",
+                    rgb[ch],
+                    want[ch]
+                );
+            }
+        }
+    }
+}
+
+/// A sphere's uv is Mitsuba 3's (φ/2π, θ/π) about +z: seen from +z, its upper half
+/// (y > 0, φ near 90°, u near ¼) shows the texture's left texel and its lower half the
+/// right one; a PNG is sRGB-decoded.
+#[test]
+fn a_sphere_s_uv_and_a_png_s_srgb_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2 × 1: left red, right green, 8-bit sRGB 188 = linear 0.5029.
+    let mut png = image::RgbImage::new(2, 1);
+    png.put_pixel(0, 0, image::Rgb([188, 0, 0]));
+    png.put_pixel(1, 0, image::Rgb([0, 188, 0]));
+    png.save(dir.path().join("t.png")).unwrap();
+    let text = r#"background = 1.0
+[camera]
+eye = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+d = 2.0
+resolution = [33, 33]
+[render]
+max_depth = 1
+[materials.m]
+type = "lambertian"
+texture = "t.png"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "m"
+"#;
+    let p = dir.path().join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    let film = run(&load_scene(&p).unwrap(), IntegratorKind::Path, 16, 1);
+    let img = film.linear_srgb();
+    let (top, bottom) = (img[10 * 33 + 16], img[22 * 33 + 16]);
+    assert!(top[0] > 0.1 && top[1] < 0.02, "top {top:?}");
+    assert!(bottom[1] > 0.1 && bottom[0] < 0.02, "bottom {bottom:?}");
+    // ρ = 0.5029 at u = ¼ exactly (the left texel's centre), the sphere lit by a
+    // uniform sky over the hemisphere it sees: radiance ρ · 1 · (1, only one bounce).
+    let decoded = ((188.0f64 / 255.0 + 0.055) / 1.055).powf(2.4);
+    assert!(
+        (top[0] as f64 - decoded).abs() < 0.01,
+        "{top:?} vs {decoded}"
+    );
+}
+
+#[test]
+fn texture_errors_name_the_material_and_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    write_exr(&dir.path().join("t.exr"), 2, 2, |_, _| [0.5; 3]);
+    for (m, want) in [
+        (
+            "type = \"lambertian\"\nrho_d = 0.5\ntexture = \"t.exr\"",
+            "materials.m: expected rho_d or texture, not both",
+        ),
+        (
+            "type = \"lambertian\"",
+            "materials.m: expected rho_d (a reflectance) or texture (an image file)",
+        ),
+        (
+            "type = \"lambertian\"\ntexture = \"nope.png\"",
+            "materials.m.texture: ",
+        ),
+        (
+            "type = \"lambertian\"\ntexture = \"t.jpg\"",
+            "expected an image file ending in .exr, .hdr or .png",
+        ),
+    ] {
+        let e = load_scene(&scene(dir.path(), m)).unwrap_err().to_string();
+        assert!(
+            e.contains(want) && e.contains("scene.toml") && !e.contains('\n'),
+            "{m}: {e}"
+        );
+    }
+}
