@@ -362,7 +362,7 @@ const BAD: &[(&str, &str, &[&str])] = &[
      &["lights[0].type: unknown variant \"laser\", expected one of point, directional, sun, spot"]),
     // Unknown keys
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = 0.5\ncolour = 1\n",
-     &["unknown key \"colour\" at materials.x (expected one of type, rho_d)"]),
+     &["unknown key \"colour\" at materials.x (expected one of type, rho_d, texture)"]),
     ("", "[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\nradus = 1\n",
      &["unknown key \"radus\" at shapes[0] (expected one of type, center, radius, material, emission, two_sided, medium)"]),
     ("", "[materials.x]\ntype = \"mirror\"\nior = 1.5\n",

@@ -189,3 +189,79 @@ fn texture_errors_name_the_material_and_the_file() {
         );
     }
 }
+
+/// A mesh's own texture coordinates: the square of the first test as an OBJ (whose v is
+/// flipped on reading, as Mitsuba 3 reads OBJ) and as a PLY (not flipped) renders exactly
+/// the pixels of the `quad`; a face without texture coordinates leaves the mesh with
+/// none, and a bad texture index is an error with its line.
+#[test]
+fn obj_and_ply_texture_coordinates_place_the_texture_as_the_quad_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_exr(&d.join("t.exr"), 8, 4, |i, j| TEXELS[(j / 2) * 4 + i / 2]);
+    let quad = load_scene(&scene(d, "type = \"lambertian\"\ntexture = \"t.exr\"")).unwrap();
+    let reference = run(&quad, IntegratorKind::Path, 4, 9);
+    // The quad's corners origin, +edge1, +edge1+edge2, +edge2 and its uv (s, t).
+    std::fs::write(
+        d.join("sq.obj"),
+        "v -1 -0.5 0\nv 1 -0.5 0\nv 1 0.5 0\nv -1 0.5 0\nvt 0 1\nvt 1 1\nvt 1 0\nvt 0 0\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("sq.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n-1 -0.5 0 0 0\n1 -0.5 0 1 0\n1 0.5 0 1 1\n-1 0.5 0 0 1\n3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    for file in ["sq.obj", "sq.ply"] {
+        let text = std::fs::read_to_string(scene(d, "type = \"lambertian\"\ntexture = \"t.exr\""))
+            .unwrap();
+        let text = text.replace(
+            "type = \"quad\"\norigin = [-1.0, -0.5, 0.0]\nedge1 = [2.0, 0.0, 0.0]\nedge2 = [0.0, 1.0, 0.0]\n",
+            &format!("type = \"mesh\"\nfile = \"{file}\"\n"),
+        );
+        let p = d.join("mesh.toml");
+        std::fs::write(&p, &text).unwrap();
+        let film = run(&load_scene(&p).unwrap(), IntegratorKind::Path, 4, 9);
+        assert_eq!(film.xyz, reference.xyz, "{file}");
+        // Flipped the other way, the texture is upside down: not the same image.
+        let flipped = text.replace(
+            &format!("file = \"{file}\"\n"),
+            &format!(
+                "file = \"{file}\"\nflip_tex_coords = {}\n",
+                file.ends_with("ply")
+            ),
+        );
+        std::fs::write(&p, &flipped).unwrap();
+        let film = run(&load_scene(&p).unwrap(), IntegratorKind::Path, 4, 9);
+        assert_ne!(film.xyz, reference.xyz, "{file} flipped");
+    }
+    // One face without texture coordinates: none for the mesh (barycentrics).
+    let mixed = "v -1 -0.5 0\nv 1 -0.5 0\nv 1 0.5 0\nv -1 0.5 0\nvt 0 1\nvt 1 1\nvt 1 0\nf 1/1 2/2 3/3\nf 1 3 4\n";
+    let g = std::fs::write(d.join("mixed.obj"), mixed);
+    g.unwrap();
+    let text = std::fs::read_to_string(scene(d, "type = \"lambertian\"\ntexture = \"t.exr\""))
+        .unwrap()
+        .replace(
+            "type = \"quad\"\norigin = [-1.0, -0.5, 0.0]\nedge1 = [2.0, 0.0, 0.0]\nedge2 = [0.0, 1.0, 0.0]\n",
+            "type = \"mesh\"\nfile = \"mixed.obj\"\n",
+        );
+    let p = d.join("mixed.toml");
+    std::fs::write(&p, &text).unwrap();
+    let s = load_scene(&p).unwrap();
+    let heron::geometry::ShapeKind::Mesh(m) = &s.shapes[0].kind else {
+        panic!()
+    };
+    assert!(m.uvs.is_empty());
+    std::fs::write(
+        d.join("bad.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/5 3/1\n",
+    )
+    .unwrap();
+    let text = text.replace("mixed.obj", "bad.obj");
+    std::fs::write(&p, &text).unwrap();
+    let e = load_scene(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("line 5: texture coordinate index 5 out of range"),
+        "{e}"
+    );
+}

@@ -521,6 +521,10 @@ pub struct MeshFile {
     /// `scale` and `translate`: Mitsuba's `to_world`, as `heron convert` writes it.
     #[serde(default)]
     pub transform: Option<Vec<Vec<f64>>>,
+    /// Use the file's texture coordinates (u, v) as (u, 1 − v): default true for OBJ
+    /// (whose images start at the bottom row), false for PLY, as Mitsuba 3 reads them.
+    #[serde(default)]
+    pub flip_tex_coords: Option<bool>,
     /// Radiance emitted by every triangle of the mesh: it becomes an area light.
     #[serde(default)]
     pub emission: Option<Emission>,

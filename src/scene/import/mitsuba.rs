@@ -957,7 +957,7 @@ impl<'a> Converter<'a> {
                 }
                 // heron shades every mesh by its face normals (README, "Mitsuba 3 scenes").
                 p.get("face_normals");
-                p.get("flip_tex_coords");
+                let flip_uv = p.boolean("flip_tex_coords")?;
                 let mut t = table(vec![
                     ("type", Value::String("mesh".into())),
                     ("file", Value::String(rel.to_string_lossy().replace('\\', "/"))),
@@ -967,6 +967,10 @@ impl<'a> Converter<'a> {
                         .map(|r| vec_row(to_world.row(r).to_array()))
                         .collect();
                     t.insert("transform".into(), Value::Array(rows));
+                }
+                // heron's defaults are Mitsuba's (true for OBJ, false for PLY).
+                if let Some(f) = flip_uv {
+                    t.insert("flip_tex_coords".into(), Value::Boolean(f));
                 }
                 entries.push(t);
             }

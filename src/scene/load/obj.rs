@@ -17,11 +17,14 @@ pub(crate) struct ObjGroup {
     pub name: String,
     pub positions: Vec<Vec3>,
     pub indices: Vec<[u32; 3]>,
+    /// The texture coordinates of each triangle's corners as the file gives them (`vt`
+    /// u v, or a PLY's u, v), or empty when not every face has them.
+    pub uvs: Vec<[glam::Vec2; 3]>,
 }
 
 /// Parses OBJ text. The error is one line, without the file name.
 pub(crate) fn parse_obj(text: &str) -> Result<Vec<ObjGroup>, String> {
-    let text = prescan(text)?;
+    let (text, every_face_textured) = prescan(text)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -49,6 +52,24 @@ pub(crate) fn parse_obj(text: &str) -> Result<Vec<ObjGroup>, String> {
             ));
         }
         let n = positions.len() as u32;
+        let texcoords: Vec<glam::Vec2> = m
+            .mesh
+            .texcoords
+            .chunks_exact(2)
+            .map(|c| glam::Vec2::new(c[0], c[1]))
+            .collect();
+        let ti = &m.mesh.texcoord_indices;
+        let uvs: Vec<[glam::Vec2; 3]> = if every_face_textured
+            && !ti.is_empty()
+            && ti.len() == m.mesh.indices.len()
+            && ti.iter().all(|&i| (i as usize) < texcoords.len())
+        {
+            ti.chunks_exact(3)
+                .map(|t| [0, 1, 2].map(|k| texcoords[t[k] as usize]))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let mut indices = Vec::with_capacity(m.mesh.indices.len() / 3);
         for t in m.mesh.indices.chunks_exact(3) {
             if t.iter().any(|&i| i >= n) {
@@ -63,6 +84,7 @@ pub(crate) fn parse_obj(text: &str) -> Result<Vec<ObjGroup>, String> {
             name: m.name,
             positions,
             indices,
+            uvs,
         });
     }
     Ok(groups)
@@ -71,13 +93,21 @@ pub(crate) fn parse_obj(text: &str) -> Result<Vec<ObjGroup>, String> {
 /// Checks `v` and `f` lines so that the common errors carry a line number, and returns
 /// the text `tobj` reads: `v`, `o`, `g` lines as they are, `f` lines with position
 /// indices only, nothing else.
-fn prescan(text: &str) -> Result<String, String> {
+/// Also whether every face has texture coordinates (else the file has none for heron:
+/// `tobj` would pair the others with made-up indices).
+fn prescan(text: &str) -> Result<(String, bool), String> {
     let mut out = String::with_capacity(text.len());
     let total_v = text
         .lines()
         .filter(|l| l.split_whitespace().next() == Some("v"))
         .count();
     let mut seen_v = 0usize;
+    let total_vt = text
+        .lines()
+        .filter(|l| l.split_whitespace().next() == Some("vt"))
+        .count();
+    let mut seen_vt = 0usize;
+    let mut every_face_textured = true;
     for (i, line) in text.lines().enumerate() {
         let ln = i + 1;
         // A `#` starts a comment, also after data.
@@ -103,6 +133,21 @@ fn prescan(text: &str) -> Result<String, String> {
                 out.push_str(line.trim());
                 out.push('\n');
             }
+            Some("vt") => {
+                seen_vt += 1;
+                let uv: Vec<Option<f32>> = words.take(2).map(|w| w.parse::<f32>().ok()).collect();
+                match uv.as_slice() {
+                    [Some(u), Some(v)] if u.is_finite() && v.is_finite() => {
+                        out.push_str(&format!("vt {u} {v}\n"));
+                    }
+                    _ => {
+                        return Err(format!(
+                            "line {ln}: expected `vt u v` with finite numbers, got {:?}",
+                            line.trim()
+                        ))
+                    }
+                }
+            }
             Some("o") | Some("g") => {
                 out.push_str(line.trim());
                 out.push('\n');
@@ -116,10 +161,31 @@ fn prescan(text: &str) -> Result<String, String> {
                     ));
                 }
                 out.push('f');
-                for w in verts {
+                // Texture coordinates are kept when every vertex of the face has one.
+                let tex: Vec<Option<&str>> = verts
+                    .iter()
+                    .map(|w| w.split('/').nth(1).filter(|t| !t.is_empty()))
+                    .collect();
+                let keep_tex = tex.iter().all(Option::is_some);
+                every_face_textured &= keep_tex;
+                for (w, t) in verts.iter().zip(&tex) {
                     let first = w.split('/').next().unwrap_or("");
                     out.push(' ');
                     out.push_str(first);
+                    if let (true, Some(t)) = (keep_tex, t) {
+                        let ti: i64 = t.parse().map_err(|_| {
+                            format!("line {ln}: cannot read the texture index of {w:?} (expected an integer)")
+                        })?;
+                        let ok = (ti > 0 && ti as u64 <= total_vt as u64)
+                            || (ti < 0 && ti.unsigned_abs() <= seen_vt as u64);
+                        if !ok {
+                            return Err(format!(
+                                "line {ln}: texture coordinate index {ti} out of range ({total_vt} vt lines in the file, {seen_vt} so far)"
+                            ));
+                        }
+                        out.push('/');
+                        out.push_str(t);
+                    }
                     let idx: i64 = first.parse().map_err(|_| {
                         format!("line {ln}: cannot read the face vertex {w:?} (expected an integer index)")
                     })?;
@@ -144,7 +210,7 @@ fn prescan(text: &str) -> Result<String, String> {
             _ => {}
         }
     }
-    Ok(out)
+    Ok((out, every_face_textured))
 }
 
 #[cfg(test)]

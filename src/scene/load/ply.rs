@@ -146,9 +146,30 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, Strin
     };
     let mut positions: Vec<Vec3> = Vec::new();
     let mut indices: Vec<[u32; 3]> = Vec::new();
+    // Texture coordinates per vertex, under the names Mitsuba 3's PLY reader accepts.
+    let mut vertex_uvs: Vec<glam::Vec2> = Vec::new();
     let mut seen_vertex = false;
     for el in &elements {
         let xyz = ["x", "y", "z"].map(|c| el.props.iter().position(|p| p.name == c));
+        let uv_props = [
+            ("u", "v"),
+            ("texture_u", "texture_v"),
+            ("s", "t"),
+            ("texture_s", "texture_t"),
+        ]
+        .iter()
+        .find_map(|(a, b)| {
+            let i = el
+                .props
+                .iter()
+                .position(|p| p.name == *a && p.list.is_none())?;
+            let j = el
+                .props
+                .iter()
+                .position(|p| p.name == *b && p.list.is_none())?;
+            Some([i, j])
+        })
+        .filter(|_| el.name == "vertex");
         let list = el.props.iter().position(|p| {
             p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
         });
@@ -165,6 +186,7 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, Strin
         let mut face = Vec::new();
         for k in 0..el.count {
             let mut p = [0.0f64; 3];
+            let mut uv = [0.0f64; 2];
             for (j, prop) in el.props.iter().enumerate() {
                 let at = || format!("{} {k}, property {}", el.name, prop.name);
                 match prop.list {
@@ -175,6 +197,9 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, Strin
                         if el.name == "vertex" {
                             if let Some(c) = xyz.iter().position(|x| *x == Some(j)) {
                                 p[c] = v;
+                            }
+                            if let Some(c) = uv_props.and_then(|t| t.iter().position(|x| *x == j)) {
+                                uv[c] = v;
                             }
                         }
                     }
@@ -226,16 +251,34 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, Strin
                     ));
                 }
                 positions.push(v);
+                if uv_props.is_some() {
+                    let t = glam::Vec2::new(uv[0] as f32, uv[1] as f32);
+                    if !t.is_finite() {
+                        return Err(format!(
+                            "vertex {k}: expected finite texture coordinates in f32, got {uv:?}"
+                        ));
+                    }
+                    vertex_uvs.push(t);
+                }
             }
         }
         if el.name == "face" && !seen_vertex {
             return Err("the face element comes before the vertex element".into());
         }
     }
+    let uvs = if vertex_uvs.len() == positions.len() && !vertex_uvs.is_empty() {
+        indices
+            .iter()
+            .map(|t| t.map(|i| vertex_uvs[i as usize]))
+            .collect()
+    } else {
+        Vec::new()
+    };
     Ok(vec![ObjGroup {
         name: name.to_string(),
         positions,
         indices,
+        uvs,
     }])
 }
 

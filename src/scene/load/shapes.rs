@@ -551,7 +551,17 @@ pub(crate) fn shapes_of_groups(
         /// Vertex index by position: OBJ groups come with their own vertex arrays, so
         /// vertices are shared within a shape by their (exact) coordinates.
         remap: HashMap<[u32; 3], u32>,
+        /// Texture coordinates per kept triangle, while every group has them.
+        uvs: Vec<[Vec2; 3]>,
+        textured: bool,
     }
+    // Mitsuba 3's readers: an OBJ's v is flipped (its images start at the bottom row,
+    // heron's uv at the top), a PLY's is not (`flip_tex_coords`, src/shapes/obj.cpp and
+    // ply.cpp).
+    let is_ply = mesh_path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+    let flip = m.flip_tex_coords.unwrap_or(!is_ply);
     let mut parts: Vec<Part> = Vec::new();
     let mut any_triangle = false;
     for g in &groups {
@@ -578,11 +588,14 @@ pub(crate) fn shapes_of_groups(
                     positions: Vec::new(),
                     indices: Vec::new(),
                     remap: HashMap::new(),
+                    uvs: Vec::new(),
+                    textured: true,
                 });
                 parts.last_mut().expect("just pushed")
             }
         };
-        for tri in &g.indices {
+        part.textured &= !g.uvs.is_empty();
+        for (k, tri) in g.indices.iter().enumerate() {
             let mut p = tri.map(|i| g.positions[i as usize] * scale + translate);
             if let Some(t) = &transform {
                 p = p.map(|v| t.transform_point3(v.as_dvec3()).as_vec3());
@@ -620,6 +633,14 @@ pub(crate) fn shapes_of_groups(
                 });
             }
             part.indices.push(out);
+            if part.textured {
+                let t = g.uvs[k];
+                part.uvs.push(if flip {
+                    t.map(|c| Vec2::new(c.x, 1.0 - c.y))
+                } else {
+                    t
+                });
+            }
         }
     }
     if !any_triangle {
@@ -630,6 +651,16 @@ pub(crate) fn shapes_of_groups(
     Ok(parts
         .into_iter()
         .filter(|p| !p.indices.is_empty())
-        .map(|p| Shape::new(mesh(p.positions, p.indices), p.material))
+        .map(|p| {
+            let uvs = if p.textured { p.uvs } else { Vec::new() };
+            Shape::new(
+                ShapeKind::Mesh(Mesh {
+                    positions: p.positions,
+                    indices: p.indices,
+                    uvs,
+                }),
+                p.material,
+            )
+        })
         .collect())
 }
