@@ -339,20 +339,9 @@ pub fn mitsuba_xml(data: &[u8], fixtures: &Path) -> Outcome {
     }
     let path = fixtures.join("scene.xml");
     let options = crate::scene::import::ImportOptions::default();
-    let imported = match crate::scene::import::import_mitsuba_str(text, &path, &options) {
-        Ok(i) => i,
-        Err(e) => return rejected(&e.to_string()),
-    };
-    for w in &imported.warnings {
-        check_message(&w.to_string());
-    }
-    match load::load_imported(&imported) {
-        Ok(scene) => {
-            check_scene(&scene);
-            Outcome::Accepted
-        }
-        Err(e) => rejected(&e.to_string()),
-    }
+    imported_scene(crate::scene::import::import_mitsuba_str(
+        text, &path, &options,
+    ))
 }
 
 /// The pbrt-v4 importer on `data` as `fixtures/scene.pbrt`, then the scene it becomes.
@@ -367,7 +356,13 @@ pub fn pbrt(data: &[u8], fixtures: &Path) -> Outcome {
     }
     let path = fixtures.join("scene.pbrt");
     let options = crate::scene::import::ImportOptions::default();
-    let imported = match crate::scene::import::import_pbrt_str(text, &path, &options) {
+    imported_scene(crate::scene::import::import_pbrt_str(text, &path, &options))
+}
+
+/// What an importer made of its input: its warnings checked as messages, then the scene
+/// loaded and checked (both importers' harnesses).
+fn imported_scene(r: crate::Result<crate::scene::import::Imported>) -> Outcome {
+    let imported = match r {
         Ok(i) => i,
         Err(e) => return rejected(&e.to_string()),
     };

@@ -5,24 +5,13 @@
 //! tests/python/test_mitsuba_xml.py.)
 mod common;
 
+use common::images::write_exr;
+
 use common::render::{mean_se, run};
 use heron::scene::load_scene;
 use heron::settings::IntegratorKind;
 use heron::HeronError;
 use std::path::{Path, PathBuf};
-
-/// Writes a float32 RGB OpenEXR of `w × h` pixels from `f(i, j)` (column, row from the top).
-fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) {
-    use exr::prelude::*;
-    let img = Image::from_channels(
-        (w, h),
-        SpecificChannels::rgb(|p: Vec2<usize>| {
-            let c = f(p.x(), p.y());
-            (c[0], c[1], c[2])
-        }),
-    );
-    img.write().to_file(path).unwrap();
-}
 
 fn scene(dir: &Path, env: &str, shapes: &str, res: u32) -> PathBuf {
     let text = format!(

@@ -5,22 +5,12 @@
 //! the environment; the layout of uv on a quad and a sphere; the loader's errors.
 mod common;
 
+use common::images::write_exr;
+
 use common::render::run;
 use heron::scene::load_scene;
 use heron::settings::IntegratorKind;
 use std::path::Path;
-
-fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) {
-    use exr::prelude::*;
-    let img = Image::from_channels(
-        (w, h),
-        SpecificChannels::rgb(|p: Vec2<usize>| {
-            let c = f(p.x(), p.y());
-            (c[0], c[1], c[2])
-        }),
-    );
-    img.write().to_file(path).unwrap();
-}
 
 /// 4 × 2 texels of distinct, moderately saturated colours.
 const TEXELS: [[f32; 3]; 8] = [

@@ -3,5 +3,6 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod images;
 pub mod render;
 pub mod scenes;

@@ -151,36 +151,37 @@ def test_a_wrong_conversion_fails_the_comparison(tmp_path, mitsuba_image):
     assert not same(z, worst), (z, worst)
 
 
+def _changed_for_heron_fails(name: str, text: str, tmp_path: pathlib.Path, what: str):
+    """Heron renders `text` (scene `name` changed), Mitsuba the file as it is: the
+    measures must tell them apart."""
+    xml, params, spp = SCENES[name]
+    changed = tmp_path / f"{name}-changed.xml"
+    changed.write_text(text)
+    a = render_heron(changed, tmp_path, params, spp)
+    b = render_mitsuba(xml, params, spp)
+    z, worst = agreement(a, b)
+    print(f"{what}: whole-image z {z}, largest region difference {worst:.2%}")
+    assert not same(z, worst), (z, worst)
+
+
 def test_a_turned_envmap_fails_the_comparison(tmp_path):
     """The envmap scene with its map turned −30° instead of 30° about the vertical."""
-    xml, params, spp = SCENES["envmap"]
+    xml = SCENES["envmap"][0]
     sky = (xml.parent / ".." / "maps" / "studio-sky.exr").resolve()
     text = (xml.read_text().replace('angle="30"', 'angle="-30"')
             .replace('value="../maps/studio-sky.exr"', f'value="{sky}"'))
     assert text.count(str(sky)) == 1 and 'angle="-30"' in text
-    turned = tmp_path / "envmap-turned.xml"
-    turned.write_text(text)
-    a = render_heron(turned, tmp_path, params, spp)
-    b = render_mitsuba(xml, params, spp)
-    z, worst = agreement(a, b)
-    print(f"map turned the other way: whole-image z {z}, largest region difference {worst:.2%}")
-    assert not same(z, worst), (z, worst)
+    _changed_for_heron_fails("envmap", text, tmp_path, "map turned the other way")
 
 
 def test_a_flipped_texture_fails_the_comparison(tmp_path):
     """The textures scene with heron given the bitmap upside down."""
     from PIL import Image
 
-    xml, params, spp = SCENES["textures"]
+    xml = SCENES["textures"][0]
     png = (xml.parent / ".." / "textures" / "tiles.png").resolve()
     flipped = tmp_path / "tiles-flipped.png"
     Image.open(png).transpose(Image.Transpose.FLIP_TOP_BOTTOM).save(flipped)
     text = xml.read_text().replace('value="../textures/tiles.png"', f'value="{flipped}"')
     assert text.count(str(flipped)) == 2
-    changed = tmp_path / "textures-flipped.xml"
-    changed.write_text(text)
-    a = render_heron(changed, tmp_path, params, spp)
-    b = render_mitsuba(xml, params, spp)
-    z, worst = agreement(a, b)
-    print(f"texture upside down: whole-image z {z}, largest region difference {worst:.2%}")
-    assert not same(z, worst), (z, worst)
+    _changed_for_heron_fails("textures", text, tmp_path, "texture upside down")
