@@ -7,6 +7,13 @@
 //! (reflect) or `T` (transmit) for that event; total internal reflection forces `R`.
 //! Surfaces with only a reflecting delta lobe (mirrors, smooth metals) reflect; the
 //! others (Lambertian, glossy, rough) absorb; a miss escapes.
+//!
+//! Embree finds the shape a ray hits; the hit itself (distance, and a triangle's
+//! barycentrics and normal) is then recomputed in f64 from the shape's own description
+//! ([`refine`]). Embree's kernels differ between instruction sets (AVX2, AVX-512) in the
+//! last bits of t, which a minimum-deviation search over traced rays magnifies to the
+//! fifth decimal of a degree; refined, a trace is the same on every x86 CPU, so the
+//! figures of papers/ regenerate byte for byte wherever they are made.
 use crate::accel::embree::{self, RayQuery};
 use crate::bsdf::{BsdfContext, LobeFlags};
 use crate::geometry::Ray;
@@ -77,6 +84,61 @@ fn arr(v: Vec3) -> [f32; 3] {
 /// Traces from `origin` along `dir` (normalised here) at `lambda_nm`. `reflect_at[k]`
 /// says whether the k-th dielectric event reflects (true) or transmits; past its end,
 /// rays transmit.
+/// `hit` of `ray` recomputed in f64 from the shape hit (see the module documentation):
+/// a sphere's root of |o + t d − c|² = r² nearest Embree's t, a triangle's plane
+/// distance, barycentrics and normal (Möller & Trumbore 1997). A refinement that fails
+/// (a grazing ray with no real root) keeps Embree's hit.
+pub fn refine(scene: &Scene, ray: &Ray, hit: &embree::Hit) -> embree::Hit {
+    use crate::geometry::ShapeKind;
+    let o = ray.origin.as_dvec3();
+    let d = ray.dir.as_dvec3();
+    let mut out = *hit;
+    match &scene.shapes[hit.geom_id as usize].kind {
+        ShapeKind::Sphere { center, radius } => {
+            let oc = o - center.as_dvec3();
+            let a = d.dot(d);
+            let b = oc.dot(d);
+            let c = oc.dot(oc) - (*radius as f64) * (*radius as f64);
+            let disc = b * b - a * c;
+            if disc >= 0.0 && a > 0.0 {
+                let q = disc.sqrt();
+                let (t0, t1) = ((-b - q) / a, (-b + q) / a);
+                let te = hit.t as f64;
+                out.t = if (t0 - te).abs() <= (t1 - te).abs() {
+                    t0
+                } else {
+                    t1
+                } as f32;
+            }
+        }
+        ShapeKind::Mesh(m) => {
+            let [p0, p1, p2] = m.triangle(hit.prim_id).map(|p| p.as_dvec3());
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            let pv = d.cross(e2);
+            let det = e1.dot(pv);
+            if det != 0.0 {
+                let inv = 1.0 / det;
+                let tv = o - p0;
+                let u = tv.dot(pv) * inv;
+                let qv = tv.cross(e1);
+                let v = d.dot(qv) * inv;
+                out.t = (e2.dot(qv) * inv) as f32;
+                out.u = u as f32;
+                out.v = v as f32;
+                // Embree's orientation, its length recomputed.
+                let n = e1.cross(e2);
+                let n = if n.dot(hit.ng.as_dvec3()) < 0.0 {
+                    -n
+                } else {
+                    n
+                };
+                out.ng = n.as_vec3();
+            }
+        }
+    }
+    out
+}
+
 pub fn trace(
     scene: &Scene,
     accel: &embree::Scene,
@@ -126,6 +188,7 @@ pub fn trace(
                 truncated: false,
             });
         };
+        let hit = refine(scene, &ray, &hit);
         let (it, material) = scene.interaction(&ray, &hit, offset.is_robust());
         let wo = -ray.dir;
         let mut ev = TraceEvent {
