@@ -11,6 +11,11 @@
 //!   splits each partial wave into the waves leaving the sphere after p internal passes
 //!   (the `mie` sky's `debye` term).
 //!
+//! - [`mueller`]: Stokes vectors and Mueller matrices (Collett 2005's convention): the
+//!   Fresnel reflection and transmission of dielectrics and conductors with their
+//!   retardance, polarisers, retarders, rotations (the algebra the polarised transport
+//!   of issue 20 is to be built on).
+//!
 //! Layer 2 ("physics", `../shared/DESIGN.md`): this module imports nothing of heron's
 //! (only `num-complex`); `sky` and `medium` import it, never the reverse.
 //!
@@ -23,5 +28,6 @@
 //! (`crate::sky::mie::MAX_DEBYE_TERM`) are the sky's.
 pub mod debye;
 pub mod mie;
+pub mod mueller;
 
 pub use mie::{amplitudes, MieCoefficients, MieSphere, RelativeIndex};
