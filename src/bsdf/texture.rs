@@ -33,11 +33,7 @@ impl ImageTexture {
             .iter()
             .map(|c| {
                 let c = c.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) });
-                if c[0] == c[1] && c[1] == c[2] {
-                    SigmoidPolynomial::grey(c[0]).c
-                } else {
-                    srgb_table().lookup(c).c
-                }
+                srgb_table().texel(c).c
             })
             .collect();
         ImageTexture {

@@ -82,12 +82,10 @@ impl Texel {
             };
         }
         let norm = rgb.map(|v| v / m);
-        let c = if norm[0] == norm[1] && norm[1] == norm[2] {
-            SigmoidPolynomial::grey(norm[0]).c
-        } else {
-            srgb_table().lookup(norm).c
-        };
-        Texel { c, m: m * scale }
+        Texel {
+            c: srgb_table().texel(norm).c,
+            m: m * scale,
+        }
     }
 
     #[inline]

@@ -365,6 +365,18 @@ impl Rgb2SpecTable {
     /// Gauss–Newton steps (microseconds) cost nothing that matters, and the result is
     /// still one sigmoid polynomial of the paper's space. Greys (black and white
     /// included) are the exact constant spectrum and need no fit.
+    /// The coefficients of an image's texel (components in [0, 1]): greys exact, others
+    /// the table's trilinear [`Self::lookup`] without the polish, which an image's
+    /// millions of texels could not afford (within ~2e-3 of the colour for saturated
+    /// ones; environment maps and textures, as Mitsuba 3 and pbrt-v4 do).
+    pub fn texel(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
+        if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+            SigmoidPolynomial::grey(rgb[0])
+        } else {
+            self.lookup(rgb)
+        }
+    }
+
     pub fn coefficients(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
         self.coefficients_and_fit(rgb).0
     }

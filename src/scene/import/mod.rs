@@ -114,35 +114,30 @@ pub fn import_pbrt_str(text: &str, path: &Path, options: &ImportOptions) -> Resu
 }
 
 impl Imported {
-    /// The scene as heron's TOML, for a file in folder `out_dir` (mesh paths rewritten
-    /// relative to it), opened by a comment naming the source and listing the warnings.
+    /// The scene as heron's TOML, for a file in folder `out_dir` (the paths of meshes,
+    /// textures and the environment map rewritten relative to it), opened by a comment naming the source and listing the warnings.
     pub fn to_toml(&self, out_dir: &Path) -> String {
         let mut table = self.table.clone();
         let src_dir = self.source.parent().unwrap_or(Path::new(""));
+        // Every file the table names (meshes, textures, the environment map) is relative
+        // to the source file; rewritten relative to the output's folder.
+        let rebase = |v: Option<&mut toml::Value>| {
+            if let Some(toml::Value::String(f)) = v {
+                let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
+                *f = rel.to_string_lossy().replace('\\', "/");
+            }
+        };
         if let Some(toml::Value::Array(shapes)) = table.get_mut("shapes") {
             for s in shapes.iter_mut() {
-                if let Some(toml::Value::String(f)) = s.get_mut("file") {
-                    let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
-                    *f = rel.to_string_lossy().replace('\\', "/");
-                }
+                rebase(s.get_mut("file"));
             }
         }
         if let Some(toml::Value::Table(materials)) = table.get_mut("materials") {
             for (_, m) in materials.iter_mut() {
-                if let Some(toml::Value::String(f)) =
-                    m.as_table_mut().and_then(|t| t.get_mut("texture"))
-                {
-                    let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
-                    *f = rel.to_string_lossy().replace('\\', "/");
-                }
+                rebase(m.as_table_mut().and_then(|t| t.get_mut("texture")));
             }
         }
-        if let Some(toml::Value::String(f)) =
-            table.get_mut("environment").and_then(|e| e.get_mut("map"))
-        {
-            let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
-            *f = rel.to_string_lossy().replace('\\', "/");
-        }
+        rebase(table.get_mut("environment").and_then(|e| e.get_mut("map")));
         let mut out = format!(
             "# Converted by heron {} from {}.\n",
             env!("CARGO_PKG_VERSION"),
