@@ -118,6 +118,9 @@ pub struct Checkpoint {
     /// resumed `sppm` render continues from; None for the other integrators, and for
     /// a merged film (whose shards were independent chains: see `render.rs`).
     pub sppm: Option<SppmPixels>,
+    /// Polarised renders: per pixel, the sums of S1, S2, S3 as XYZ over the finite
+    /// samples (empty otherwise).
+    pub sum_stokes: Vec<[i128; 9]>,
 }
 
 fn err(path: &Path, message: impl Into<String>) -> HeronError {
@@ -145,6 +148,10 @@ impl Checkpoint {
         }
         if self.sppm.is_some() {
             header["sppm"] = true.into();
+        }
+        // Only when polarised, so that other films keep their bytes.
+        if !self.sum_stokes.is_empty() {
+            header["stokes"] = true.into();
         }
         b.extend_from_slice(header.to_string().as_bytes());
         b.push(b'\n');
@@ -184,6 +191,9 @@ impl Checkpoint {
             for v in s.n.iter().chain(&s.r2) {
                 b.extend_from_slice(&v.to_le_bytes());
             }
+        }
+        for v in self.sum_stokes.iter().flatten() {
+            b.extend_from_slice(&v.to_le_bytes());
         }
         b
     }
@@ -254,6 +264,7 @@ impl Checkpoint {
             Some(v) => v.as_bool().ok_or_else(|| bad(k)),
         };
         let (variance, has_sppm) = (flag("variance")?, flag("sppm")?);
+        let has_stokes = flag("stokes")?;
         let mut r = Reader { b: &rest[nl + 1..] };
         let passes_done = r.u32()?;
         let spp_done = r.u32()?;
@@ -312,6 +323,19 @@ impl Checkpoint {
         } else {
             None
         };
+        let sum_stokes = if has_stokes {
+            (0..n_xyz)
+                .map(|_| {
+                    let mut v = [0i128; 9];
+                    for x in v.iter_mut() {
+                        *x = r.i128()?;
+                    }
+                    Ok(v)
+                })
+                .collect::<std::result::Result<Vec<_>, String>>()?
+        } else {
+            Vec::new()
+        };
         if !r.b.is_empty() {
             return Err(format!("{} bytes after the data", r.b.len()));
         }
@@ -336,6 +360,7 @@ impl Checkpoint {
             sum_sq,
             splat_sq,
             sppm,
+            sum_stokes,
         })
     }
 
@@ -426,12 +451,24 @@ impl Checkpoint {
                 .collect();
             (SpectralBins { count: nb }, data)
         });
+        let stokes = (!self.sum_stokes.is_empty()).then(|| {
+            (0..npix)
+                .map(|i| {
+                    std::array::from_fn(|k| {
+                        std::array::from_fn(|j| {
+                            mean(self.sum_stokes[i][3 * k + j], self.good[i], None)
+                        })
+                    })
+                })
+                .collect()
+        });
         Film {
             width: self.width,
             height: self.height,
             xyz,
             spectral,
             variance: self.variance.then(|| self.variance_image()),
+            stokes,
         }
     }
 
@@ -487,6 +524,11 @@ impl Checkpoint {
         }
         for (a, b) in self.good.iter_mut().zip(&o.good) {
             *a += b;
+        }
+        for (a, b) in self.sum_stokes.iter_mut().zip(&o.sum_stokes) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.wrapping_add(*y);
+            }
         }
         for (a, b) in self
             .sum_sq
@@ -563,6 +605,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
             )
             || (c.sum_sq.len(), c.splat_sq.len()) != (first.sum_sq.len(), first.splat_sq.len())
             || c.xyz_channels != first.xyz_channels
+            || c.sum_stokes.len() != first.sum_stokes.len()
         {
             return Err(err(
                 p,
@@ -617,6 +660,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
         sum_sq: vec![Default::default(); first.sum_sq.len()],
         splat_sq: vec![Default::default(); first.splat_sq.len()],
         sppm: None,
+        sum_stokes: vec![[0; 9]; first.sum_stokes.len()],
         ..first.clone()
     };
     for (_, c) in parts {
@@ -693,6 +737,7 @@ mod tests {
             sum_sq: vec![],
             splat_sq: vec![],
             sppm: None,
+            sum_stokes: vec![],
         };
         let b = c.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&b).unwrap(), c);
@@ -707,6 +752,14 @@ mod tests {
         let sb = s.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&sb).unwrap(), s);
         assert!(Checkpoint::from_bytes(&sb[..sb.len() - 1]).is_err());
+        // With a polarised render's Stokes sums.
+        let p = Checkpoint {
+            sum_stokes: vec![[-1, 2, -3, 4, -5, 6, -7, 8, i128::MIN], [9; 9]],
+            ..c.clone()
+        };
+        let pb = p.to_bytes();
+        assert_eq!(Checkpoint::from_bytes(&pb).unwrap(), p);
+        assert!(Checkpoint::from_bytes(&pb[..pb.len() - 16]).is_err());
         for cut in [0, 5, MAGIC.len() + 3, b.len() - 1] {
             assert!(Checkpoint::from_bytes(&b[..cut]).is_err(), "{cut}");
         }

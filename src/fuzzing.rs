@@ -159,6 +159,13 @@ fn check_material(m: &Material) {
             metal(&c.ior);
             assert!(c.distribution.alpha.is_finite());
         }
+        Material::Polarizer(p) => {
+            assert!(p.axis.is_finite() && p.angle.is_finite());
+            assert!(p.t_x > 0.0 && p.t_x <= 1.0 && (0.0..=p.t_x).contains(&p.t_y));
+        }
+        Material::Retarder(r) => {
+            assert!(r.axis.is_finite() && r.angle.is_finite() && r.retardance.is_finite());
+        }
     }
 }
 

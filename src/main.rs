@@ -799,6 +799,11 @@ struct RenderArgs {
     /// Add the CIE XYZ channels X, Y, Z to the EXR.
     #[arg(long)]
     xyz: bool,
+    /// Polarised transport: Stokes vectors along every path, Mueller matrices at every
+    /// event; the EXR gains S1.R … S3.B (R, G, B are S0) and the previews OUT.dolp.png
+    /// and OUT.aolp.png (default: the scene's [render] polarization).
+    #[arg(long)]
+    polarization: bool,
     /// Add N spectral channels (equal bins over 360–830 nm, the layout of Fichet et al.
     /// 2021, readable by colour.read_spectral_image_Fichet2021).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=470))]
@@ -1135,6 +1140,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         sppm_photons: args.sppm_photons,
         sppm_alpha: args.sppm_alpha,
         sppm_radius: args.sppm_radius,
+        polarization: args.polarization.then_some(true),
     };
     // Before the scene loads, which may take seconds (sky and medium tables).
     settings_args.check().map_err(anyhow::Error::msg)?;

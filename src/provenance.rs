@@ -93,6 +93,10 @@ pub const MEDIA_KEYS: [&str; 2] = ["mediumNee", "sunGuide"];
 /// iteration (as resolved for the image), α and initial radius (0: automatic).
 pub const SPPM_KEYS: [&str; 3] = ["sppmPhotons", "sppmAlpha", "sppmRadius"];
 
+/// Keys written last only for a polarised render (`[render] polarization`), so that
+/// unpolarised EXRs keep their bytes.
+pub const POLARIZATION_KEYS: [&str; 1] = ["polarization"];
+
 impl Provenance {
     /// The provenance a film's settings key holds (the key of `render.rs` contains every
     /// provenance entry), with `spp` samples per pixel: what `heron merge` writes, the
@@ -104,6 +108,7 @@ impl Provenance {
         KEYS.iter()
             .chain(MEDIA_KEYS.iter().filter(|k| key.contains_key(**k)))
             .chain(SPPM_KEYS.iter().filter(|k| key.contains_key(**k)))
+            .chain(POLARIZATION_KEYS.iter().filter(|k| key.contains_key(**k)))
             .map(|&k| {
                 let v = key.get(k)?.as_str()?;
                 Some((
@@ -166,6 +171,9 @@ impl Provenance {
             p.0.push(("sppmPhotons", sppm.photons_for(pixels).to_string()));
             p.0.push(("sppmAlpha", sppm.alpha.to_string()));
             p.0.push(("sppmRadius", sppm.radius.to_string()));
+        }
+        if settings.polarization {
+            p.0.push(("polarization", "stokes".to_string()));
         }
         p
     }

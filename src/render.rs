@@ -20,6 +20,7 @@ use crate::integrator::{self, Context, Deferred, PathState, TraceCounters, WALKS
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene};
 use crate::settings::{IntegratorKind, KernelFlags, Packets, RenderSettings};
+use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
@@ -237,6 +238,24 @@ fn render_with(
             kind.name()
         )));
     }
+    if scene.camera.polarizer.is_some() && !opts.settings.polarization {
+        return Err(HeronError::Invalid(
+            "camera.polarizer: an analyser needs polarised transport; set [render] polarization = true or pass --polarization".into(),
+        ));
+    }
+    if opts.settings.polarization {
+        integrator::stokes_kernel::<1>(kind).map_err(HeronError::Invalid)?;
+        if !scene.media.is_empty() {
+            return Err(HeronError::Invalid(
+                "polarization: participating media are not polarised yet (their phase matrices are not in the transport); render this scene without polarization".into(),
+            ));
+        }
+        if opts.settings.spectral_bins > 0 {
+            return Err(HeronError::Invalid(
+                "polarization: spectral bins of S1-S3 are not written yet; render with spectral_bins = 0 (the EXR has S0-S3 in linear sRGB)".into(),
+            ));
+        }
+    }
     let ctx = Context {
         scene,
         accel,
@@ -275,9 +294,27 @@ fn render_with(
     };
     // Light tracing and BDPT have no steps: with `paths`, each pixel sample sends its
     // connections' shadow rays 8 at a time (toolkit `Connections`).
+    if opts.settings.polarization && opts.settings.packets == Packets::Paths {
+        // The packet engine's steps carry scalar throughputs: camera packets only.
+        opts.settings.packets = Packets::Camera;
+    }
     let paths =
         opts.settings.packets == Packets::Paths && integrator::path_fns::<1>(kind, 0).is_some();
+    let polarized = opts.settings.polarization;
     let integrate = move |n: Lanes| -> SampleFn {
+        if polarized {
+            // Checked above: the integrator has a polarised kernel.
+            const WHY: &str = "a polarised kernel";
+            return match n {
+                Lanes::One => SampleFn::StokesOne(integrator::stokes_kernel::<1>(kind).expect(WHY)),
+                Lanes::Four => {
+                    SampleFn::StokesFour(integrator::stokes_kernel::<4>(kind).expect(WHY))
+                }
+                Lanes::Eight => {
+                    SampleFn::StokesEight(integrator::stokes_kernel::<8>(kind).expect(WHY))
+                }
+            };
+        }
         let p = |f1, f4, f8| match n {
             Lanes::One => f1,
             Lanes::Four => f4,
@@ -363,6 +400,64 @@ pub(crate) enum SampleFn {
     PathsOne(integrator::PathFns<1>),
     PathsFour(integrator::PathFns<4>),
     PathsEight(integrator::PathFns<8>),
+    /// Polarised transport's (`integrator::polarized`).
+    StokesOne(integrator::StokesFn<1>),
+    StokesFour(integrator::StokesFn<4>),
+    StokesEight(integrator::StokesFn<8>),
+}
+
+/// What one pixel sample gives the film: radiance, or Stokes radiance in a polarised
+/// render (whose S0 is the radiance and whose S1–S3 go to sums of their own). The tile
+/// loop is one generic function, so an unpolarised render runs the loop it ran before
+/// polarisation existed (`STOKES` false: no Stokes code is compiled into it).
+pub(crate) trait SampleValue<const N: usize>: Copy {
+    const STOKES: bool;
+    fn zero() -> Self;
+    /// The radiance (S0).
+    fn s0(&self) -> SampledSpectrum<N>;
+    /// S1, S2, S3 as XYZ, in fixed point; None when any is out of the film's range.
+    fn stokes_fixed(&self, wl: &SampledWavelengths<N>) -> Option<[i128; 9]>;
+}
+
+impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
+    const STOKES: bool = false;
+    #[inline(always)]
+    fn zero() -> Self {
+        SampledSpectrum::zero()
+    }
+    #[inline(always)]
+    fn s0(&self) -> SampledSpectrum<N> {
+        *self
+    }
+    #[inline(always)]
+    fn stokes_fixed(&self, _: &SampledWavelengths<N>) -> Option<[i128; 9]> {
+        Some([0; 9])
+    }
+}
+
+impl<const N: usize> SampleValue<N> for StokesSpectrum<N> {
+    const STOKES: bool = true;
+    #[inline]
+    fn zero() -> Self {
+        StokesSpectrum::zero()
+    }
+    #[inline]
+    fn s0(&self) -> SampledSpectrum<N> {
+        self.component(0)
+    }
+    #[inline]
+    fn stokes_fixed(&self, wl: &SampledWavelengths<N>) -> Option<[i128; 9]> {
+        let mut out = [0i128; 9];
+        for k in 1..4 {
+            let c = self.component(k);
+            if !c.is_finite() {
+                return None;
+            }
+            let f = to_fixed3(xyz_of_sample(&c, wl))?;
+            out[3 * (k - 1)..3 * k].copy_from_slice(&f);
+        }
+        Some(out)
+    }
 }
 
 /// Renders `spp` samples per pixel (or the shard's share of them) in passes of
@@ -433,22 +528,22 @@ pub(crate) fn render_passes(
                     // variance runs the loop it ran before the variance existed.
                     let r = match (&sample, opts.variance) {
                         (SampleFn::One(f), false) => {
-                            render_tile::<1, false>(ctx, opts, x0, y0, s0..s1, f)
+                            render_tile::<1, false, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                         (SampleFn::Four(f), false) => {
-                            render_tile::<4, false>(ctx, opts, x0, y0, s0..s1, f)
+                            render_tile::<4, false, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                         (SampleFn::Eight(f), false) => {
-                            render_tile::<8, false>(ctx, opts, x0, y0, s0..s1, f)
+                            render_tile::<8, false, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                         (SampleFn::One(f), true) => {
-                            render_tile::<1, true>(ctx, opts, x0, y0, s0..s1, f)
+                            render_tile::<1, true, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                         (SampleFn::Four(f), true) => {
-                            render_tile::<4, true>(ctx, opts, x0, y0, s0..s1, f)
+                            render_tile::<4, true, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                         (SampleFn::Eight(f), true) => {
-                            render_tile::<8, true>(ctx, opts, x0, y0, s0..s1, f)
+                            render_tile::<8, true, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                         (SampleFn::PathsOne(f), false) => {
                             render_tile_paths::<1, false>(ctx, opts, x0, y0, s0..s1, f)
@@ -467,6 +562,24 @@ pub(crate) fn render_passes(
                         }
                         (SampleFn::PathsEight(f), true) => {
                             render_tile_paths::<8, true>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::StokesOne(f), false) => {
+                            render_tile::<1, false, _>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::StokesFour(f), false) => {
+                            render_tile::<4, false, _>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::StokesEight(f), false) => {
+                            render_tile::<8, false, _>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::StokesOne(f), true) => {
+                            render_tile::<1, true, _>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::StokesFour(f), true) => {
+                            render_tile::<4, true, _>(ctx, opts, x0, y0, s0..s1, f)
+                        }
+                        (SampleFn::StokesEight(f), true) => {
+                            render_tile::<8, true, _>(ctx, opts, x0, y0, s0..s1, f)
                         }
                     };
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
@@ -562,11 +675,11 @@ fn render_sppm<const N: usize>(
         }
         state.sppm = Some(pixels);
         // The camera paths' light, as one tile of the whole image.
-        let mut sums = TileSums::new(cam.width, cam.height, nb, false);
+        let mut sums = TileSums::new(cam.width, cam.height, nb, false, false);
         for y in 0..cam.height {
             for x in 0..cam.width {
                 let l = &it.l[(y * cam.width + x) as usize];
-                sums.add::<N, false>((0, 0), (x, y, k), l, &it.wl);
+                sums.add::<N, false, SampledSpectrum<N>>((0, 0), (x, y, k), l, &it.wl);
             }
         }
         let tile = sums.result(
@@ -662,6 +775,11 @@ fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, widt
                 state.sum_xyz[dst][j] = state.sum_xyz[dst][j].wrapping_add(t.xyz[src][j]);
             }
             state.good[dst] += t.good[src];
+            if let Some(st) = t.stokes.get(src) {
+                for (a, b) in state.sum_stokes[dst].iter_mut().zip(st) {
+                    *a = a.wrapping_add(*b);
+                }
+            }
             if let Some(sq) = t.sq.get(src) {
                 for (a, b) in state.sum_sq[dst].iter_mut().zip(sq) {
                     a.add(*b);
@@ -752,6 +870,7 @@ fn initial_state(
                 || c.sum_sq.len() != sq_len
                 || c.splat_sq.len() != splat_sq_len
                 || c.passes_done as usize > passes
+                || c.sum_stokes.len() != if opts.settings.polarization { npix } else { 0 }
                 || c.sppm.as_ref().map(|s| s.n.len()) != sppm.then_some(npix)
             {
                 return Err(HeronError::Invalid(
@@ -777,6 +896,7 @@ fn initial_state(
             sum_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).0],
             splat_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).1],
             sppm: sppm.then(|| integrator::sppm::SppmPixels::new(npix)),
+            sum_stokes: vec![[0; 9]; if opts.settings.polarization { npix } else { 0 }],
             ..Default::default()
         },
     })
@@ -802,6 +922,8 @@ struct TileResult {
     xyz: Vec<[i128; 3]>,
     spectral: Vec<i128>,
     good: Vec<u32>,
+    /// Polarised renders: per pixel, the sums of S1, S2, S3 as XYZ (empty otherwise).
+    stokes: Vec<[i128; 9]>,
     /// With `--variance`: per pixel, the sums of the squares of the samples' linear sRGB
     /// (empty otherwise); and per sample that splatted, the squares of its splats summed
     /// per pixel.
@@ -821,6 +943,7 @@ struct TileSums {
     xyz: Vec<[i128; 3]>,
     spectral: Vec<i128>,
     good: Vec<u32>,
+    stokes: Vec<[i128; 9]>,
     sq: Vec<[SquareSum; 3]>,
     nonfinite: u64,
     /// The first sample left out, in the one-path-at-a-time engine's order (its key:
@@ -829,7 +952,7 @@ struct TileSums {
 }
 
 impl TileSums {
-    fn new(w: u32, h: u32, nb: usize, variance: bool) -> Self {
+    fn new(w: u32, h: u32, nb: usize, variance: bool, stokes: bool) -> Self {
         let n = (w * h) as usize;
         TileSums {
             w,
@@ -838,6 +961,7 @@ impl TileSums {
             xyz: vec![[0i128; 3]; n],
             spectral: vec![0i128; n * nb],
             good: vec![0u32; n],
+            stokes: if stokes { vec![[0; 9]; n] } else { Vec::new() },
             sq: if variance {
                 vec![[SquareSum::default(); 3]; n]
             } else {
@@ -852,13 +976,14 @@ impl TileSums {
     /// (`x`, `y`) (tile coordinates; the tile starts at `origin`). The sums are exact
     /// integers, so the order in which samples arrive does not change them.
     #[inline]
-    fn add<const N: usize, const VARIANCE: bool>(
+    fn add<const N: usize, const VARIANCE: bool, O: SampleValue<N>>(
         &mut self,
         origin: (u32, u32),
         (x, y, s): (u32, u32, u32),
-        l: &SampledSpectrum<N>,
+        value: &O,
         wl: &SampledWavelengths<N>,
     ) {
+        let l = &value.s0();
         let (nb, i) = (self.nb, (y * self.w + x) as usize);
         // A sample whose radiance is not finite, or too large for the film's fixed-point
         // sums (film/fixed.rs), is left out and counted.
@@ -868,9 +993,16 @@ impl TileSums {
             None
         };
         let c = v.and_then(to_fixed3);
+        // S1–S3 (polarised renders) count only with S0, and S0 only with them.
+        let st = if O::STOKES {
+            value.stokes_fixed(wl)
+        } else {
+            Some([0; 9])
+        };
         // The bins are added only when the XYZ is in range, and the XYZ only when the
         // bins were.
         let ok = c.is_some()
+            && st.is_some()
             && (nb == 0
                 || add_to_bins(&self.bins, &mut self.spectral[i * nb..(i + 1) * nb], l, wl));
         let (Some(c), true) = (c, ok) else {
@@ -883,6 +1015,13 @@ impl TileSums {
         };
         for (a, b) in self.xyz[i].iter_mut().zip(c) {
             *a = a.wrapping_add(b);
+        }
+        if O::STOKES {
+            if let Some(st) = st {
+                for (a, b) in self.stokes[i].iter_mut().zip(st) {
+                    *a = a.wrapping_add(b);
+                }
+            }
         }
         self.good[i] += 1;
         if VARIANCE {
@@ -910,6 +1049,7 @@ impl TileSums {
             xyz: self.xyz,
             spectral: self.spectral,
             good: self.good,
+            stokes: self.stokes,
             sq: self.sq,
             splat_sq,
             splats,
@@ -930,18 +1070,18 @@ fn cancelled(opts: &RenderOptions) -> bool {
 
 /// One tile's samples of one pass, one path at a time (camera rays in packets with
 /// `Packets::Camera`); `VARIANCE` also sums the squares (`--variance`).
-fn render_tile<const N: usize, const VARIANCE: bool>(
+fn render_tile<const N: usize, const VARIANCE: bool, O: SampleValue<N>>(
     ctx: &Context,
     opts: &RenderOptions,
     x0: u32,
     y0: u32,
     samples: std::ops::Range<u32>,
-    sample_fn: &SampleFnN<N>,
+    sample_fn: &integrator::KernelFn<N, O>,
 ) -> TileResult {
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
-    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE);
+    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE, O::STOKES);
     let mut splat_sq = Vec::new();
     let mut scratch = Vec::new();
     let mut counters = TraceCounters::default();
@@ -1030,7 +1170,7 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
                             &mut splats,
                         ),
                         // Stopped by the lens: the sample adds 0.
-                        None => SampledSpectrum::zero(),
+                        None => O::zero(),
                     };
                     if VARIANCE && splats.list.len() > splats_before {
                         add_splat_squares(
@@ -1039,7 +1179,7 @@ fn render_tile<const N: usize, const VARIANCE: bool>(
                             &mut splat_sq,
                         );
                     }
-                    sums.add::<N, VARIANCE>((x0, y0), (xs + k as u32, y, s), &l, &wls[k]);
+                    sums.add::<N, VARIANCE, O>((x0, y0), (xs + k as u32, y, s), &l, &wls[k]);
                 }
             }
         }
@@ -1078,7 +1218,7 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
-    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE);
+    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE, false);
     let mut counters = TraceCounters::default();
     let base = Sampler::new(
         opts.settings.sampler,
@@ -1143,9 +1283,12 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
                     }
                     // Stopped by the lens: the sample adds 0, and the lane takes the
                     // next one.
-                    None => {
-                        sums.add::<N, VARIANCE>((x0, y0), (x, y, s), &SampledSpectrum::zero(), &wl)
-                    }
+                    None => sums.add::<N, VARIANCE, SampledSpectrum<N>>(
+                        (x0, y0),
+                        (x, y, s),
+                        &SampledSpectrum::zero(),
+                        &wl,
+                    ),
                 }
             }
             if let Some(lane) = &lanes[k] {
@@ -1257,7 +1400,7 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
             shadows[k].resolve(&mut lane.state.l);
             if going & (1 << k) == 0 {
                 let l = lane.state.radiance();
-                sums.add::<N, VARIANCE>((x0, y0), lane.pixel, &l, &lane.wl);
+                sums.add::<N, VARIANCE, SampledSpectrum<N>>((x0, y0), lane.pixel, &l, &lane.wl);
                 lanes[k] = None;
                 shadows[k].clear();
             }

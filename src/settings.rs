@@ -475,6 +475,10 @@ pub struct RenderSettings {
     pub sun_guide: f32,
     /// Stochastic progressive photon mapping's options.
     pub sppm: SppmSettings,
+    /// Polarised transport (`[render] polarization`, `--polarization`): every lane
+    /// carries a Stokes vector and every event applies a Mueller matrix
+    /// (`integrator::polarized`); the film gains S1–S3.
+    pub polarization: bool,
 }
 
 impl Default for RenderSettings {
@@ -499,6 +503,7 @@ impl Default for RenderSettings {
             medium_nee: MediumNee::Forced,
             sun_guide: DEFAULT_SUN_GUIDE,
             sppm: SppmSettings::default(),
+            polarization: false,
         }
     }
 }
@@ -528,6 +533,8 @@ pub struct SettingsArgs<'a> {
     pub sppm_photons: Option<i64>,
     pub sppm_alpha: Option<f64>,
     pub sppm_radius: Option<f64>,
+    /// `--polarization` (true turns it on; a scene's `true` stays on without it).
+    pub polarization: Option<bool>,
 }
 
 impl SettingsArgs<'_> {
@@ -615,6 +622,9 @@ impl RenderSettings {
         }
         if let Some(v) = a.sppm_radius {
             s.sppm.radius = parse_sppm_radius(v).map_err(|e| format!("--sppm-radius: {e}"))?;
+        }
+        if let Some(p) = a.polarization {
+            s.polarization = p;
         }
         *self = s;
         Ok(())

@@ -7,10 +7,14 @@
 //! user's table. A metal's reflectance depends on wavelength but its direction does
 //! not, so every lane is kept.
 use super::fresnel::fresnel_conductor;
+use super::polarization::{normalized, s_of_plane, Polarizing};
 use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags};
+use crate::math::Frame;
+use crate::optics::mueller;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
+use num_complex::Complex64;
 
 impl ComplexIor {
     /// R(cos θ) per lane.
@@ -26,6 +30,13 @@ impl ComplexIor {
             r.0[i] = fresnel_conductor(cos, self.n.eval(l), self.k.eval(l));
         }
         r
+    }
+
+    /// The normalised Mueller matrix of reflection at `cos` and `lambda` nm.
+    #[inline]
+    pub fn mueller(&self, cos: f32, lambda: f32) -> glam::Mat4 {
+        let eta = Complex64::new(self.n.eval(lambda) as f64, self.k.eval(lambda) as f64);
+        normalized(&mueller::reflection(cos as f64, eta))
     }
 }
 
@@ -64,5 +75,25 @@ impl BsdfModel for Conductor {
             eta: 1.0,
             ended_companions: false,
         })
+    }
+
+    /// Fresnel reflection of the complex index n(λ) + i k(λ), with its retardance
+    /// (`optics::mueller::reflection`), in the s/p frame.
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        _: Vec3,
+        wi: Vec3,
+        _: LobeFlags,
+        wl: &SampledWavelengths<N>,
+        _: &Frame,
+    ) -> Polarizing<N> {
+        let x = s_of_plane(wi);
+        let m = std::array::from_fn(|i| self.ior.mueller(wi.z.abs(), wl.lambda[i]));
+        Polarizing::Mueller {
+            m,
+            x_in: x,
+            x_out: x,
+        }
     }
 }

@@ -20,10 +20,15 @@
 //! both branches then end the companions. This is the one place in heron where that
 //! decision is written.
 use super::fresnel::fresnel_dielectric;
+use super::polarization::{normalized, s_of_plane, Polarizing};
 use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags, TransportMode};
+use crate::math::Frame;
+use crate::optics::mueller;
 use crate::spectrum::ior::Ior;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use glam::Mat4;
 use glam::{Vec2, Vec3};
+use num_complex::Complex64;
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
@@ -86,6 +91,24 @@ impl Dielectric {
             1.0 / eta
         } else {
             eta
+        }
+    }
+
+    /// The normalised Mueller matrix of light arriving along `wi` and leaving along `wo`
+    /// at `lambda` nm, where `cos_i` is the cosine of the light's incidence on the
+    /// (macro- or micro-) surface, signed: positive when it arrives from outside.
+    #[inline]
+    pub(crate) fn interface_mueller(&self, wo: Vec3, wi: Vec3, cos_i: f32, lambda: f32) -> Mat4 {
+        let eta = self.eta(lambda) as f64;
+        // The light goes from ωi's side into the other: n_t/n_i.
+        let eta = if cos_i > 0.0 { eta } else { 1.0 / eta };
+        let cos = cos_i.abs() as f64;
+        if wi.z * wo.z > 0.0 {
+            normalized(&mueller::reflection(cos, Complex64::new(eta, 0.0)))
+        } else if self.fresnel {
+            normalized(&mueller::transmission(cos, eta))
+        } else {
+            Mat4::IDENTITY
         }
     }
 
@@ -180,6 +203,28 @@ impl BsdfModel for Dielectric {
             eta: etap,
             ended_companions: split,
         })
+    }
+
+    /// Fresnel reflection (with total internal reflection's retardance) or
+    /// transmission in the s/p frame of the plane of incidence, per lane's n(λ)
+    /// (`optics::mueller::reflection`, `transmission`); the lecture's pure refraction
+    /// (`fresnel = false`) transmits unchanged.
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        _: LobeFlags,
+        wl: &SampledWavelengths<N>,
+        _: &Frame,
+    ) -> Polarizing<N> {
+        let x = s_of_plane(wi);
+        let m = std::array::from_fn(|i| self.interface_mueller(wo, wi, wi.z, wl.lambda[i]));
+        Polarizing::Mueller {
+            m,
+            x_in: x,
+            x_out: x,
+        }
     }
 }
 

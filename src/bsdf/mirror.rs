@@ -1,8 +1,11 @@
 //! Perfect specular reflector (seed, "Reflected rays"): the law of reflection,
 //! ωr = 2(ωi·n)n − ωi, with ωi pointing away from the surface. As a BSDF it is the
 //! delta ρs δ(ωi − ωr)/|cos θi|, so the throughput changes by ρs.
+use super::polarization::{s_of_plane, Polarizing};
 use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags};
+use crate::math::Frame;
 use crate::spectrum::{DenseSpectrum, SampledWavelengths};
+use glam::Mat4;
 use glam::{Vec2, Vec3};
 
 pub use super::reflect;
@@ -42,5 +45,25 @@ impl BsdfModel for Mirror {
             eta: 1.0,
             ended_companions: false,
         })
+    }
+
+    /// The ideal mirror (r_s = −r_p = −1): diag(1, 1, −1, −1), a half-wave retarder in
+    /// Collett's frames, which turns the handedness of circular light.
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        _: Vec3,
+        wi: Vec3,
+        _: LobeFlags,
+        _: &SampledWavelengths<N>,
+        _: &Frame,
+    ) -> Polarizing<N> {
+        let x = s_of_plane(wi);
+        let m = Mat4::from_diagonal(glam::Vec4::new(1.0, 1.0, -1.0, -1.0));
+        Polarizing::Mueller {
+            m: [m; N],
+            x_in: x,
+            x_out: x,
+        }
     }
 }

@@ -33,6 +33,9 @@ pub mod lambertian;
 pub mod microfacet;
 pub mod mirror;
 pub mod phong;
+pub mod polarization;
+pub mod polarizer;
+pub mod retarder;
 pub mod rough_conductor;
 pub mod rough_dielectric;
 pub mod texture;
@@ -43,11 +46,15 @@ pub use dielectric::Dielectric;
 pub use lambertian::Lambertian;
 pub use mirror::Mirror;
 pub use phong::Glossy;
+pub use polarization::Polarizing;
+pub use polarizer::Polarizer;
+pub use retarder::Retarder;
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
 pub use texture::ImageTexture;
 pub use textured_diffuse::TexturedDiffuse;
 
+use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -257,6 +264,23 @@ pub trait BsdfModel {
     ) -> f32 {
         0.0
     }
+
+    /// The Mueller matrix of scattering light arriving along ωi into ωo by the lobe
+    /// `lobe` (a sample's flags; for an evaluation, the model's non-delta lobes), per
+    /// lane, divided by its [0][0], with its frames ([`polarization`]). `frame` is the
+    /// local frame in world space, for a model whose axes the scene gives in world
+    /// space (a polariser sheet). The default depolarises (diffuse and Phong lobes).
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        _wo: Vec3,
+        _wi: Vec3,
+        _lobe: LobeFlags,
+        _wl: &SampledWavelengths<N>,
+        _frame: &Frame,
+    ) -> Polarizing<N> {
+        Polarizing::Depolarizing
+    }
 }
 
 /// A sampled direction (pbrt-v4 `BSDFSample`).
@@ -352,6 +376,10 @@ pub enum Material {
     RoughDielectric(RoughDielectric),
     /// A diffuse reflector whose ρd is an image over the surface's uv.
     TexturedDiffuse(TexturedDiffuse),
+    /// A linear polariser sheet (light passes straight through).
+    Polarizer(Polarizer),
+    /// A linear retarder, a wave plate (light passes straight through).
+    Retarder(Retarder),
 }
 
 /// `match` over the models, the same call in every arm.
@@ -366,6 +394,8 @@ macro_rules! dispatch {
             Material::Conductor($m) => $call,
             Material::RoughConductor($m) => $call,
             Material::RoughDielectric($m) => $call,
+            Material::Polarizer($m) => $call,
+            Material::Retarder($m) => $call,
         }
     };
 }
@@ -412,6 +442,19 @@ impl Material {
             return None;
         }
         dispatch!(self, m => m.sample(wo, uc, u, wl, ctx))
+    }
+
+    /// The event's normalised Mueller matrix and frames ([`BsdfModel::mueller`]).
+    #[inline]
+    pub fn mueller<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: LobeFlags,
+        wl: &SampledWavelengths<N>,
+        frame: &Frame,
+    ) -> Polarizing<N> {
+        dispatch!(self, m => m.mueller(wo, wi, lobe, wl, frame))
     }
 
     /// Density (hero wavelength, solid angle) with which `sample` under `ctx.lobes`

@@ -16,6 +16,7 @@
 //! the Phong part from the lights and continues through the base, as the course does;
 //! with ρd > 0 that combination can reflect more than it receives (the course's scenes
 //! use ρd = 0). The path tracer samples the same sum, base weight 1.
+use super::polarization::Polarizing;
 use super::{
     reflect_local, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, Dielectric,
     LobeFlags,
@@ -211,6 +212,23 @@ impl BsdfModel for Glossy {
             eta: 1.0,
             ended_companions: false,
         })
+    }
+
+    /// The refractive base's Fresnel matrices for its specular events; the diffuse and
+    /// Phong lobes depolarise.
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: LobeFlags,
+        wl: &SampledWavelengths<N>,
+        frame: &Frame,
+    ) -> Polarizing<N> {
+        match &self.base {
+            Some(b) if lobe.is_specular() => b.mueller(wo, wi, lobe, wl, frame),
+            _ => Polarizing::Depolarizing,
+        }
     }
 }
 

@@ -7,7 +7,9 @@
 //! normals (Heitz 2018): pdf = D_ωo(ωm)/(4 |ωo·ωm|). Single scattering only, so energy
 //! is lost at high roughness (tests/bsdf.rs states how much).
 use super::microfacet::TrowbridgeReitz;
+use super::polarization::{s_of_pair, Polarizing};
 use super::{reflect, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
+use crate::math::Frame;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::SampledWavelengths;
 use glam::{Vec2, Vec3};
@@ -106,5 +108,29 @@ impl BsdfModel for RoughConductor {
             eta: 1.0,
             ended_companions: false,
         })
+    }
+
+    /// The microfacet's Fresnel reflection, in the frame of the plane that holds ωi, ωo
+    /// and the microfacet normal ωm (the s direction ωi × ωo), at ωi·ωm.
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        _: LobeFlags,
+        wl: &SampledWavelengths<N>,
+        _: &Frame,
+    ) -> Polarizing<N> {
+        let Some(wm) = Self::half(wo, wi) else {
+            return Polarizing::Depolarizing;
+        };
+        let x = s_of_pair(wi, wo);
+        let cos = wi.dot(wm).abs();
+        let m = std::array::from_fn(|i| self.ior.mueller(cos, wl.lambda[i]));
+        Polarizing::Mueller {
+            m,
+            x_in: x,
+            x_out: x,
+        }
     }
 }

@@ -20,10 +20,12 @@
 //! Single scattering only, so energy is lost at high roughness.
 use super::fresnel::fresnel_dielectric_signed;
 use super::microfacet::TrowbridgeReitz;
+use super::polarization::{s_of_pair, Polarizing};
 use super::{
     reflect, refract_eta, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample,
     Dielectric, LobeFlags, TransportMode,
 };
+use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -259,6 +261,34 @@ impl BsdfModel for RoughDielectric {
             eta: etap,
             ended_companions: split,
         })
+    }
+
+    /// The microfacet's Fresnel reflection or transmission per lane's n(λ), in the frame
+    /// of the plane that holds ωi, ωo and ωm (the s direction ωi × ωo), at ωi·ωm: the
+    /// rough interface polarises as each of its facets does (single scattering).
+    #[inline]
+    fn mueller<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        _: LobeFlags,
+        wl: &SampledWavelengths<N>,
+        _: &Frame,
+    ) -> Polarizing<N> {
+        let eta = self.interface.eta(wl.lambda[0]);
+        let Some((wm, _, _)) = half(wo, wi, eta) else {
+            return Polarizing::Depolarizing;
+        };
+        let x = s_of_pair(wi, wo);
+        // Signed by the side the light arrives from (ωm points outward).
+        let cos = wi.dot(wm).abs() * wi.z.signum();
+        let m =
+            std::array::from_fn(|i| self.interface.interface_mueller(wo, wi, cos, wl.lambda[i]));
+        Polarizing::Mueller {
+            m,
+            x_in: x,
+            x_out: x,
+        }
     }
 }
 

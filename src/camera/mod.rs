@@ -66,6 +66,10 @@ pub struct Camera {
     v: Vec3,
     /// The lens in front of the film; None for the seed's pinhole.
     pub lens: Option<Arc<lens::LensCamera>>,
+    /// An ideal linear analyser in front of the camera (`[camera] polarizer`), its
+    /// transmission axis this many radians from the image's horizontal, counter-clockwise
+    /// as the photographer sees it; read by polarised transport only.
+    pub polarizer: Option<f32>,
 }
 
 impl Camera {
@@ -111,7 +115,22 @@ impl Camera {
             b2,
             v,
             lens: None,
+            polarizer: None,
         })
+    }
+
+    /// The Stokes frame of light arriving at the camera along −`dir` (`dir` the camera
+    /// ray's unit direction): x̂ is the image's horizontal (rightward) made
+    /// perpendicular to the ray, so ŷ = −dir × x̂ is the image's up and S1 > 0 is
+    /// horizontally polarised light in the picture.
+    #[inline]
+    pub fn stokes_x(&self, dir: Vec3) -> Vec3 {
+        let x = self.b1 - dir * self.b1.dot(dir);
+        if x.length_squared() > 1e-12 {
+            x.normalize()
+        } else {
+            crate::spectrum::stokes::any_perpendicular(dir)
+        }
     }
 
     /// This camera with `lens` in front of its film (the film's centre at `eye`).
@@ -124,6 +143,7 @@ impl Camera {
     pub fn resized(&self, width: u32, height: u32) -> Result<Camera, String> {
         let mut c = Camera::new(self.eye, self.look_at, self.up, self.d, width, height)?;
         c.lens = self.lens.clone();
+        c.polarizer = self.polarizer;
         Ok(c)
     }
 

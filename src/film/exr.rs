@@ -8,6 +8,7 @@
 //! --variance`), the channels `variance.R`, `variance.G`, `variance.B`: the variance of
 //! each pixel's R, G, B value (of the mean over its samples, not of one sample; the
 //! layer `variance` in OpenEXR's `layer.channel` naming), which `heron compare` reads.
+//! A polarised render adds the Stokes components `S1.R` … `S3.B` ([`STOKES_CHANNELS`]).
 use super::Film;
 use crate::files::Staged;
 use crate::provenance::{Provenance, PREFIX};
@@ -17,6 +18,14 @@ use std::path::Path;
 
 /// The names of the variance channels, for R, G and B.
 pub const VARIANCE_CHANNELS: [&str; 3] = ["variance.R", "variance.G", "variance.B"];
+
+/// The channels of S1, S2, S3 of a polarised render (R, G, B each, linear sRGB in the
+/// camera's Stokes frame; R, G, B are S0), Mitsuba 3's `stokes` integrator's names.
+pub const STOKES_CHANNELS: [[&str; 3]; 3] = [
+    ["S1.R", "S1.G", "S1.B"],
+    ["S2.R", "S2.G", "S2.B"],
+    ["S3.R", "S3.G", "S3.B"],
+];
 
 /// Which channels go into the EXR besides R, G, B (and the variance channels, written
 /// whenever the film has a variance estimate).
@@ -56,6 +65,19 @@ pub fn stage_exr(
     if let Some(var) = &film.variance {
         for (c, name) in VARIANCE_CHANNELS.iter().enumerate() {
             list.push(AnyChannel::new(*name, plane(&|i| var[i][c])));
+        }
+    }
+    if let Some(stokes) = &film.stokes {
+        // S1–S3 in linear sRGB through the film's matrix (linear, so signed XYZ gives
+        // signed RGB); R, G, B are S0.
+        let rgb: Vec<[[f32; 3]; 3]> = stokes
+            .iter()
+            .map(|s| s.map(crate::spectrum::color::xyz_to_linear_srgb))
+            .collect();
+        for (k, names) in STOKES_CHANNELS.iter().enumerate() {
+            for (c, name) in names.iter().enumerate() {
+                list.push(AnyChannel::new(*name, plane(&|i| rgb[i][k][c])));
+            }
         }
     }
     let mut layer_attrs = LayerAttributes::named("heron");

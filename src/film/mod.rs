@@ -232,6 +232,9 @@ pub struct Film {
     /// of the mean, not of one sample (`Checkpoint::film` says how it is estimated).
     /// Infinite where a pixel has fewer than two finite samples.
     pub variance: Option<Vec<[f32; 3]>>,
+    /// Polarised renders: per pixel, the Stokes components S1, S2, S3 as CIE XYZ (signed;
+    /// S0 is `xyz`), in the camera's frame (`Camera::stokes_x`: S1 > 0 horizontal).
+    pub stokes: Option<Vec<[[f32; 3]; 3]>>,
 }
 
 impl Film {

@@ -19,6 +19,7 @@
 pub mod bdpt;
 pub mod lighttrace;
 pub mod path;
+pub mod polarized;
 pub mod sppm;
 pub(crate) mod toolkit;
 pub mod whitted;
@@ -31,6 +32,7 @@ use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
 use crate::settings::{KernelFlags, ALL, MEDIA, SPECULAR};
+use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 pub(crate) use toolkit::WALKS;
@@ -62,7 +64,11 @@ pub struct TraceCounters {
 /// camera ray's closest hit when it was already traced (in an Embree packet); `None`
 /// traces it here. One function per (integrator, lanes, kernel), chosen once per render
 /// by [`kernel`] (pbrt-v4's `RayIntegrator::EvaluatePixelSample`).
-pub type RadianceFn<const N: usize> = fn(
+pub type RadianceFn<const N: usize> = KernelFn<N, SampledSpectrum<N>>;
+
+/// A pixel sample's function returning `O`: radiance ([`RadianceFn`]) or, in a
+/// polarised render, Stokes radiance ([`StokesFn`]).
+pub type KernelFn<const N: usize, O> = fn(
     &Context,
     CameraRay,
     Option<Option<Hit>>,
@@ -70,7 +76,34 @@ pub type RadianceFn<const N: usize> = fn(
     &mut Sampler,
     &mut TraceCounters,
     &mut Splats,
-) -> SampledSpectrum<N>;
+) -> O;
+
+/// What one pixel sample of a polarised render computes: the Stokes radiance along the
+/// camera ray in the camera's frame (`integrator::polarized`).
+pub type StokesFn<const N: usize> = KernelFn<N, StokesSpectrum<N>>;
+
+fn polarized_path<const N: usize>(
+    ctx: &Context,
+    ray: CameraRay,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    _: &mut Splats,
+) -> StokesSpectrum<N> {
+    polarized::radiance(ctx, ray, first_hit, wl, sampler, counters)
+}
+
+/// The polarised kernel of integrator `kind` with `N` lanes, or why there is none.
+pub fn stokes_kernel<const N: usize>(kind: IntegratorKind) -> Result<StokesFn<N>, String> {
+    match kind {
+        IntegratorKind::Path => Ok(polarized_path::<N>),
+        other => Err(format!(
+            "integrator {}: polarised transport (polarization = true) is implemented for integrator = \"path\" so far",
+            other.name()
+        )),
+    }
+}
 
 fn whitted_k<const N: usize, const K: KernelFlags>(
     ctx: &Context,

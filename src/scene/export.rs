@@ -43,6 +43,12 @@ pub fn spectra_json(scene: &Scene) -> Value {
                 "k": values(&c.ior.k), "alpha": c.distribution.alpha}),
             Material::Glossy(g) => json!({"type": "glossy", "rho_d": values(&g.rho_d),
                 "rho_s": g.rho_s, "shininess": g.shininess}),
+            Material::Polarizer(p) => json!({"type": "polarizer",
+                "axis": [p.axis.x, p.axis.y, p.axis.z], "angle": p.angle,
+                "t_x": p.t_x, "t_y": p.t_y}),
+            Material::Retarder(r) => json!({"type": "retarder",
+                "axis": [r.axis.x, r.axis.y, r.axis.z], "angle": r.angle,
+                "retardance": r.retardance}),
         };
         materials.insert(name.clone(), v);
     }

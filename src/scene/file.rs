@@ -180,6 +180,11 @@ pub struct CameraFile {
     /// wavelength, object at infinity).
     #[serde(default)]
     pub f_number: Option<PositiveNumber>,
+    /// An ideal linear polariser in front of the lens, its axis this many degrees from
+    /// the image's horizontal, counter-clockwise as the photographer sees it (polarised
+    /// renders only: `[render] polarization`).
+    #[serde(default)]
+    pub polarizer: Option<f32>,
     /// Exit-pupil sampling: "bounds" (default) or "rear-element".
     #[serde(default)]
     pub pupil: Option<String>,
@@ -235,6 +240,9 @@ pub struct RenderFile {
     /// (0, the default: none); `--spectral-bins` overrides it.
     #[serde(default)]
     pub spectral_bins: Option<i64>,
+    /// Polarised transport (default false); `--polarization` turns it on.
+    #[serde(default)]
+    pub polarization: Option<bool>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.
@@ -246,13 +254,58 @@ pub enum MaterialFile {
     Dielectric(DielectricFile),
     Glossy(GlossyFile),
     Conductor(ConductorFile),
+    Polarizer(PolarizerFile),
+    Retarder(RetarderFile),
 }
 
 impl MaterialFile {
     /// The `type` values, in declaration order (serde's `rename_all = "lowercase"` of the
     /// variants; `tests::names_are_the_serde_tags` holds them to it).
-    pub const NAMES: &'static [&'static str] =
-        &["lambertian", "mirror", "dielectric", "glossy", "conductor"];
+    pub const NAMES: &'static [&'static str] = &[
+        "lambertian",
+        "mirror",
+        "dielectric",
+        "glossy",
+        "conductor",
+        "polarizer",
+        "retarder",
+    ];
+}
+
+/// A linear polariser sheet (src/bsdf/polarizer.rs): light passes straight through.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolarizerFile {
+    /// The transmission axis's angle in degrees from `axis` projected onto the sheet,
+    /// counter-clockwise seen from the side the normal points to (default 0).
+    #[serde(default)]
+    pub angle: Option<f32>,
+    /// A world direction whose projection onto the sheet is the axis at angle 0
+    /// (default [0, 1, 0]; the sheet's own first axis where it is parallel to the normal).
+    #[serde(default)]
+    pub axis: Option<Direction3>,
+    /// Intensity transmittance along the axis, in (0, 1] (default 1).
+    #[serde(default)]
+    pub transmittance: Option<f32>,
+    /// t_along / t_across, at least 1 (default: an ideal polariser, t_across = 0).
+    #[serde(default)]
+    pub extinction_ratio: Option<f32>,
+}
+
+/// A linear retarder, a wave plate (src/bsdf/retarder.rs): light passes straight through.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RetarderFile {
+    /// Retardance in waves (0.25: a quarter-wave plate, 0.5: a half-wave plate; default
+    /// 0.25), the same at every wavelength.
+    #[serde(default)]
+    pub retardance: Option<f32>,
+    /// The fast axis's angle in degrees, as a polarizer's `angle`.
+    #[serde(default)]
+    pub angle: Option<f32>,
+    /// As a polarizer's `axis`.
+    #[serde(default)]
+    pub axis: Option<Direction3>,
 }
 
 #[derive(Debug, serde::Deserialize)]

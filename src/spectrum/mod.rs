@@ -13,6 +13,7 @@ pub mod ior;
 pub mod metals;
 pub mod rgb2spec;
 pub mod sampled;
+pub mod stokes;
 pub mod uplift;
 
 pub use dense::DenseSpectrum;

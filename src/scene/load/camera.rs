@@ -81,6 +81,16 @@ pub(super) fn build_camera(
         c.resolution.height,
     )
     .map_err(|e| format!("camera: {e}"))?;
+    let mut cam = cam;
+    cam.polarizer = match c.polarizer {
+        None => None,
+        Some(a) if a.is_finite() => Some(a.to_radians()),
+        Some(a) => {
+            return Err(format!(
+                "camera.polarizer: expected the analyser's angle in degrees from the image's horizontal, got {a}"
+            ))
+        }
+    };
     Ok(match lens {
         Some(l) => cam.with_lens(l),
         None => cam,

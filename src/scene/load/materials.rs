@@ -4,8 +4,8 @@
 use super::errors::key;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    Conductor, Dielectric, Glossy, ImageTexture, Lambertian, Material, Mirror, RoughConductor,
-    RoughDielectric, TexturedDiffuse,
+    Conductor, Dielectric, Glossy, ImageTexture, Lambertian, Material, Mirror, Polarizer, Retarder,
+    RoughConductor, RoughDielectric, TexturedDiffuse,
 };
 use crate::scene::file::{IorSpec, MaterialFile, MetalSpec, SceneFile};
 use crate::spectrum::ior::Ior;
@@ -271,7 +271,54 @@ fn build_material(
                 },
             })
         }
+        MaterialFile::Polarizer(p) => {
+            let t_x = p.transmittance.unwrap_or(1.0);
+            if !(t_x > 0.0 && t_x <= 1.0) {
+                return Err(format!(
+                    "{at}.transmittance: expected a number in (0, 1], got {t_x}"
+                ));
+            }
+            let t_y = match p.extinction_ratio {
+                None => 0.0,
+                Some(r) if r >= 1.0 && r.is_finite() => t_x / r,
+                Some(r) => {
+                    return Err(format!(
+                        "{at}.extinction_ratio: expected a finite number of at least 1 (t along the axis / t across it), got {r}"
+                    ))
+                }
+            };
+            Material::Polarizer(Polarizer {
+                axis: p.axis.map_or(glam::Vec3::Y, |a| a.unit()),
+                angle: sheet_angle(at, p.angle)?,
+                t_x,
+                t_y,
+            })
+        }
+        MaterialFile::Retarder(r) => {
+            let waves = r.retardance.unwrap_or(0.25);
+            if !waves.is_finite() {
+                return Err(format!(
+                    "{at}.retardance: expected a finite number of waves (0.25 for a quarter-wave plate), got {waves}"
+                ));
+            }
+            Material::Retarder(Retarder {
+                axis: r.axis.map_or(glam::Vec3::Y, |a| a.unit()),
+                angle: sheet_angle(at, r.angle)?,
+                retardance: waves * std::f32::consts::TAU,
+            })
+        }
     })
+}
+
+/// A sheet's `angle` in degrees, as radians (default 0).
+fn sheet_angle(at: &str, angle: Option<f32>) -> std::result::Result<f32, String> {
+    match angle {
+        None => Ok(0.0),
+        Some(a) if a.is_finite() => Ok(a.to_radians()),
+        Some(a) => Err(format!(
+            "{at}.angle: expected a finite angle in degrees, got {a}"
+        )),
+    }
 }
 
 #[cfg(test)]

@@ -64,5 +64,8 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
         }
         settings.spectral_bins = b as usize;
     }
+    if let Some(p) = r.polarization {
+        settings.polarization = p;
+    }
     Ok(settings)
 }

@@ -1,0 +1,297 @@
+//! Polarised transport through the whole renderer (`[render] polarization`): Malus's
+//! law with two polariser sheets and with the camera's analyser, a quarter-wave plate
+//! turning 45° light circular, the degree of polarisation of light reflected at
+//! Brewster's angle, an all-diffuse scene whose S0 is the unpolarised image, the same
+//! bytes on one and two threads, and the errors for what polarised transport does not
+//! support. The closed forms of the matrices are `optics::mueller`'s unit tests.
+//!
+//! The sheet scenes are noiseless: every camera ray goes straight through the sheets
+//! to a uniform emitter (delta events only), so the expected values hold to rounding,
+//! and the tolerances are rounding's (f32 products of a few matrices).
+mod common;
+
+use common::render::render_with;
+use heron::film::Film;
+use heron::scene::load::{load_scene, load_scene_from_str};
+use heron::scene::Scene;
+use std::path::Path;
+
+fn scene(toml: &str) -> Scene {
+    load_scene_from_str(toml, Path::new("polarization-test.toml")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Camera at z = 3 looking down −z at a uniform two-sided emitter at z = 0, with the
+/// `sheets` (material tables) as 4 × 4 quads facing the camera at z = 1.0, 0.5, …,
+/// seen through a field of ±0.3° so that every ray crosses them at normal incidence
+/// within 0.3° (Malus's cos² is the law of normal incidence).
+fn sheets_scene(camera_polarizer: Option<f32>, sheets: &[&str]) -> Scene {
+    let mut t = String::from(
+        "background = 0.0\n[camera]\neye = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nd = 50.0\nresolution = [8, 8]\n",
+    );
+    if let Some(a) = camera_polarizer {
+        t += &format!("polarizer = {a}\n");
+    }
+    t += "[render]\nintegrator = \"path\"\npolarization = true\nspp = 2\nmax_depth = 8\n";
+    t += "[materials.black]\ntype = \"lambertian\"\nrho_d = 0.0\n";
+    for (i, m) in sheets.iter().enumerate() {
+        t += &format!("[materials.sheet{i}]\n{m}\n");
+        t += &format!(
+            "[[shapes]]\ntype = \"quad\"\norigin = [-2.0, -2.0, {z}]\nedge1 = [4.0, 0.0, 0.0]\nedge2 = [0.0, 4.0, 0.0]\nmaterial = \"sheet{i}\"\n",
+            z = 1.0 - 0.5 * i as f32
+        );
+    }
+    t += "[[shapes]]\ntype = \"quad\"\norigin = [-3.0, -3.0, 0.0]\nedge1 = [6.0, 0.0, 0.0]\nedge2 = [0.0, 6.0, 0.0]\nmaterial = \"black\"\nemission = 1.0\ntwo_sided = true\n";
+    scene(&t)
+}
+
+/// The film's mean Stokes vector (of Y) over all pixels.
+fn mean_stokes(f: &Film) -> [f64; 4] {
+    let st = f.stokes.as_ref().expect("a polarised film");
+    let n = f.xyz.len() as f64;
+    let mut s = [0.0; 4];
+    for (xyz, p) in f.xyz.iter().zip(st) {
+        s[0] += xyz[1] as f64 / n;
+        for k in 0..3 {
+            s[k + 1] += p[k][1] as f64 / n;
+        }
+    }
+    s
+}
+
+fn render_scene(s: &Scene) -> Film {
+    render_with(s, |_| {})
+}
+
+#[test]
+fn malus_law_holds_for_two_sheets_and_for_sheet_and_analyser() {
+    let open = mean_stokes(&render_scene(&sheets_scene(None, &[])))[0];
+    assert!(open > 0.5, "the emitter is seen: {open}");
+    for theta in [0.0f64, 30.0, 60.0, 90.0] {
+        // Light meets sheet 1 (z = 0.5, axis vertical) first, then sheet 0 at θ.
+        let s = sheets_scene(
+            None,
+            &[
+                &format!("type = \"polarizer\"\nangle = {theta}"),
+                "type = \"polarizer\"",
+            ],
+        );
+        let got = mean_stokes(&render_scene(&s))[0] / open;
+        let want = 0.5 * theta.to_radians().cos().powi(2);
+        assert!(
+            (got - want).abs() < 1e-4,
+            "θ = {theta}°: {got} vs ½cos²θ = {want}"
+        );
+    }
+    // The sheet's angle (counter-clockwise seen from the camera's side, from the
+    // horizontal) and the analyser's (counter-clockwise as the photographer sees it)
+    // are one convention: cos²(α − β), not cos²(α + β).
+    let s = sheets_scene(
+        Some(50.0),
+        &["type = \"polarizer\"\naxis = [1.0, 0.0, 0.0]\nangle = 20.0"],
+    );
+    let got = mean_stokes(&render_scene(&s))[0] / open;
+    let want = 0.5 * 30f64.to_radians().cos().powi(2);
+    assert!((got - want).abs() < 1e-4, "analyser: {got} vs {want}");
+}
+
+#[test]
+fn crossed_sheets_extinguish_as_their_extinction_ratio_says() {
+    let open = mean_stokes(&render_scene(&sheets_scene(None, &[])))[0];
+    let ideal = sheets_scene(
+        None,
+        &["type = \"polarizer\"\nangle = 90", "type = \"polarizer\""],
+    );
+    let got = mean_stokes(&render_scene(&ideal))[0] / open;
+    assert!(got.abs() < 1e-6, "ideal crossed sheets pass {got}");
+    // Two sheets of t_x = 0.8, t_y = t_x / 100 crossed: t_x t_y of the light.
+    let real = "type = \"polarizer\"\ntransmittance = 0.8\nextinction_ratio = 100.0";
+    let s = sheets_scene(None, &[&format!("{real}\nangle = 90"), real]);
+    let got = mean_stokes(&render_scene(&s))[0] / open;
+    let want = 0.8 * 0.008;
+    assert!((got - want).abs() < 1e-5, "{got} vs t_x t_y = {want}");
+}
+
+#[test]
+fn a_quarter_wave_plate_turns_45_degree_light_circular() {
+    let mut s3 = Vec::new();
+    for fast in [0.0, 90.0] {
+        // Light meets the polariser at 45° (z = 0.5) and then the plate (z = 1).
+        let s = sheets_scene(
+            None,
+            &[
+                &format!("type = \"retarder\"\nretardance = 0.25\naxis = [1.0, 0.0, 0.0]\nangle = {fast}"),
+                "type = \"polarizer\"\naxis = [1.0, 0.0, 0.0]\nangle = 45",
+            ],
+        );
+        let st = mean_stokes(&render_scene(&s));
+        assert!(st[0] > 0.1);
+        assert!(
+            st[1].abs() < 1e-5 * st[0] && st[2].abs() < 1e-5 * st[0],
+            "{st:?}"
+        );
+        assert!(
+            (st[3].abs() - st[0]).abs() < 1e-5 * st[0],
+            "S3 = ±S0: {st:?}"
+        );
+        s3.push(st[3].signum());
+        // Without the plate the light is linear at +45°: S2 = S0.
+        let lin = sheets_scene(
+            None,
+            &["type = \"polarizer\"\naxis = [1.0, 0.0, 0.0]\nangle = 45"],
+        );
+        let st = mean_stokes(&render_scene(&lin));
+        assert!((st[2] - st[0]).abs() < 1e-5 * st[0], "{st:?}");
+    }
+    assert_eq!(
+        s3[0], -s3[1],
+        "turning the fast axis by 90° reverses the handedness"
+    );
+}
+
+#[test]
+fn light_reflected_at_brewsters_angle_is_completely_polarised() {
+    // A glass plane (n = 1.5) seen at θB = atan 1.5 through a narrow field (±0.3°, where (R_s − R_p)/(R_s + R_p) > 0.9998),
+    // reflecting a uniform emitter; what the glass transmits leaves the scene.
+    let tb = 1.5f32.atan();
+    let (c, s) = (tb.cos(), tb.sin());
+    let t = format!(
+        "background = 0.0\n[camera]\neye = [0.0, {ey}, {ez}]\nlook_at = [0.0, 0.0, 0.0]\nd = 100.0\nresolution = [16, 16]\n\
+[render]\nintegrator = \"path\"\npolarization = true\nspp = 64\nmax_depth = 3\n\
+[materials.glass]\ntype = \"dielectric\"\nior = 1.5\n[materials.black]\ntype = \"lambertian\"\nrho_d = 0.0\n\
+[[shapes]]\ntype = \"quad\"\norigin = [-50.0, 0.0, -50.0]\nedge1 = [0.0, 0.0, 100.0]\nedge2 = [100.0, 0.0, 0.0]\nmaterial = \"glass\"\n\
+[[shapes]]\ntype = \"quad\"\norigin = [-2.0, {oy}, {oz}]\nedge1 = [4.0, 0.0, 0.0]\nedge2 = [0.0, {e2y}, {e2z}]\nmaterial = \"black\"\nemission = 1.0\ntwo_sided = true\n",
+        ey = 4.0 * c,
+        ez = -4.0 * s,
+        oy = 4.0 * c + 2.0 * s,
+        oz = 4.0 * s - 2.0 * c,
+        e2y = -4.0 * s,
+        e2z = 4.0 * c,
+    );
+    let f = render_scene(&scene(&t));
+    let st = f.stokes.as_ref().unwrap();
+    // The glass reflects with probability R ≈ 0.074 per sample, so some pixels saw only
+    // transmission (S = 0); every light the others saw is the reflection's.
+    let mut lit = 0;
+    for (xyz, p) in f.xyz.iter().zip(st) {
+        let s0 = xyz[1] as f64;
+        if s0 == 0.0 {
+            continue;
+        }
+        lit += 1;
+        let dop = (p[0][1] as f64).hypot(p[1][1] as f64).hypot(p[2][1] as f64) / s0;
+        assert!(dop > 0.9995, "degree of polarisation {dop}");
+        // s-polarised is horizontal in this picture: S1 = +S0.
+        assert!(p[0][1] > 0.0);
+    }
+    assert!(lit > 100, "{lit} pixels saw the reflection");
+    // And the intensity is Fresnel's: (R_s + 0)/2 of the emitter's Y (1), within 4
+    // standard errors of the 256 pixels' mean (each pixel a mean of 64 Bernoulli
+    // choices; SE ≈ 3% of the mean).
+    let (y, se) = common::render::mean_se_y(&f);
+    let (ci, ct) = (c as f64, (1.0 - (s as f64 / 1.5).powi(2)).sqrt());
+    let rs = ((ci - 1.5 * ct) / (ci + 1.5 * ct)).powi(2);
+    assert!(
+        (y - 0.5 * rs).abs() < 4.0 * se,
+        "{y} ± {se} vs R_s/2 = {}",
+        0.5 * rs
+    );
+}
+
+/// The Cornell box, 40 × 40: Lambertian surfaces and an area light only.
+fn small_cornell_box() -> Scene {
+    let mut s = load_scene(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    s.camera = s.camera.resized(40, 40).unwrap();
+    s
+}
+
+#[test]
+fn an_all_diffuse_scene_renders_the_unpolarised_image_in_s0() {
+    let s = small_cornell_box();
+    let plain = render_with(&s, |o| o.settings.spp = 4);
+    let pol = render_with(&s, |o| {
+        o.settings.spp = 4;
+        o.settings.polarization = true;
+    });
+    assert!(plain.stokes.is_none());
+    for (a, b) in plain.xyz.iter().zip(&pol.xyz) {
+        for j in 0..3 {
+            assert!(
+                (a[j] - b[j]).abs() <= 1e-5 + 1e-4 * a[j].abs(),
+                "S0 {b:?} against the unpolarised {a:?}"
+            );
+        }
+    }
+    // Diffuse surfaces depolarise, the light is unpolarised: S1 = S2 = S3 = 0 exactly.
+    assert!(pol
+        .stokes
+        .unwrap()
+        .iter()
+        .flatten()
+        .flatten()
+        .all(|&v| v == 0.0));
+}
+
+#[test]
+fn polarised_renders_are_the_same_bytes_on_one_and_two_threads() {
+    let s = scene(
+        &std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/brewster.toml"),
+        )
+        .unwrap(),
+    );
+    let run = |threads: usize| {
+        render_with(&s, |o| {
+            o.settings.spp = 2;
+            o.threads = threads;
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a, b);
+    assert!(a.stokes.unwrap().iter().any(|p| p[0][1] != 0.0));
+}
+
+#[test]
+fn what_polarised_transport_does_not_support_is_a_clear_error() {
+    let s = sheets_scene(None, &[]);
+    let err = |set: &dyn Fn(&mut heron::render::RenderOptions)| {
+        let mut o = heron::render::RenderOptions::from_scene(&s);
+        set(&mut o);
+        heron::render::render(&s, &o).unwrap_err().to_string()
+    };
+    let e = err(&|o| o.settings.integrator = heron::settings::IntegratorKind::Bdpt);
+    assert!(
+        e.contains("integrator bdpt") && e.contains("polarised transport"),
+        "{e}"
+    );
+    let e = err(&|o| o.settings.spectral_bins = 10);
+    assert!(e.contains("spectral bins"), "{e}");
+    // An analyser without polarised transport.
+    let s = sheets_scene(Some(10.0), &[]);
+    let mut o = heron::render::RenderOptions::from_scene(&s);
+    o.settings.polarization = false;
+    let e = heron::render::render(&s, &o).unwrap_err().to_string();
+    assert!(
+        e.contains("camera.polarizer") && e.contains("--polarization"),
+        "{e}"
+    );
+    // Bad sheet keys name the key.
+    let bad = |m: &str| {
+        let t = format!("[camera]\neye = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nresolution = [8, 8]\n[materials.p]\n{m}\n");
+        load_scene_from_str(&t, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string()
+    };
+    let e = bad("type = \"polarizer\"\nextinction_ratio = 0.5");
+    assert!(
+        e.contains("materials.p.extinction_ratio") && e.contains("at least 1"),
+        "{e}"
+    );
+    let e = bad("type = \"polarizer\"\ntransmittance = 1.5");
+    assert!(e.contains("materials.p.transmittance"), "{e}");
+    let e = bad("type = \"retarder\"\nretardance = \"quarter\"");
+    assert!(
+        e.contains("materials.p") && e.contains("expected a number"),
+        "{e}"
+    );
+}
