@@ -79,6 +79,8 @@ class Scene:
         sppm_photons: Optional[int] = None,
         sppm_alpha: Optional[float] = None,
         sppm_radius: Optional[float] = None,
+        polarization: Optional[bool] = None,
+        polarizer: Optional[float] = None,
     ) -> "RenderResult":
         """Renders the scene with ``heron render``'s options and defaults.
 
@@ -91,7 +93,11 @@ class Scene:
         (``--medium-nee``, ``--sun-guide``); integrator "sppm" is stochastic
         progressive photon mapping (spp: its iterations) with sppm_photons,
         sppm_alpha and sppm_radius (``--sppm-photons``, ``--sppm-alpha``,
-        ``--sppm-radius``). The GIL is released while
+        ``--sppm-radius``); polarization=True renders Stokes vectors (``--polarization``;
+        None keeps the scene's ``[render] polarization``) into ``RenderResult.stokes``;
+        polarizer puts an analyser at that many degrees in front of the camera
+        (``--polarizer``, over the scene's ``[camera] polarizer``).
+        The GIL is released while
         rendering; Ctrl-C stops the render within a row of a tile and raises
         KeyboardInterrupt.
         """
@@ -115,6 +121,11 @@ class RenderResult:
     def variance(self) -> Optional[npt.NDArray[np.float32]]:
         """The variance of each pixel's R, G, B (of its mean), H x W x 3 (the EXR's
         variance.R, .G, .B), or None without variance=True."""
+    @property
+    def stokes(self) -> Optional[npt.NDArray[np.float32]]:
+        """Stokes vectors in linear sRGB, H x W x 4 x 3: [..., k, c] is S_k of channel c,
+        in the camera's frame (S1 > 0 horizontal, S2 > 0 at +45° counter-clockwise, S3 > 0
+        right-circular; the EXR's R, G, B and S1.R ... S3.B), or None unpolarised."""
     spp: int
     """Samples per pixel in the image."""
     rays: int

@@ -804,6 +804,11 @@ struct RenderArgs {
     /// and OUT.aolp.png (default: the scene's [render] polarization).
     #[arg(long)]
     polarization: bool,
+    /// An ideal linear analyser in front of the camera at DEG from the image's
+    /// horizontal, counter-clockwise as the photographer sees it (overrides the scene's
+    /// [camera] polarizer; needs --polarization or [render] polarization = true).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    polarizer: Option<f64>,
     /// Add N spectral channels (equal bins over 360–830 nm, the layout of Fichet et al.
     /// 2021, readable by colour.read_spectral_image_Fichet2021).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=470))]
@@ -1141,6 +1146,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         sppm_alpha: args.sppm_alpha,
         sppm_radius: args.sppm_radius,
         polarization: args.polarization.then_some(true),
+        polarizer: args.polarizer,
     };
     // Before the scene loads, which may take seconds (sky and medium tables).
     settings_args.check().map_err(anyhow::Error::msg)?;

@@ -95,7 +95,7 @@ pub const SPPM_KEYS: [&str; 3] = ["sppmPhotons", "sppmAlpha", "sppmRadius"];
 
 /// Keys written last only for a polarised render (`[render] polarization`), so that
 /// unpolarised EXRs keep their bytes.
-pub const POLARIZATION_KEYS: [&str; 1] = ["polarization"];
+pub const POLARIZATION_KEYS: [&str; 2] = ["polarization", "polarizer"];
 
 impl Provenance {
     /// The provenance a film's settings key holds (the key of `render.rs` contains every
@@ -174,6 +174,10 @@ impl Provenance {
         }
         if settings.polarization {
             p.0.push(("polarization", "stokes".to_string()));
+            // The analyser in degrees, the flag's over the scene's.
+            if let Some(a) = settings.polarizer.or(scene.camera.polarizer) {
+                p.0.push(("polarizer", a.to_degrees().to_string()));
+            }
         }
         p
     }

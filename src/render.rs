@@ -238,10 +238,19 @@ fn render_with(
             kind.name()
         )));
     }
-    if scene.camera.polarizer.is_some() && !opts.settings.polarization {
-        return Err(HeronError::Invalid(
-            "camera.polarizer: an analyser needs polarised transport; set [render] polarization = true or pass --polarization".into(),
-        ));
+    if !opts.settings.polarization {
+        let which = if opts.settings.polarizer.is_some() {
+            Some("--polarizer")
+        } else if scene.camera.polarizer.is_some() {
+            Some("camera.polarizer")
+        } else {
+            None
+        };
+        if let Some(w) = which {
+            return Err(HeronError::Invalid(format!(
+                "{w}: an analyser needs polarised transport; set [render] polarization = true or pass --polarization"
+            )));
+        }
     }
     if opts.settings.polarization {
         integrator::stokes_kernel::<1>(kind).map_err(HeronError::Invalid)?;
@@ -254,6 +263,10 @@ fn render_with(
             return Err(HeronError::Invalid(
                 "polarization: spectral bins of S1-S3 are not written yet; render with spectral_bins = 0 (the EXR has S0-S3 in linear sRGB)".into(),
             ));
+        }
+        // The sky's polarisation is tabulated here, before the workers start.
+        if let Some(sky) = &scene.sky {
+            sky.linear_table();
         }
     }
     let ctx = Context {

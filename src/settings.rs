@@ -479,6 +479,10 @@ pub struct RenderSettings {
     /// carries a Stokes vector and every event applies a Mueller matrix
     /// (`integrator::polarized`); the film gains S1–S3.
     pub polarization: bool,
+    /// An analyser in front of the camera at this angle (radians from the image's
+    /// horizontal, counter-clockwise as the photographer sees it), in place of the
+    /// scene's `[camera] polarizer` (`--polarizer`); polarised renders only.
+    pub polarizer: Option<f32>,
 }
 
 impl Default for RenderSettings {
@@ -504,6 +508,7 @@ impl Default for RenderSettings {
             sun_guide: DEFAULT_SUN_GUIDE,
             sppm: SppmSettings::default(),
             polarization: false,
+            polarizer: None,
         }
     }
 }
@@ -535,6 +540,8 @@ pub struct SettingsArgs<'a> {
     pub sppm_radius: Option<f64>,
     /// `--polarization` (true turns it on; a scene's `true` stays on without it).
     pub polarization: Option<bool>,
+    /// `--polarizer` in degrees.
+    pub polarizer: Option<f64>,
 }
 
 impl SettingsArgs<'_> {
@@ -625,6 +632,14 @@ impl RenderSettings {
         }
         if let Some(p) = a.polarization {
             s.polarization = p;
+        }
+        if let Some(deg) = a.polarizer {
+            if !deg.is_finite() {
+                return Err(format!(
+                    "--polarizer: expected the analyser's angle in degrees from the image's horizontal, got {deg}"
+                ));
+            }
+            s.polarizer = Some((deg as f32).to_radians());
         }
         *self = s;
         Ok(())

@@ -3,7 +3,7 @@ use crate::{err, guard, lib_err, panic_message};
 use heron_core::film::Film;
 use heron_core::render::{RenderOptions, RenderStats};
 use heron_core::settings::SettingsArgs;
-use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray3, PyArray4, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::panic::AssertUnwindSafe;
@@ -29,6 +29,8 @@ const RENAMES: &[(&str, &str)] = &[
     ("--sppm-photons", "sppm_photons"),
     ("--sppm-alpha", "sppm_alpha"),
     ("--sppm-radius", "sppm_radius"),
+    ("--polarization", "polarization"),
+    ("--polarizer", "polarizer"),
 ];
 
 /// How often the thread that called `render` wakes to let Python run its signal
@@ -181,7 +183,7 @@ impl Scene {
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None, polarization=None, polarizer=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
@@ -203,6 +205,8 @@ impl Scene {
         sppm_photons: Option<i64>,
         sppm_alpha: Option<f64>,
         sppm_radius: Option<f64>,
+        polarization: Option<bool>,
+        polarizer: Option<f64>,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -232,6 +236,8 @@ impl Scene {
                     sppm_photons,
                     sppm_alpha,
                     sppm_radius,
+                    polarization,
+                    polarizer,
                 })
                 .map_err(|e| lib_err(e, RENAMES))?;
             opts.threads = threads as usize;
@@ -316,6 +322,7 @@ pub struct RenderResult {
     spectral: Option<Py<PyArray3<f32>>>,
     wavelengths: Option<Py<PyArray1<f32>>>,
     variance: Option<Py<PyArray3<f32>>>,
+    stokes: Option<Py<PyArray4<f32>>>,
     /// Samples per pixel in the image.
     #[pyo3(get)]
     spp: u32,
@@ -402,12 +409,28 @@ impl RenderResult {
             Some(v) => Some(image(flat(v.clone()), 3)?),
             None => None,
         };
+        let stokes = match &film.stokes {
+            Some(st) => {
+                let rgb = film.linear_srgb();
+                let data: Vec<f32> = rgb
+                    .iter()
+                    .zip(st)
+                    .flat_map(|(s0, s)| {
+                        let rest = s.map(heron_core::spectrum::color::xyz_to_linear_srgb);
+                        std::iter::once(*s0).chain(rest).flatten()
+                    })
+                    .collect();
+                Some(data.into_pyarray(py).reshape([h, w, 4, 3])?.unbind())
+            }
+            None => None,
+        };
         Ok(RenderResult {
             rgb,
             xyz,
             spectral,
             wavelengths,
             variance,
+            stokes,
             spp: stats.spp,
             rays: stats.total_rays(),
             camera_rays: stats.counters.rays,
@@ -455,6 +478,15 @@ impl RenderResult {
     #[getter]
     fn variance(&self, py: Python<'_>) -> Option<Py<PyArray3<f32>>> {
         self.variance.as_ref().map(|a| a.clone_ref(py))
+    }
+
+    /// The Stokes vector of each pixel in linear sRGB, H×W×4×3 float32: [..., k, c] is
+    /// S_k of channel c (R, G, B), in the camera's frame (S1 > 0 horizontal polarisation
+    /// in the picture, S2 > 0 at +45° counter-clockwise, S3 > 0 right-circular; the EXR's
+    /// R, G, B and S1.R … S3.B), or None when rendered without polarization.
+    #[getter]
+    fn stokes(&self, py: Python<'_>) -> Option<Py<PyArray4<f32>>> {
+        self.stokes.as_ref().map(|a| a.clone_ref(py))
     }
 
     /// The spectral bins' centres in nm (float32), or None without spectral bins.

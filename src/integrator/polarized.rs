@@ -16,8 +16,11 @@
 //! weight w = f |cos θi| / pdf, T becomes T · R(x̂_out → x̂_cur) · w M, and x̂_cur
 //! becomes x̂_in; R is the rotation of the Stokes frame about the direction of travel
 //! (`spectrum::stokes::rotate_basis`). Light found at a vertex (an emitter hit, a light
-//! sample, light at infinity) adds T · R · S_e. Every light heron has is unpolarised
-//! (S_e = (L, 0, 0, 0)), so emission needs no frame; the first column of T carries it.
+//! sample, light at infinity) adds T · R · S_e. Lights are unpolarised (S_e = (L, 0,
+//! 0, 0), which needs no frame: the first column of T carries it) but for the physical
+//! rainbow skies, whose light is linearly polarised perpendicular or parallel to the
+//! scattering plane (`Light::le_linear`, `SceneSky::linear_table`); the sun itself is
+//! unpolarised.
 //!
 //! **What stays scalar.** Sampling, MIS and roulette use the unpolarised scalar
 //! throughput and densities exactly as `path.rs` does, so a scene whose materials all
@@ -25,7 +28,7 @@
 //! that), and the roulette's 1/q reweights T as it does β.
 //!
 //! **What is not here yet.** Participating media (the render refuses them with
-//! polarisation), polarised skies (the sky is unpolarised radiance), light tracing,
+//! polarisation), polarised lights of the scene's own, light tracing,
 //! BDPT, the Whitted tracer and the packet engine.
 use super::toolkit::Immediate;
 use super::toolkit::{light_pdf, next_hit, roulette, sample_light, PathState, ShadowSink};
@@ -55,6 +58,24 @@ impl<const N: usize> Throughput<N> {
     #[inline]
     fn unpolarized(&self, l: SampledSpectrum<N>, w: f32) -> StokesSpectrum<N> {
         StokesSpectrum(std::array::from_fn(|i| self.t[i].col(0) * (l.0[i] * w)))
+    }
+
+    /// Light of S0 `l` and S1 `s1` per lane (S2 = S3 = 0) in the frame `x` (⊥ `k`, its
+    /// direction of travel) arriving along the current segment, as the camera sees it,
+    /// times `w`.
+    #[inline]
+    fn linear(
+        &self,
+        l: SampledSpectrum<N>,
+        s1: SampledSpectrum<N>,
+        x: Vec3,
+        k: Vec3,
+        w: f32,
+    ) -> StokesSpectrum<N> {
+        let r = rotate_basis(k, x, self.x);
+        StokesSpectrum(std::array::from_fn(|i| {
+            self.t[i] * (r * Vec4::new(l.0[i] * w, s1.0[i] * w, 0.0, 0.0))
+        }))
     }
 
     /// T · R(x̂_out → x̂_cur) · M per lane for an event whose light leaves along `k_out`
@@ -91,7 +112,7 @@ pub fn radiance<const N: usize>(
 ) -> StokesSpectrum<N> {
     let scene = ctx.scene;
     let mut s = PathState::<N>::at_camera(&cam);
-    let analyser = match scene.camera.polarizer {
+    let analyser = match ctx.settings.polarizer.or(scene.camera.polarizer) {
         Some(a) => {
             let m = Mueller::linear_polarizer(a as f64);
             mueller_from_rows(m.0.map(|r| r.map(|v| v as f32)))
@@ -118,10 +139,14 @@ pub fn radiance<const N: usize>(
         };
         let Some(hit) = hit else {
             for &i in &scene.infinite_lights {
-                let le = scene.lights[i as usize].le(ray.dir, wl);
+                let light = &scene.lights[i as usize];
+                let le = light.le(ray.dir, wl);
                 if !le.is_zero() {
                     let w = found(&s, &|| light_pdf(ctx, i as usize, s.prev_p, ray.dir, None));
-                    out += tp.unpolarized(le, w);
+                    out += match light.le_linear(ray.dir, wl) {
+                        None => tp.unpolarized(le, w),
+                        Some((s1, x)) => tp.linear(le, s1, x, -ray.dir, w),
+                    };
                 }
             }
             break;
@@ -175,9 +200,20 @@ pub fn radiance<const N: usize>(
                     if let Some(c) = Immediate.test(ctx, q, counters, || f * ls.l * scale) {
                         let lobe = LobeFlags::from_bits(flags.bits() & !LobeFlags::SPECULAR.bits());
                         let p = material.mueller(wo_local, wi_local, lobe, wl, &frame);
-                        let (t, _) = tp.through(&p, &frame, wo);
-                        // The light is unpolarised: M's first column, in any frame.
-                        out += StokesSpectrum(std::array::from_fn(|i| t[i].col(0) * c.0[i]));
+                        let (t, x_in) = tp.through(&p, &frame, wo);
+                        let linear = scene.lights[cl.index].le_linear(ls.wi, wl);
+                        out += match (linear, x_in) {
+                            // Polarised light onto a polarising event: into its frame.
+                            (Some((s1, x)), Some(x_in)) => {
+                                let r = rotate_basis(-ls.wi, x, x_in);
+                                let c1 = f * s1 * scale;
+                                StokesSpectrum(std::array::from_fn(|i| {
+                                    t[i] * (r * Vec4::new(c.0[i], c1.0[i], 0.0, 0.0))
+                                }))
+                            }
+                            // Unpolarised light, or a depolarising event: only S0 counts.
+                            _ => StokesSpectrum(std::array::from_fn(|i| t[i].col(0) * c.0[i])),
+                        };
                     }
                 }
             }

@@ -45,6 +45,8 @@ pub(crate) fn next_hit(
 pub(crate) struct ChosenLight<const N: usize> {
     pub sample: LightLiSample<N>,
     pub pdf: f32,
+    /// The light's index in `Scene::lights`.
+    pub index: usize,
 }
 
 /// Chooses a light with the scene's light sampler (`u_choice`) and samples a direction
@@ -67,6 +69,7 @@ pub(crate) fn sample_light<const N: usize>(
     Some(ChosenLight {
         pdf: pmf * sample.pdf,
         sample,
+        index,
     })
 }
 

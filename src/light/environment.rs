@@ -198,6 +198,30 @@ impl EnvironmentLight {
         }
     }
 
+    /// S1 of the sky's light along `dir` and its frame x̂ = (sun × dir)/|…|, perpendicular
+    /// to the scattering plane ([`crate::light::Light::le_linear`]); None without a
+    /// polarised sky.
+    pub fn le_linear<const N: usize>(
+        &self,
+        dir: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> Option<(SampledSpectrum<N>, Vec3)> {
+        let sky = self.sky.as_ref()?;
+        let table = sky.linear_table()?;
+        let theta = crate::sky::antisolar_angle(dir, sky.sun_dir).to_degrees();
+        let s1 = SampledSpectrum(std::array::from_fn(|i| {
+            let lambda = wl.lambda[i];
+            table.eval(theta, lambda) * sky.factor.eval(lambda)
+        }));
+        let x = sky.sun_dir.cross(dir);
+        let x = if x.length_squared() > 1e-12 {
+            x.normalize()
+        } else {
+            crate::spectrum::stokes::any_perpendicular(dir)
+        };
+        Some((s1, x))
+    }
+
     #[inline]
     fn sample_dir(&self, u: Vec2) -> (Vec3, f32) {
         if let Some(m) = &self.map {

@@ -218,6 +218,22 @@ impl Light {
         }
     }
 
+    /// The linear polarisation of the light a ray leaving the scene along `dir`
+    /// receives, for polarised transport: S1 per lane in the frame x̂ returned (⊥ `dir`;
+    /// S2 = S3 = 0), or None when this light is unpolarised there (every light but a
+    /// physical rainbow sky: `SceneSky::linear_table`).
+    #[inline]
+    pub fn le_linear<const N: usize>(
+        &self,
+        dir: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> Option<(SampledSpectrum<N>, Vec3)> {
+        match self {
+            Light::Environment(l) => l.le_linear(dir, wl),
+            _ => None,
+        }
+    }
+
     /// An emitted ray; `u1` picks the position (or, at infinity, the direction) and `u2`
     /// the other.
     #[inline]

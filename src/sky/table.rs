@@ -6,10 +6,11 @@
 //! band and the secondary bow, where profiles change fastest) and 0.25° elsewhere; λ
 //! every 5 nm over 360–830 nm. Interpolating between 5 nm rows moves a bow by at most
 //! its own dispersion over 5 nm (≈ 0.03°), well inside the sun's 0.53° disk.
-use super::Sky;
+use super::{Polarisation, Sky, SkyModel, SkySpec};
 use crate::spectrum::{DenseSpectrum, LAMBDA_MAX, LAMBDA_MIN};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 const FINE_FROM: f64 = 35.0;
 const FINE_TO: f64 = 56.0;
@@ -61,6 +62,20 @@ impl SkyTable {
             theta_deg,
             n_lambda,
             values: rows.concat(),
+        }
+    }
+
+    /// The table whose every value is `f(a, b)` of `self`'s and `other`'s (same grid).
+    fn combine(&self, other: &SkyTable, f: impl Fn(f32, f32) -> f32) -> SkyTable {
+        SkyTable {
+            theta_deg: self.theta_deg.clone(),
+            n_lambda: self.n_lambda,
+            values: self
+                .values
+                .iter()
+                .zip(&other.values)
+                .map(|(&a, &b)| f(a, b))
+                .collect(),
         }
     }
 
@@ -117,6 +132,10 @@ pub struct SceneSky {
     /// True when the model already contains the background (aristotle, constant), so it
     /// replaces it rather than adding to it.
     pub replaces_background: bool,
+    /// The spec the model was built from, for the polarised table ([`Self::linear_table`]).
+    spec: Option<SkySpec>,
+    /// S1 of the scattered sunlight, built on first use (polarised renders only).
+    linear: OnceLock<Option<SkyTable>>,
 }
 
 impl SceneSky {
@@ -130,20 +149,78 @@ impl SceneSky {
         factor: DenseSpectrum,
         replaces_background: bool,
     ) -> SceneSky {
-        if let Sky::Mie(m) = &mut sky {
-            if m.drops.len() > 1 {
-                // One Mie series per node and wavelength: a table every 10 nm, interpolated
-                // (the bows move by ≤ 0.06° over 10 nm, well inside the 0.53° disk), halves
-                // the scene's 95 wavelengths of the sky table.
-                m.lambda_step_nm = 10.0;
-            }
-        }
+        prepare(&mut sky);
         SceneSky {
             table: SkyTable::build(&sky),
             model,
             sun_dir,
             factor,
             replaces_background,
+            spec: None,
+            linear: OnceLock::new(),
+        }
+    }
+
+    /// This sky with the spec its model was built from, so that a polarised render can
+    /// tabulate its polarisation.
+    pub fn with_spec(mut self, spec: SkySpec) -> SceneSky {
+        self.spec = Some(spec);
+        self
+    }
+
+    /// The linear polarisation of the sky light, S1 per unit solar irradiance over
+    /// (θ, λ) (times `factor`, as the radiance table), in the frame x̂ perpendicular to
+    /// the scattering plane (the plane of the sun, the drop and the observer): a
+    /// sphere scatters the s and p components of unpolarised sunlight independently,
+    /// with the intensities I_s and I_p of the model's `s` and `p` profiles, so the
+    /// scattered light is S = ((I_s + I_p)/2, (I_s − I_p)/2, 0, 0) (Bohren & Huffman
+    /// 1983, eq. 4.77 with an unpolarised incident beam: F11 and F12 only; Können 1985,
+    /// "Polarized light in nature", ch. 10, for the bows' tangential polarisation). With
+    /// the model's `polarisation = "s"` or `"p"` the sunlight is taken polarised that
+    /// way, S1 = +S0 or −S0. None for the constant and Aristotelian skies, which are
+    /// unpolarised. Tabulated on first call (twice the cost of the radiance table for an
+    /// unpolarised sun); only polarised renders call it.
+    pub fn linear_table(&self) -> Option<&SkyTable> {
+        self.linear.get_or_init(|| self.build_linear()).as_ref()
+    }
+
+    fn build_linear(&self) -> Option<SkyTable> {
+        let spec = self.spec.as_ref()?;
+        if !SkyModel::from_name(&spec.model).is_some_and(SkyModel::is_physical) {
+            return None;
+        }
+        let pol = spec
+            .polarisation
+            .as_deref()
+            .and_then(Polarisation::from_name)
+            .unwrap_or_default();
+        let table = |name: &str| {
+            let mut s = spec.clone();
+            s.polarisation = Some(name.into());
+            // The spec was built once already: it builds again.
+            let mut sky = s.build(&|k| format!("{k:?}")).ok()?;
+            prepare(&mut sky);
+            Some(SkyTable::build(&sky))
+        };
+        match pol {
+            Polarisation::Unpolarised => {
+                let (ts, tp) = (table("s")?, table("p")?);
+                Some(ts.combine(&tp, |s, p| 0.5 * (s - p)))
+            }
+            Polarisation::S => Some(self.table.combine(&self.table, |s, _| s)),
+            Polarisation::P => Some(self.table.combine(&self.table, |p, _| -p)),
+        }
+    }
+}
+
+/// Settings of a model that only its tabulation for rendering changes.
+fn prepare(sky: &mut Sky) {
+    if let Sky::Mie(m) = sky {
+        if m.drops.len() > 1 {
+            // One Mie series per node and wavelength: a table every 10 nm, interpolated
+            // (the bows move by ≤ 0.06° over 10 nm, well inside the 0.53° disk), halves
+            // the scene's 95 wavelengths of the sky table.
+            m.lambda_step_nm = 10.0;
         }
     }
 }

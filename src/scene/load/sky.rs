@@ -13,6 +13,7 @@ use glam::Vec3;
 pub(super) struct SkyPlan {
     model: String,
     sky: Sky,
+    spec: SkySpec,
     sun_dir: Vec3,
     factor: DenseSpectrum,
     replaces_background: bool,
@@ -28,6 +29,7 @@ impl SkyPlan {
             self.factor,
             self.replaces_background,
         )
+        .with_spec(self.spec)
     }
 }
 
@@ -89,6 +91,7 @@ pub(super) fn plan_sky(
     Ok(SkyPlan {
         model: sf.model.clone(),
         sky,
+        spec,
         sun_dir: -sun.direction,
         factor: if physical {
             sun.irradiance.scaled(scale)
