@@ -30,7 +30,6 @@ use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{Scene, SceneParts};
 use heron::settings::{IntegratorKind, SamplerKind, WavelengthSampler};
-use heron::sky::SceneSky;
 use heron::spectrum::{DenseSpectrum, SampledWavelengths};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -471,13 +470,7 @@ irradiance = 1.0
         let factor = DenseSpectrum::from_fn(|lambda| {
             table.factor.eval(lambda) * scale(m.sigma_t.eval(lambda) as f64, cos_c) as f32
         });
-        let sky = SceneSky {
-            model: table.model.clone(),
-            table: table.table.clone(),
-            sun_dir: table.sun_dir,
-            factor,
-            replaces_background: table.replaces_background,
-        };
+        let sky = table.with_factor(factor);
         Scene::from_parts(SceneParts {
             source: file.source.clone(),
             source_sha256: String::new(),

@@ -161,6 +161,20 @@ impl SceneSky {
         }
     }
 
+    /// The same sky with the per-wavelength factor `factor` in place of its own (the
+    /// tables are shared in value, the polarised one built anew when asked).
+    pub fn with_factor(&self, factor: DenseSpectrum) -> SceneSky {
+        SceneSky {
+            model: self.model.clone(),
+            table: self.table.clone(),
+            sun_dir: self.sun_dir,
+            factor,
+            replaces_background: self.replaces_background,
+            spec: self.spec.clone(),
+            linear: OnceLock::new(),
+        }
+    }
+
     /// This sky with the spec its model was built from, so that a polarised render can
     /// tabulate its polarisation.
     pub fn with_spec(mut self, spec: SkySpec) -> SceneSky {
