@@ -13,8 +13,8 @@
 //!
 //! - [`mueller`]: Stokes vectors and Mueller matrices (Collett 2005's convention): the
 //!   Fresnel reflection and transmission of dielectrics and conductors with their
-//!   retardance, polarisers, retarders, rotations (the algebra the polarised transport
-//!   of issue 20 is to be built on).
+//!   retardance, polarisers, retarders, rotations (the closed forms the materials'
+//!   Mueller matrices for polarised transport are computed from, `crate::bsdf::polarization`).
 //!
 //! Layer 2 ("physics", `../shared/DESIGN.md`): this module imports nothing of heron's
 //! (only `num-complex`); `sky` and `medium` import it, never the reverse.

@@ -1,5 +1,6 @@
-//! Stokes vectors and Mueller matrices: the algebra of polarised light, for the
-//! polarised transport of issue 20 (not yet wired into the renderer).
+//! Stokes vectors and Mueller matrices: the algebra of polarised light, in f64, from
+//! which the materials build the matrices of polarised transport
+//! (`crate::bsdf::polarization`, `crate::integrator::polarized`).
 //!
 //! # Convention
 //!
