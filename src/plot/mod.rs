@@ -2,7 +2,9 @@
 //! `heron converge --plot` ([`converge`]: error against time, log–log, with the 1/√t
 //! slope) and `heron sky profile --plot` ([`sky`]: radiance against the angle from the
 //! antisolar point, one line per wavelength). The figure sets in `papers/` keep
-//! matplotlib.
+//! matplotlib. [`stokes`] writes false-colour previews of a polarised render's degree
+//! and angle of linear polarisation (viridis; hue wheel with brightness = DoLP) with a
+//! colour-bar legend.
 //!
 //! Drawing is by the `plotters` crate's bitmap backend into an RGB buffer in memory,
 //! encoded as PNG by the `image` crate and written through [`Staged`] (a temporary file
@@ -20,6 +22,7 @@
 //! [`PALETTE`], without its yellow, which does not show on white.
 pub mod converge;
 pub mod sky;
+pub mod stokes;
 
 use crate::files::Staged;
 use crate::{HeronError, Result};
