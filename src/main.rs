@@ -1331,6 +1331,14 @@ fn write_image(
     exr.commit()?;
     if let Some(p) = png {
         p.commit()?;
+        if film.stokes.is_some() {
+            // A polarised render's previews of its degree and angle of polarisation.
+            heron::plot::stokes::write_previews(
+                film,
+                &exr_path.with_extension("dolp.png"),
+                &exr_path.with_extension("aolp.png"),
+            )?;
+        }
     }
     Ok(())
 }
