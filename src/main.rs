@@ -652,6 +652,20 @@ struct TraceArgs {
     /// internal reflection forces R), e.g. TRT for the primary rainbow ray.
     #[arg(long, default_value = "")]
     path: String,
+    /// Also report the light's Stokes vector after each event, starting from S0,S1,S2,S3
+    /// (e.g. 1,0,0,0, unpolarised) in a frame of the ray's choosing, which the first
+    /// event's output names; `stokes_x` is each output's frame (x̂; S1 > 0 along it).
+    #[arg(long, value_name = "S0,S1,S2,S3", value_parser = parse_stokes, allow_hyphen_values = true)]
+    stokes: Option<[f64; 4]>,
+}
+
+fn parse_stokes(s: &str) -> std::result::Result<[f64; 4], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| format!("expected S0,S1,S2,S3 (four numbers), got {s:?}"))?;
+    <[f64; 4]>::try_from(v).map_err(|_| format!("expected S0,S1,S2,S3 (four numbers), got {s:?}"))
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<[f32; 3], String> {
@@ -1510,6 +1524,7 @@ fn cmd_trace(a: TraceArgs) -> Result<()> {
         a.dir.into(),
         a.lambda,
         &choices,
+        a.stokes,
     )?;
     println!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())

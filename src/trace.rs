@@ -8,6 +8,14 @@
 //! Surfaces with only a reflecting delta lobe (mirrors, smooth metals) reflect; the
 //! others (Lambertian, glossy, rough) absorb; a miss escapes.
 //!
+//! With a Stokes vector to start from (`heron trace --stokes`), each event also reports
+//! the light's Stokes vector after it, as power: the event's Mueller matrix (the
+//! material's, `BsdfModel::mueller`, scaled so that its [0][0] is the unpolarised power
+//! fraction of the event, R or 1 − R) applied after rotating the vector into the
+//! event's frame, and the frame's x̂ (the s direction of the plane of incidence at a
+//! Fresnel event; `spectrum::stokes` has the convention). The light travels along the
+//! traced ray.
+//!
 //! Embree finds the shape a ray hits; the hit itself (distance, and a triangle's
 //! barycentrics and normal) is then recomputed in f64 from the shape's own description
 //! ([`refine`]). Embree's kernels differ between instruction sets (AVX2, AVX-512) in the
@@ -54,6 +62,12 @@ pub struct TraceEvent {
     pub fresnel_r: Option<f32>,
     /// Distance travelled from the previous event (absent for `escape`).
     pub distance: Option<f32>,
+    /// With `--stokes`: the light's Stokes vector after the event (power), in the frame
+    /// whose x̂ is `stokes_x`; absent otherwise and after an absorption.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stokes: Option<[f64; 4]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stokes_x: Option<[f32; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -146,6 +160,7 @@ pub fn trace(
     dir: Vec3,
     lambda_nm: f32,
     reflect_at: &[bool],
+    stokes: Option<[f64; 4]>,
 ) -> Result<TraceReport> {
     if !origin.is_finite() || !dir.is_finite() || dir.length_squared() == 0.0 {
         return Err(HeronError::Invalid(
@@ -159,7 +174,17 @@ pub fn trace(
     }
     // Offsets as a render of the scene's own integrator would make them.
     let offset = scene.settings.ray_offset(scene.settings.integrator);
+    if let Some(st) = stokes {
+        let pol = (st[1] * st[1] + st[2] * st[2] + st[3] * st[3]).sqrt();
+        if !st.iter().all(|v| v.is_finite()) || !(st[0] > 0.0) || pol > st[0] * (1.0 + 1e-9) {
+            return Err(HeronError::Invalid(format!(
+                "--stokes: expected S0,S1,S2,S3 with S0 > 0 and S1² + S2² + S3² ≤ S0² (a physical state), got {st:?}"
+            )));
+        }
+    }
     let mut ray = Ray::new(origin, dir.normalize(), 0.0, f32::INFINITY);
+    // The light's state and its frame's x̂ (⊥ the ray), when asked.
+    let mut pol = stokes.map(|st| (st, crate::spectrum::stokes::any_perpendicular(ray.dir)));
     let mut events = Vec::new();
     let mut dielectric_events = 0usize;
     for _ in 0..=scene.settings.max_depth {
@@ -181,6 +206,8 @@ pub fn trace(
                 outgoing: Some(arr(ray.dir)),
                 fresnel_r: None,
                 distance: None,
+                stokes: pol.map(|p| p.0),
+                stokes_x: pol.map(|p| arr(p.1)),
             });
             return Ok(TraceReport {
                 lambda_nm,
@@ -202,6 +229,8 @@ pub fn trace(
             outgoing: None,
             fresnel_r: None,
             distance: Some(hit.t),
+            stokes: None,
+            stokes_x: None,
         };
         let flags = material.flags();
         let frame = it.frame();
@@ -248,6 +277,41 @@ pub fn trace(
             None
         };
         ev.outgoing = out.map(arr);
+        if let (Some((st, x)), Some(d)) = (pol, out) {
+            // The material's ωi is where the light comes from (−ray), ωo where it goes.
+            let fraction = match ev.kind {
+                EventKind::Refract => 1.0 - ev.fresnel_r.unwrap_or(0.0) as f64,
+                EventKind::TotalInternalReflection => 1.0,
+                _ => ev.fresnel_r.map_or_else(
+                    || {
+                        let ctx = BsdfContext::radiance::<1>()
+                            .with_lobes(LobeFlags::SPECULAR | LobeFlags::REFLECTION);
+                        material
+                            .sample(wo_local, 0.5, Vec2::ZERO, &wl, &ctx)
+                            .map_or(0.0, |b| b.weight().0[0] as f64)
+                    },
+                    |r| r as f64,
+                ),
+            };
+            let (m, x_in, x_out) =
+                match material.mueller(frame.to_local(d), wo_local, flags, &wl, &frame) {
+                    crate::bsdf::Polarizing::Mueller { m, x_in, x_out } => {
+                        (m[0], frame.to_world(x_in), frame.to_world(x_out))
+                    }
+                    crate::bsdf::Polarizing::Depolarizing => (
+                        glam::Mat4::from_diagonal(glam::Vec4::new(1.0, 0.0, 0.0, 0.0)),
+                        x,
+                        crate::spectrum::stokes::any_perpendicular(d),
+                    ),
+                };
+            let r = crate::spectrum::stokes::rotate_basis(ray.dir, x, x_in);
+            let v = glam::Vec4::new(st[0] as f32, st[1] as f32, st[2] as f32, st[3] as f32);
+            let out_st = (m * (r * v)) * fraction as f32;
+            let after = out_st.to_array().map(f64::from);
+            ev.stokes = Some(after);
+            ev.stokes_x = Some(arr(x_out));
+            pol = Some((after, x_out));
+        }
         events.push(ev);
         let Some(d) = out else {
             return Ok(TraceReport {

@@ -338,7 +338,16 @@ fn traced_raster(scene: &Scene, r: &Renderer, lambda: f32) -> (f32, f32) {
     };
     let centre = slit.origin + 0.5 * slit.edge1 + 0.5 * slit.edge2;
     let dir = Vec3::new(0.8370, 0.5473, 0.0);
-    let rep = heron::trace::trace(scene, r.accel(), centre - 0.01 * dir, dir, lambda, &[]).unwrap();
+    let rep = heron::trace::trace(
+        scene,
+        r.accel(),
+        centre - 0.01 * dir,
+        dir,
+        lambda,
+        &[],
+        None,
+    )
+    .unwrap();
     let last = rep.events.last().unwrap();
     assert_eq!(
         scene_material(scene, last),

@@ -295,3 +295,67 @@ fn what_polarised_transport_does_not_support_is_a_clear_error() {
         "{e}"
     );
 }
+
+#[test]
+fn heron_trace_follows_the_stokes_vector_event_by_event() {
+    let s = scene(
+        &std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/brewster.toml"),
+        )
+        .unwrap(),
+    );
+    let r = heron::render::Renderer::new(&s).unwrap();
+    let tb = 1.5f32.atan();
+    let (c, sn) = (tb.cos(), tb.sin());
+    let origin = glam::Vec3::new(0.0, 4.0 * c, -4.0 * sn);
+    let dir = glam::Vec3::new(0.0, -c, sn);
+    // Unpolarised light reflected at Brewster's angle: (R, R, 0, 0) in the s frame, with
+    // R = R_s/2 the unpolarised reflectance.
+    let rep = heron::trace::trace(
+        &s,
+        r.accel(),
+        origin,
+        dir,
+        550.0,
+        &[true],
+        Some([1.0, 0.0, 0.0, 0.0]),
+    )
+    .unwrap();
+    let ev = &rep.events[0];
+    let st = ev.stokes.unwrap();
+    let rf = ev.fresnel_r.unwrap() as f64;
+    assert!(
+        (st[0] - rf).abs() < 1e-6 && (st[1] - st[0]).abs() < 1e-5 * st[0],
+        "{st:?}"
+    );
+    assert!(st[2].abs() < 1e-6 && st[3].abs() < 1e-6);
+    // The s direction is perpendicular to the plane of incidence (the yz plane): ±x.
+    assert!((ev.stokes_x.unwrap()[0].abs() - 1.0).abs() < 1e-6);
+    // p-polarised light is not reflected at all. The starting frame is the tracer's
+    // choice (`any_perpendicular`: x̂ = +x for this ray, the s direction), so S1 = −S0
+    // is p there, and S1 = +S0 is s, reflected with R_s = 2R.
+    let run = |st: [f64; 4]| {
+        heron::trace::trace(&s, r.accel(), origin, dir, 550.0, &[true], Some(st))
+            .unwrap()
+            .events[0]
+            .stokes
+            .unwrap()
+    };
+    assert!(run([1.0, -1.0, 0.0, 0.0])[0] < 1e-6);
+    assert!((run([1.0, 1.0, 0.0, 0.0])[0] - 2.0 * rf).abs() < 1e-5);
+    // Without --stokes the JSON has no Stokes fields; a non-physical state is an error.
+    let plain = heron::trace::trace(&s, r.accel(), origin, dir, 550.0, &[true], None).unwrap();
+    assert!(plain.events.iter().all(|e| e.stokes.is_none()));
+    let e = heron::trace::trace(
+        &s,
+        r.accel(),
+        origin,
+        dir,
+        550.0,
+        &[],
+        Some([1.0, 1.0, 1.0, 0.0]),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--stokes") && e.contains("physical"), "{e}");
+}

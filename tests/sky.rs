@@ -579,8 +579,8 @@ fn monte_carlo_bows_through_heron_tracer_peak_at_descartes_angles() {
                     let b = rng.uniform().sqrt() * 0.999_999;
                     let phi = std::f32::consts::TAU * rng.uniform();
                     let o = Vec3::new(b * phi.cos(), b * phi.sin(), -5.0);
-                    let rep =
-                        heron::trace::trace(&scene, accel, o, Vec3::Z, lambda, &path).unwrap();
+                    let rep = heron::trace::trace(&scene, accel, o, Vec3::Z, lambda, &path, None)
+                        .unwrap();
                     let last = rep.events.last().unwrap();
                     assert_eq!(rep.events.len(), k as usize + 3);
                     let out = Vec3::from_array(last.outgoing.unwrap())

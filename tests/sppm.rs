@@ -351,7 +351,8 @@ fn screen_point(scene: &Scene, accel: &heron::accel::embree::Scene, lambda: f32)
     };
     let centre = slit.origin + 0.5 * slit.edge1 + 0.5 * slit.edge2;
     let dir = glam::Vec3::new(0.8370, 0.5473, 0.0);
-    let rep = heron::trace::trace(scene, accel, centre - 0.01 * dir, dir, lambda, &[]).unwrap();
+    let rep =
+        heron::trace::trace(scene, accel, centre - 0.01 * dir, dir, lambda, &[], None).unwrap();
     let last = rep.events.last().unwrap();
     assert_eq!(
         last.material.as_deref(),
@@ -374,7 +375,7 @@ fn film_position_of(
     let land = |x: f64, y: f64| -> glam::DVec3 {
         let cam = &scene.camera;
         let d = cam.direction(x as f32, y as f32);
-        let rep = heron::trace::trace(scene, accel, cam.eye, d, lambda, &[]).unwrap();
+        let rep = heron::trace::trace(scene, accel, cam.eye, d, lambda, &[], None).unwrap();
         let last = rep.events.last().unwrap();
         assert_eq!(
             last.material.as_deref(),

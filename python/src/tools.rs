@@ -57,6 +57,7 @@ pub fn trace<'py>(
                     direction,
                     wavelength as f32,
                     &choices,
+                    None,
                 )
             })
             .map_err(|e| lib_err(e, RENAMES))?;
