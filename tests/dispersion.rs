@@ -89,7 +89,7 @@ fn angle_deg(a: Vec3, b: Vec3) -> f64 {
 }
 
 fn run(s: &Scene, r: &Renderer, o: Vec3, d: Vec3, l: f32, path: &[bool]) -> TraceReport {
-    trace(s, r.accel(), o, d, l, path).unwrap()
+    trace(s, r.accel(), o, d, l, path, None).unwrap()
 }
 
 #[test]
