@@ -6,8 +6,8 @@
 use crate::error::HeronError;
 use crate::scene::file::{
     show, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile,
-    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, QuadFile, ShapeFile,
-    SphereFile, SpotLightFile, SunLightFile, TriangleFile, WavesFile,
+    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, PolarizerFile, QuadFile,
+    RetarderFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile, TriangleFile, WavesFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -186,6 +186,8 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("materials", "dielectric") => check::<DielectricFile>(t),
         ("materials", "glossy") => check::<GlossyFile>(t),
         ("materials", "conductor") => check::<ConductorFile>(t),
+        ("materials", "polarizer") => check::<PolarizerFile>(t),
+        ("materials", "retarder") => check::<RetarderFile>(t),
         ("shapes", "sphere") => check::<SphereFile>(t),
         ("shapes", "triangle") => check::<TriangleFile>(t),
         ("shapes", "plane") => check::<PlaneFile>(t),
