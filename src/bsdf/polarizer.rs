@@ -17,9 +17,12 @@
 //! The axis is given in world space (`axis`, projected onto the sheet) and turned by
 //! `angle` about the sheet's outward normal, counter-clockwise as seen from the side
 //! the normal points to (Mitsuba 3's `polarizer` measures its angle from the shape's
-//! tangent instead). As a BSDF it is a delta transmission ωi = −ωo of weight
+//! tangent instead). An oblique ray is transmitted along the axis of Korger et al.
+//! 2013 (`polarization::polarizer_axis`: perpendicular to the ray and to the absorption
+//! axis, the in-sheet axis across the transmission axis, projected across the ray), as
+//! Mitsuba's `polarizer` does. As a BSDF it is a delta transmission ωi = −ωo of weight
 //! ½ (t_x + t_y), wavelength-independent.
-use super::polarization::{normalized, sheet_axis, Polarizing};
+use super::polarization::{normalized, polarizer_axis, Polarizing};
 use super::{BsdfContext, BsdfModel, BsdfSample, LobeFlags};
 use crate::math::Frame;
 use crate::optics::mueller::Mueller;
@@ -95,7 +98,7 @@ impl BsdfModel for Polarizer {
         _: &SampledWavelengths<N>,
         frame: &Frame,
     ) -> Polarizing<N> {
-        let x = sheet_axis(frame.to_local(self.axis), self.angle, wi);
+        let x = polarizer_axis(frame.to_local(self.axis), self.angle, wi);
         let m: Mat4 = normalized(&self.matrix());
         Polarizing::Mueller {
             m: [m; N],

@@ -32,7 +32,12 @@
 //!   0                    0                    C   S
 //!   0                    0                   −S   C
 //!
-//! with C = Re(r_s r_p*), S = Im(r_s r_p*). So at normal incidence on glass it is
+//! with C = Re(r_s r_p*), S = −Im(r_s r_p*) = Im(r_s* r_p). The minus: Born & Wolf's
+//! amplitudes belong to the time dependence e^{−iωt} (an absorbing index n + ik), and
+//! Collett's S3 > 0 for right-circular light is written for the opposite one, whose
+//! amplitudes are these' complex conjugates (Mitsuba's `fresnel_polarized` takes
+//! n − ik for the same reason; `mueller.h`'s `specular_reflection` has −c sin δ at
+//! [2][3] with δ = arg a_p − arg a_s). So at normal incidence on glass it is
 //! R · diag(1, 1, −1, −1), a half-wave retarder, and at Brewster's angle (r_p = 0) a
 //! polariser along s.
 use num_complex::Complex64;
@@ -158,7 +163,8 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> (Complex64, Complex64, 
 pub fn reflection(cos_i: f64, eta: Complex64) -> Mueller {
     let (rs, rp, _) = fresnel_amplitudes(cos_i, eta);
     let (s2, p2) = (rs.norm_sqr(), rp.norm_sqr());
-    let x = rs * rp.conj();
+    // r_s* r_p: the conjugate time convention's r_s r_p* (module docs).
+    let x = rs.conj() * rp;
     let (a, b) = (0.5 * (s2 + p2), 0.5 * (s2 - p2));
     Mueller([
         [a, b, 0.0, 0.0],
@@ -274,6 +280,25 @@ mod tests {
             );
             assert!(transmission(th.cos(), eta).0[0][0] == 0.0);
         }
+    }
+
+    /// The sign of the retardance (S3's handedness) against Mitsuba 3.9.1's
+    /// `mi.mueller.specular_reflection` in `scalar_spectral_polarized`, evaluated at 60°
+    /// (values printed by it, to its f32 precision): a conductor n = 1, k = 2.5, and
+    /// total internal reflection at η = 1/1.5.
+    #[test]
+    fn retardance_has_mitsubas_sign() {
+        let c = 60f64.to_radians().cos();
+        let m = reflection(c, Complex64::new(1.0, 2.5));
+        let want = [0.6145143, 0.17434072, -0.33963892, -0.4815376];
+        let got = [m.0[0][0], m.0[0][1], m.0[2][2], m.0[2][3]];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-6, "{got:?} vs {want:?}");
+        }
+        assert!((m.0[3][2] + m.0[2][3]).abs() < 1e-15);
+        let m = reflection(c, Complex64::new(1.0 / 1.5, 0.0));
+        assert!((m.0[2][2] - 0.76086962).abs() < 1e-6, "{:?}", m.0);
+        assert!((m.0[2][3] + 0.64890486).abs() < 1e-6, "{:?}", m.0);
     }
 
     #[test]

@@ -22,9 +22,22 @@ What maps onto what:
 | `background` | `constant` emitter |
 | `point` light | `point` emitter with heron's intensity spectrum |
 | `max_depth` (scattering events) | `path` max_depth = heron's + 1 (Mitsuba counts vertices) |
+| ideal `polarizer` on a `quad` | `polarizer`: theta from heron's axis (below), transmittance t_x |
 
-Anything else (OBJ meshes, dispersive glass, directional, spot and sun lights…) raises
-ValueError: the comparison covers what both renderers model the same way.
+Anything else (OBJ meshes, dispersive glass, directional, spot and sun lights, a
+polariser on a sphere or a mesh, a partial polariser, retarders…) raises ValueError: the
+comparison covers what both renderers model the same way.
+
+The polariser's axis. heron's transmission axis is the scene vector `axis` projected onto
+the sheet and turned by `angle` about the outward normal n = edge1 × edge2,
+counter-clockwise seen from the side n points to. Mitsuba's `polarizer` absorbs along
+(sin θ, cos θ, 0) of the rectangle's shading frame (s = edge1 normalised, t = n × s,
+Mitsuba's mesh frame from its texture coordinates), so it transmits along
+(cos θ, −sin θ, 0): θ = −atan2(a·t, a·s) for heron's in-plane axis a (θ = −angle when
+`axis` is along edge1). Both models are the ideal diattenuator at normal incidence; for an
+oblique ray heron projects the transmission axis perpendicular to the ray while Mitsuba
+(Korger et al. 2013) projects the absorption axis and transmits across it, which differ at
+second order in the angle of incidence (test_mitsuba_polarized.py measures it).
 """
 from __future__ import annotations
 
@@ -77,6 +90,43 @@ def _bsdf(m: dict, name: str) -> dict:
         return {"type": "roughdielectric", "distribution": "ggx", "alpha": m["alpha"],
                 "sample_visible": True, **d}
     raise ValueError(f"{name}: no Mitsuba counterpart for heron's {t}")
+
+
+def _polarizer(m: dict, name: str, shape: dict, i: int) -> dict:
+    """Mitsuba's `polarizer` for heron's polariser material `m` on quad `shape`."""
+    if shape["type"] != "quad":
+        raise ValueError(f"shapes[{i}]: the polarizer {name} on a {shape['type']} is not "
+                         "converted (only quads)")
+    if m["t_y"] != 0.0:
+        raise ValueError(f"{name}: Mitsuba's polarizer is ideal (no extinction_ratio)")
+    e1, e2 = (list(map(float, shape[k])) for k in ("edge1", "edge2"))
+    n = _unit(_cross(e1, e2))
+    s = _unit([e1[j] - _dot(e1, n) * n[j] for j in range(3)])
+    t = _cross(n, s)
+    axis = list(map(float, m["axis"]))
+    a = [axis[j] - _dot(axis, n) * n[j] for j in range(3)]
+    if _dot(a, a) < 1e-12:
+        raise ValueError(f"{name}: axis along the normal of shapes[{i}] is not converted")
+    a = _unit(a)
+    # turned by `angle` (radians in `heron spectra`) about n, counter-clockwise seen from n
+    c, sn = math.cos(m["angle"]), math.sin(m["angle"])
+    na = _cross(n, a)
+    a = [c * a[j] + sn * na[j] for j in range(3)]
+    theta = -math.degrees(math.atan2(_dot(a, t), _dot(a, s)))
+    return {"type": "polarizer", "theta": theta, "transmittance": float(m["t_x"])}
+
+
+def _dot(a, b) -> float:
+    return sum(x * y for x, y in zip(a, b))
+
+
+def _cross(a, b) -> list:
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _unit(a) -> list:
+    ln = math.sqrt(_dot(a, a))
+    return [x / ln for x in a]
 
 
 def _look_at(mi, eye, target, up):
@@ -142,6 +192,8 @@ def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, hei
         if name.startswith("("):
             scene["bsdf-black"] = {"type": "diffuse", "reflectance": 0.0}
             continue
+        if m["type"] == "polarizer":
+            continue  # one per shape: its theta depends on the shape's frame
         scene[f"bsdf-{name}"] = _bsdf(m, name)
     for i, (s, sp) in enumerate(zip(doc.get("shapes", []), spectra["shapes"])):
         t = s["type"]
@@ -159,7 +211,11 @@ def mitsuba_dict(mi, scene_path: pathlib.Path, spectra: dict, *, width=None, hei
         else:
             raise ValueError(f"shapes[{i}]: {t} is not converted")
         mat = sp["material"]
-        shape["bsdf"] = {"type": "ref", "id": "bsdf-black" if mat.startswith("(") else f"bsdf-{mat}"}
+        if spectra["materials"].get(mat, {}).get("type") == "polarizer":
+            shape["bsdf"] = _polarizer(spectra["materials"][mat], mat, s, i)
+        else:
+            shape["bsdf"] = {"type": "ref",
+                             "id": "bsdf-black" if mat.startswith("(") else f"bsdf-{mat}"}
         if sp["emission"] is not None:
             if sp["two_sided"]:
                 raise ValueError(f"shapes[{i}]: Mitsuba's area emitter is one-sided")
