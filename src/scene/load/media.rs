@@ -119,7 +119,8 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String>
         }
     };
     for n in &nodes {
-        if !(1e-4..=1.0).contains(&n.radius_mm) {
+        // The bounds as f32, as the scene's numbers are read: 0.0001 is then allowed.
+        if !((1e-4f32 as f64)..=1.0).contains(&n.radius_mm) {
             return Err(if dist.is_some() {
                 format!(
                     "{at}.drops: expected drop radii in [0.0001, 1] mm (larger drops take minutes to tabulate), but the distribution has a quadrature node at {:.4} mm",
