@@ -258,6 +258,20 @@ enum SkyCommand {
         #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
         step: f64,
     },
+    /// The phase table (p and F12, F33, F34 over F11) of a medium of one drop radius at
+    /// one wavelength node, for tests/python/test_mie.py.
+    #[command(hide = true)]
+    MieMatrix {
+        /// Drop radius, μm.
+        #[arg(long, allow_hyphen_values = true)]
+        radius_um: f64,
+        /// Wavelength node, nm (360 to 830 in steps of 10).
+        #[arg(long, allow_hyphen_values = true)]
+        lambda: f64,
+        /// With water's absorption (its imaginary index).
+        #[arg(long)]
+        absorption: bool,
+    },
 }
 
 #[derive(clap::Args)]
@@ -463,6 +477,11 @@ fn cmd_sky(c: SkyCommand) -> Result<()> {
             to,
             step,
         } => heron::sky::profile::mie_phase_csv(m, x, from, to, step)?,
+        SkyCommand::MieMatrix {
+            radius_um,
+            lambda,
+            absorption,
+        } => heron::medium::homogeneous::matrix_csv(radius_um, lambda, absorption)?,
     };
     print!("{csv}");
     Ok(())

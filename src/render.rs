@@ -253,12 +253,7 @@ fn render_with(
         }
     }
     if opts.settings.polarization {
-        integrator::stokes_kernel::<1>(kind).map_err(HeronError::Invalid)?;
-        if !scene.media.is_empty() {
-            return Err(HeronError::Invalid(
-                "polarization: participating media are not polarised yet (their phase matrices are not in the transport); render this scene without polarization".into(),
-            ));
-        }
+        integrator::stokes_kernel::<1>(kind, 0).map_err(HeronError::Invalid)?;
         if opts.settings.spectral_bins > 0 {
             return Err(HeronError::Invalid(
                 "polarization: spectral bins of S1-S3 are not written yet; render with spectral_bins = 0 (the EXR has S0-S3 in linear sRGB)".into(),
@@ -279,6 +274,12 @@ fn render_with(
     let k = Features::of(scene)
         .choose(kind, opts.settings.kernel)
         .map_err(HeronError::Invalid)?;
+    // Polarised transport has two kernels: with media and without.
+    let k = if opts.settings.polarization {
+        integrator::stokes_flags(kind, k)
+    } else {
+        k
+    };
     if kind == IntegratorKind::Sppm {
         // Rays one at a time: the camera pass follows specular chains and the photons
         // scatter from wherever the lights put them, so neither has packets.
@@ -319,12 +320,12 @@ fn render_with(
             // Checked above: the integrator has a polarised kernel.
             const WHY: &str = "a polarised kernel";
             return match n {
-                Lanes::One => SampleFn::StokesOne(integrator::stokes_kernel::<1>(kind).expect(WHY)),
+                Lanes::One => SampleFn::StokesOne(integrator::stokes_kernel::<1>(kind, k).expect(WHY)),
                 Lanes::Four => {
-                    SampleFn::StokesFour(integrator::stokes_kernel::<4>(kind).expect(WHY))
+                    SampleFn::StokesFour(integrator::stokes_kernel::<4>(kind, k).expect(WHY))
                 }
                 Lanes::Eight => {
-                    SampleFn::StokesEight(integrator::stokes_kernel::<8>(kind).expect(WHY))
+                    SampleFn::StokesEight(integrator::stokes_kernel::<8>(kind, k).expect(WHY))
                 }
             };
         }

@@ -150,13 +150,20 @@ fn a_quarter_wave_plate_turns_45_degree_light_circular() {
 
 #[test]
 fn light_reflected_at_brewsters_angle_is_completely_polarised() {
+    // The path tracer and the seed's Whitted tracer (its delta reflection of the emitter).
+    for integrator in ["path", "whitted"] {
+        brewster_reflection(integrator);
+    }
+}
+
+fn brewster_reflection(integrator: &str) {
     // A glass plane (n = 1.5) seen at θB = atan 1.5 through a narrow field (±0.3°, where (R_s − R_p)/(R_s + R_p) > 0.9998),
     // reflecting a uniform emitter; what the glass transmits leaves the scene.
     let tb = 1.5f32.atan();
     let (c, s) = (tb.cos(), tb.sin());
     let t = format!(
         "background = 0.0\n[camera]\neye = [0.0, {ey}, {ez}]\nlook_at = [0.0, 0.0, 0.0]\nd = 100.0\nresolution = [16, 16]\n\
-[render]\nintegrator = \"path\"\npolarization = true\nspp = 64\nmax_depth = 3\n\
+[render]\nintegrator = \"{integrator}\"\npolarization = true\nspp = 64\nmax_depth = 3\n\
 [materials.glass]\ntype = \"dielectric\"\nior = 1.5\n[materials.black]\ntype = \"lambertian\"\nrho_d = 0.0\n\
 [[shapes]]\ntype = \"quad\"\norigin = [-50.0, 0.0, -50.0]\nedge1 = [0.0, 0.0, 100.0]\nedge2 = [100.0, 0.0, 0.0]\nmaterial = \"glass\"\n\
 [[shapes]]\ntype = \"quad\"\norigin = [-2.0, {oy}, {oz}]\nedge1 = [4.0, 0.0, 0.0]\nedge2 = [0.0, {e2y}, {e2z}]\nmaterial = \"black\"\nemission = 1.0\ntwo_sided = true\n",
@@ -179,11 +186,11 @@ fn light_reflected_at_brewsters_angle_is_completely_polarised() {
         }
         lit += 1;
         let dop = (p[0][1] as f64).hypot(p[1][1] as f64).hypot(p[2][1] as f64) / s0;
-        assert!(dop > 0.9995, "degree of polarisation {dop}");
+        assert!(dop > 0.9995, "{integrator}: degree of polarisation {dop}");
         // s-polarised is horizontal in this picture: S1 = +S0.
         assert!(p[0][1] > 0.0);
     }
-    assert!(lit > 100, "{lit} pixels saw the reflection");
+    assert!(lit > 100, "{integrator}: {lit} pixels saw the reflection");
     // And the intensity is Fresnel's: (R_s + 0)/2 of the emitter's Y (1), within 4
     // standard errors of the 256 pixels' mean (each pixel a mean of 64 Bernoulli
     // choices; SE ≈ 3% of the mean).
@@ -192,7 +199,7 @@ fn light_reflected_at_brewsters_angle_is_completely_polarised() {
     let rs = ((ci - 1.5 * ct) / (ci + 1.5 * ct)).powi(2);
     assert!(
         (y - 0.5 * rs).abs() < 4.0 * se,
-        "{y} ± {se} vs R_s/2 = {}",
+        "{integrator}: {y} ± {se} vs R_s/2 = {}",
         0.5 * rs
     );
 }
@@ -294,6 +301,27 @@ fn what_polarised_transport_does_not_support_is_a_clear_error() {
         e.contains("materials.p") && e.contains("expected a number"),
         "{e}"
     );
+    // A light's polarisation: its keys, ranges and degree.
+    let light = |p: &str| {
+        let t = format!("[camera]\neye = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nresolution = [8, 8]\n[[lights]]\ntype = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = 1.0\npolarization = {{ {p} }}\n");
+        load_scene_from_str(&t, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string()
+    };
+    let e = light("linear = 1.0");
+    assert!(e.contains("lights[0].polarization.axis"), "{e}");
+    let e = light("axis = [0.0, 0.0, 1.0], linear = 1.5");
+    assert!(
+        e.contains("lights[0].polarization.linear") && e.contains("[-1, 1]"),
+        "{e}"
+    );
+    let e = light("axis = [0.0, 0.0, 1.0], linear = 0.8, circular = 0.8");
+    assert!(
+        e.contains("lights[0].polarization") && e.contains("at most 1"),
+        "{e}"
+    );
+    let e = light("axis = [0.0, 0.0, 1.0], angle = 3.0");
+    assert!(e.contains("angle"), "{e}");
 }
 
 #[test]
@@ -358,4 +386,57 @@ fn heron_trace_follows_the_stokes_vector_event_by_event() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("--stokes") && e.contains("physical"), "{e}");
+}
+
+/// A directional light travelling at Brewster's angle for n = 1.5 onto a rough (α =
+/// 0.02) glass floor, seen along the mirror direction through a field of ±0.6°, with
+/// the light's `polarization` table `pol` (None: unpolarised).
+fn brewster_light_scene(pol: Option<&str>) -> Scene {
+    let tb = 1.5f32.atan();
+    let (s, c) = tb.sin_cos();
+    let pol = pol.map_or(String::new(), |p| format!("polarization = {{ {p} }}\n"));
+    scene(&format!(
+        "background = 0.0\n[camera]\neye = [{ex}, {ey}, 0.0]\nlook_at = [0.0, 0.0, 0.0]\nd = 50.0\nresolution = [8, 8]\n\
+         [render]\nintegrator = \"path\"\npolarization = true\nspp = 4\nmax_depth = 1\n\
+         [materials.glass]\ntype = \"dielectric\"\nior = 1.5\nroughness = 0.02\n\
+         [[shapes]]\ntype = \"quad\"\norigin = [-5.0, 0.0, -5.0]\nedge1 = [0.0, 0.0, 10.0]\nedge2 = [10.0, 0.0, 0.0]\nmaterial = \"glass\"\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [{s}, {mc}, 0.0]\nradiance = 1.0\n{pol}",
+        ex = 10.0 * s,
+        ey = 10.0 * c,
+        mc = -c,
+    ))
+}
+
+/// A light's own polarisation (`polarization` on a delta light): at Brewster's angle the
+/// glass reflects s-polarised light (the light's axis along z, perpendicular to the
+/// plane of incidence) with R_s, twice what it reflects of unpolarised light, and
+/// p-polarised light (linear = −1: across that axis) hardly at all; circular light
+/// reflects as unpolarised light does (a Fresnel matrix's first row is (A, B, 0, 0)).
+/// The four renders follow the same paths (the same random numbers and scalar weights),
+/// so the ratios are the Mueller algebra's, not noise; the microfacets (α = 0.02) spread
+/// the incidence over about ±1° of Brewster's angle, where R_p/R_s < 1e-3.
+#[test]
+fn a_polarised_light_is_reflected_at_brewsters_angle_as_its_state_says() {
+    let y = |p: Option<&str>| mean_stokes(&render_scene(&brewster_light_scene(p)))[0];
+    let unpolarised = y(None);
+    assert!(unpolarised > 0.0);
+    let s = y(Some("axis = [0.0, 0.0, 1.0]")) / unpolarised;
+    let p = y(Some("axis = [0.0, 0.0, 1.0], linear = -1.0")) / unpolarised;
+    let circular = y(Some("axis = [0.0, 0.0, 1.0], circular = 1.0")) / unpolarised;
+    assert!((s - 2.0).abs() < 0.01, "s-polarised: {s} of the unpolarised light");
+    assert!(p < 0.005, "p-polarised: {p} of the unpolarised light");
+    assert!((circular - 1.0).abs() < 1e-4, "circular: {circular}");
+    // The axis is projected across the ray: z tilted toward the light's direction of
+    // travel k is still s; z tilted within the plane of incidence (toward x, which has
+    // a part across k) is partly p, cos² of its angle to z after projection.
+    let (sn, c) = 1.5f32.atan().sin_cos();
+    let tilted = y(Some(&format!("axis = [{}, {}, 1.0]", 0.5 * sn, -0.5 * c))) / unpolarised;
+    assert!((tilted - s).abs() < 1e-4, "{tilted} vs {s}");
+    let k = glam::Vec3::new(sn, -c, 0.0);
+    let a = glam::Vec3::new(0.3, 0.0, 1.0);
+    let proj = (a - k * a.dot(k)).normalize();
+    let cos2 = proj.z as f64 * proj.z as f64;
+    let mixed = y(Some("axis = [0.3, 0.0, 1.0]")) / unpolarised;
+    let want = cos2 * s + (1.0 - cos2) * p;
+    assert!((mixed - want).abs() < 1e-3, "{mixed} vs {want}");
 }

@@ -82,7 +82,7 @@ pub type KernelFn<const N: usize, O> = fn(
 /// camera ray in the camera's frame (`integrator::polarized`).
 pub type StokesFn<const N: usize> = KernelFn<N, StokesSpectrum<N>>;
 
-fn polarized_path<const N: usize>(
+fn polarized_path<const N: usize, const K: KernelFlags>(
     ctx: &Context,
     ray: CameraRay,
     first_hit: Option<Option<Hit>>,
@@ -91,15 +91,47 @@ fn polarized_path<const N: usize>(
     counters: &mut TraceCounters,
     _: &mut Splats,
 ) -> StokesSpectrum<N> {
-    polarized::radiance(ctx, ray, first_hit, wl, sampler, counters)
+    polarized::radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
 }
 
-/// The polarised kernel of integrator `kind` with `N` lanes, or why there is none.
-pub fn stokes_kernel<const N: usize>(kind: IntegratorKind) -> Result<StokesFn<N>, String> {
+fn polarized_whitted<const N: usize, const K: KernelFlags>(
+    ctx: &Context,
+    ray: CameraRay,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    _: &mut Splats,
+) -> StokesSpectrum<N> {
+    polarized::whitted_radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
+}
+
+/// The kernel flags a polarised render with integrator `kind` of a scene whose flags
+/// are `k` runs with: every feature on but media, which only the path tracer's scenes
+/// with media pay for (two kernels per lane count, rather than 32, keep the build's
+/// time and size).
+pub fn stokes_flags(kind: IntegratorKind, k: KernelFlags) -> KernelFlags {
     match kind {
-        IntegratorKind::Path => Ok(polarized_path::<N>),
+        IntegratorKind::Whitted => ALL & !MEDIA,
+        _ if k & MEDIA != 0 => ALL & !SPECULAR,
+        _ => ALL & !SPECULAR & !MEDIA,
+    }
+}
+
+/// The polarised kernel of integrator `kind` with `N` lanes for kernel flags `k` (from
+/// [`stokes_flags`]), or why there is none.
+pub fn stokes_kernel<const N: usize>(
+    kind: IntegratorKind,
+    k: KernelFlags,
+) -> Result<StokesFn<N>, String> {
+    match kind {
+        IntegratorKind::Path if k & MEDIA != 0 => {
+            Ok(polarized_path::<N, { ALL & !SPECULAR }>)
+        }
+        IntegratorKind::Path => Ok(polarized_path::<N, { ALL & !SPECULAR & !MEDIA }>),
+        IntegratorKind::Whitted => Ok(polarized_whitted::<N, { ALL & !MEDIA }>),
         other => Err(format!(
-            "integrator {}: polarised transport (polarization = true) is implemented for integrator = \"path\" so far",
+            "integrator {}: polarised transport (polarization = true) is implemented for integrator = \"path\" and \"whitted\" so far",
             other.name()
         )),
     }

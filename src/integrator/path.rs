@@ -75,12 +75,12 @@
 //! index-matched boundaries), so ratio tracking, which estimates it in heterogeneous
 //! media, has nothing to add here.
 use super::toolkit::{
-    lane_mean, light_pdf, next_hit, roulette, sample_light, Finish, Immediate, PathState,
-    ShadowSink, TransmittanceWalk, MAX_CROSSINGS,
+    lane_mean, light_pdf, next_hit, roulette, sample_light, Carrier, Finish, Immediate,
+    PathState, ShadowSink, TransmittanceWalk, Unpolarized, Vertex, MAX_CROSSINGS,
 };
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
-use crate::bsdf::Material;
+use crate::bsdf::{LobeFlags, Material};
 use crate::camera::CameraRay;
 use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::SurfacePoint;
@@ -150,11 +150,46 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     counters: &mut TraceCounters,
     shadows: &mut S,
 ) -> bool {
+    step_carrying::<N, K, S, _>(
+        ctx,
+        s,
+        ray,
+        hit,
+        wl,
+        sampler,
+        counters,
+        shadows,
+        &mut Unpolarized,
+    )
+}
+
+/// [`step`] with what the path carries besides its scalar throughput (`carry`: nothing
+/// for unpolarised transport, the Mueller product for `integrator::polarized`), which
+/// receives every contribution and every scattering event.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn step_carrying<
+    const N: usize,
+    const K: KernelFlags,
+    S: ShadowSink<N>,
+    C: Carrier<N>,
+>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: Option<Hit>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    shadows: &mut S,
+    carry: &mut C,
+) -> bool {
     let scene = ctx.scene;
     if on(K, MEDIA) && s.medium != NO_MEDIUM {
         // A closed boundary always stops a ray inside; a ray that escapes it leaked.
         let Some(h) = &hit else { return false };
-        match medium_segment::<N, K, S>(ctx, s, ray, h, wl, sampler, counters, shadows) {
+        match medium_segment::<N, K, S, C>(ctx, s, ray, h, wl, sampler, counters, shadows, carry)
+        {
             Segment::Scattered => return true,
             Segment::Ended => return false,
             Segment::Crossed => {}
@@ -191,7 +226,8 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
                 let le = scene.lights[i as usize].le(ray.dir, wl);
                 if !le.is_zero() {
                     let (prev_p, dir) = (s.prev_p, ray.dir);
-                    s.add_found_light::<K>(le, mis, || {
+                    let found = (i as usize, dir, wl);
+                    s.add_found_light::<K, C>(carry, found, le, mis, || {
                         light_pdf(ctx, i as usize, prev_p, dir, None)
                     });
                 }
@@ -199,32 +235,37 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
         }
         return false;
     };
-    surface_vertex::<N, K, S>(ctx, s, ray, &hit, mis, wl, sampler, counters, shadows)
+    surface_vertex::<N, K, S, C>(ctx, s, ray, &hit, mis, wl, sampler, counters, shadows, carry)
 }
 
 impl<const N: usize> PathState<N> {
     /// Adds radiance `le` from a light the path reached by BSDF or phase sampling:
     /// whole after a delta lobe, else weighted against light sampling, whose density
     /// `p_light` gives (the power heuristic after a surface, the balance heuristic over
-    /// the lanes after a medium vertex); `mis` is the lanes' mean r_u.
+    /// the lanes after a medium vertex); `mis` is the lanes' mean r_u. `found` is the
+    /// light's index, the ray's direction and the wavelengths, for `carry`.
     #[inline(always)]
-    fn add_found_light<const K: KernelFlags>(
+    fn add_found_light<const K: KernelFlags, C: Carrier<N>>(
         &mut self,
+        carry: &mut C,
+        found: (usize, Vec3, &SampledWavelengths<N>),
         le: SampledSpectrum<N>,
         mis: f32,
         p_light: impl FnOnce() -> f32,
     ) {
+        let (light, dir, wl) = found;
         if self.specular_bounce {
-            self.l += self.beta * le / mis;
+            carry.found(&mut self.l, self.beta * le / mis, light, dir, wl);
             return;
         }
         let p_l = p_light();
-        if on(K, MEDIA) && self.prev_medium {
+        let c = if on(K, MEDIA) && self.prev_medium {
             let d = lane_mean(self.r_u + self.r_l * p_l, self.bsdf_ctx.companions_alive);
-            self.l += self.beta * le / d;
+            self.beta * le / d
         } else {
-            self.l += self.beta * le * (power_heuristic(self.prev_pdf, p_l) / mis);
-        }
+            self.beta * le * (power_heuristic(self.prev_pdf, p_l) / mis)
+        };
+        carry.found(&mut self.l, c, light, dir, wl);
     }
 }
 
@@ -245,7 +286,7 @@ enum Segment {
 /// the lanes' weights and rescaled probabilities updated.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
+fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Carrier<N>>(
     ctx: &Context,
     s: &mut PathState<N>,
     ray: &mut Ray,
@@ -254,6 +295,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
     shadows: &mut S,
+    carry: &mut C,
 ) -> Segment {
     let m = &ctx.scene.media[s.medium as usize];
     let sigma_t = m.sigma_t(wl);
@@ -279,10 +321,14 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
                 collide,
                 u: u_forced,
             };
-            if let Some(ld) =
+            if let Some((ld, wi, light)) =
                 forced_direct_light(ctx, s, m, &f, u_light, u_light_point, wl, counters, shadows)
             {
-                s.l += ld;
+                let v = Vertex::Medium {
+                    medium: m,
+                    d_in: ray.dir,
+                };
+                carry.lit(&mut s.l, ld, &v, wi, wi, light, wl);
             }
         }
     }
@@ -342,10 +388,14 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
             r_u: s.r_u,
             q_scale: SampledSpectrum::splat(1.0),
         };
-        if let Some(ld) =
+        if let Some((ld, wi, light)) =
             light_from_medium(ctx, s, m, &v, u_light, u_light_point, wl, counters, shadows)
         {
-            s.l += ld;
+            let v = Vertex::Medium {
+                medium: m,
+                d_in: ray.dir,
+            };
+            carry.lit(&mut s.l, ld, &v, wi, wi, light, wl);
         }
     }
     let (wi, pv, q) = sample_direction(ctx, s.depth, m, ray.dir, u_node, u_dir, wl);
@@ -364,6 +414,11 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     s.prev_medium = true;
     s.prev_p = p;
     s.prev_pdf = pdf;
+    let v = Vertex::Medium {
+        medium: m,
+        d_in: ray.dir,
+    };
+    carry.scattered(&v, wi, wi, LobeFlags::NONE, wl);
     *ray = Ray::new(p, wi, 0.0, f32::INFINITY);
     if s.beta.is_zero() {
         return Segment::Ended;
@@ -421,7 +476,7 @@ fn forced_direct_light<const N: usize, S: ShadowSink<N>>(
     wl: &SampledWavelengths<N>,
     counters: &mut TraceCounters,
     shadows: &mut S,
-) -> Option<SampledSpectrum<N>> {
+) -> Option<(SampledSpectrum<N>, Vec3, usize)> {
     let s0 = f.sigma_t.0[0];
     let c0 = f.collide.0[0];
     if !(s0 > 0.0 && c0 > 0.0) {
@@ -546,6 +601,7 @@ struct MediumVertex<const N: usize> {
 /// its transmittance through the media on the way, and the balance heuristic over
 /// (technique, hero) pairs against direction sampling, whose density toward the light
 /// is q_λ(ω) T_λ (T_λ: the chance of flying there unscattered) times `q_scale`.
+/// Returns the contribution, the direction toward the light and the light's index.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn light_from_medium<const N: usize, S: ShadowSink<N>>(
@@ -558,7 +614,7 @@ fn light_from_medium<const N: usize, S: ShadowSink<N>>(
     wl: &SampledWavelengths<N>,
     counters: &mut TraceCounters,
     shadows: &mut S,
-) -> Option<SampledSpectrum<N>> {
+) -> Option<(SampledSpectrum<N>, Vec3, usize)> {
     let cl = sample_light(ctx, v.p, u_light, u_light_point, wl)?;
     let ls = &cl.sample;
     let f = m.phase(v.dir, ls.wi, wl);
@@ -578,14 +634,16 @@ fn light_from_medium<const N: usize, S: ShadowSink<N>>(
         delta: ls.delta,
         alive: s.bsdf_ctx.companions_alive,
     };
-    shadows.transmit(ctx, walk, finish, wl, counters)
+    shadows
+        .transmit(ctx, walk, finish, wl, counters)
+        .map(|c| (c, ls.wi, cl.index))
 }
 
 /// A surface vertex: the emission found there, next-event estimation, and the BSDF's
 /// continuation with Russian roulette. Returns false when the path ends.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
+fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Carrier<N>>(
     ctx: &Context,
     s: &mut PathState<N>,
     ray: &mut Ray,
@@ -595,6 +653,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
     shadows: &mut S,
+    carry: &mut C,
 ) -> bool {
     let scene = ctx.scene;
     let (it, material) = scene.interaction(ray, hit, ctx.offset.is_robust());
@@ -616,7 +675,8 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
                 p: it.position,
                 n: it.n_outward,
             };
-            s.add_found_light::<K>(le, mis, || {
+            let found = (emitter as usize, dir, wl);
+            s.add_found_light::<K, C>(carry, found, le, mis, || {
                 light_pdf(ctx, emitter as usize, prev_p, dir, Some(&sp))
             });
         }
@@ -642,7 +702,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
             frame: &frame,
             wo_local,
         };
-        if let Some(ld) = surface_direct_light::<N, K, S>(
+        if let Some((ld, wi, wi_local, light)) = surface_direct_light::<N, K, S>(
             ctx,
             s,
             &v,
@@ -653,7 +713,12 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
             counters,
             shadows,
         ) {
-            s.l += ld;
+            let v = Vertex::Surface {
+                material,
+                frame: &frame,
+                wo_local,
+            };
+            carry.lit(&mut s.l, ld, &v, wi, wi_local, light, wl);
         }
     }
 
@@ -672,7 +737,14 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     if bs.is_transmission() {
         s.eta_scale *= bs.eta * bs.eta;
     }
-    *ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
+    let wi = frame.to_world(bs.wi);
+    let v = Vertex::Surface {
+        material,
+        frame: &frame,
+        wo_local,
+    };
+    carry.scattered(&v, wi, bs.wi, bs.flags, wl);
+    *ray = ctx.offset.spawn(&it.spawn_point(), wi);
     if on(K, MEDIA) && bs.is_transmission() {
         // Through a dielectric around a medium (a glass of milk) into or out of it.
         s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
@@ -702,7 +774,8 @@ struct SurfaceVertex<'a> {
 
 /// Next-event estimation at a surface vertex: a light sample, weighted by the power
 /// heuristic against the BSDF's density (delta lights: weight 1), through the media on
-/// the way (kernels with `MEDIA`) or past occluders.
+/// the way (kernels with `MEDIA`) or past occluders. Returns the contribution, the
+/// direction toward the light (world and local) and the light's index.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
@@ -715,7 +788,7 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     wl: &SampledWavelengths<N>,
     counters: &mut TraceCounters,
     shadows: &mut S,
-) -> Option<SampledSpectrum<N>> {
+) -> Option<(SampledSpectrum<N>, Vec3, Vec3, usize)> {
     let it = v.it;
     let cl = sample_light(ctx, it.position, u_light, u_light_point, wl)?;
     let ls = &cl.sample;
@@ -739,9 +812,11 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
         let q = ctx
             .offset
             .shadow(&it.spawn_point(), ls.wi, ls.dist, &ls.target());
-        return shadows.test(ctx, q, counters, || {
-            s.beta * f * ls.l * (weight(cl.pdf) / (cl.pdf * mis))
-        });
+        return shadows
+            .test(ctx, q, counters, || {
+                s.beta * f * ls.l * (weight(cl.pdf) / (cl.pdf * mis))
+            })
+            .map(|c| (c, ls.wi, wi_local, cl.index));
     }
     // Through media: the transmittance of the shadow ray (None: blocked).
     let from = if ls.wi.dot(it.n_outward) < 0.0 {
@@ -756,7 +831,9 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
         l: ls.l,
         scale: weight(cl.pdf) / (cl.pdf * mis),
     };
-    shadows.transmit(ctx, walk, finish, wl, counters)
+    shadows
+        .transmit(ctx, walk, finish, wl, counters)
+        .map(|c| (c, ls.wi, wi_local, cl.index))
 }
 
 /// exp(−σ_t d) per lane.

@@ -11,12 +11,13 @@
 //! either rule.
 use super::{Context, TraceCounters};
 use crate::accel::embree::{Hit, RayQuery};
-use crate::bsdf::BsdfContext;
+use crate::bsdf::{BsdfContext, LobeFlags, Material};
 use crate::camera::{Camera, CameraRay};
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
-use crate::medium::NO_MEDIUM;
+use crate::math::Frame;
+use crate::medium::{Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -408,6 +409,109 @@ impl<const N: usize> PathState<N> {
     pub fn radiance(&self) -> SampledSpectrum<N> {
         self.l
     }
+}
+
+/// Where a path scatters, as a [`Carrier`] needs to know it: a surface (its material,
+/// shading frame and ωo in that frame) or a point in a medium reached along `d_in`.
+#[derive(Clone, Copy)]
+pub(crate) enum Vertex<'a> {
+    Surface {
+        material: &'a Material,
+        frame: &'a Frame,
+        wo_local: Vec3,
+    },
+    Medium {
+        medium: &'a Medium,
+        d_in: Vec3,
+    },
+}
+
+/// What a path carries besides its scalar throughput, and what it does with the light
+/// it finds. The path tracer (`path::step`) computes every contribution as a scalar per
+/// lane (throughput, BSDF or phase value, MIS weight, transmittance, radiance) and hands
+/// it here with the event it came through: unpolarised transport ([`Unpolarized`]) adds
+/// it to the radiance; polarised transport (`integrator::polarized`) multiplies it by
+/// the path's normalised Mueller product, so both share the sampling, the MIS and the
+/// media estimators line for line. Each event's full Mueller matrix is its scalar
+/// weight times its matrix divided by its [0][0] element (`bsdf::polarization`), which
+/// is why the two factor.
+pub(crate) trait Carrier<const N: usize> {
+    /// Whether contributions need their light one by one (the Whitted tracer sums its
+    /// lights' before scaling them when they do not).
+    const POLARIZED: bool;
+
+    /// The path reached light `light` along its ray `dir` (by BSDF or phase sampling,
+    /// or escaping); `c` is the contribution.
+    fn found(
+        &mut self,
+        l: &mut SampledSpectrum<N>,
+        c: SampledSpectrum<N>,
+        light: usize,
+        dir: Vec3,
+        wl: &SampledWavelengths<N>,
+    );
+
+    /// Light `light`, sampled along `wi` (world; `wi_local` in a surface's frame) from
+    /// the vertex `v`, scattered there toward the path's previous vertex; `c` is the
+    /// contribution.
+    #[allow(clippy::too_many_arguments)]
+    fn lit(
+        &mut self,
+        l: &mut SampledSpectrum<N>,
+        c: SampledSpectrum<N>,
+        v: &Vertex,
+        wi: Vec3,
+        wi_local: Vec3,
+        light: usize,
+        wl: &SampledWavelengths<N>,
+    );
+
+    /// The path continues from `v` along `wi` (world; `wi_local` in a surface's frame)
+    /// by a lobe of `flags` (empty in a medium).
+    fn scattered(
+        &mut self,
+        v: &Vertex,
+        wi: Vec3,
+        wi_local: Vec3,
+        flags: LobeFlags,
+        wl: &SampledWavelengths<N>,
+    );
+}
+
+/// Unpolarised transport: contributions are summed, events change nothing else.
+pub(crate) struct Unpolarized;
+
+impl<const N: usize> Carrier<N> for Unpolarized {
+    const POLARIZED: bool = false;
+
+    #[inline(always)]
+    fn found(
+        &mut self,
+        l: &mut SampledSpectrum<N>,
+        c: SampledSpectrum<N>,
+        _: usize,
+        _: Vec3,
+        _: &SampledWavelengths<N>,
+    ) {
+        *l += c;
+    }
+
+    #[inline(always)]
+    fn lit(
+        &mut self,
+        l: &mut SampledSpectrum<N>,
+        c: SampledSpectrum<N>,
+        _: &Vertex,
+        _: Vec3,
+        _: Vec3,
+        _: usize,
+        _: &SampledWavelengths<N>,
+    ) {
+        *l += c;
+    }
+
+    #[inline(always)]
+    fn scattered(&mut self, _: &Vertex, _: Vec3, _: Vec3, _: LobeFlags, _: &SampledWavelengths<N>) {}
 }
 
 /// Where a vertex's shadow rays go. The one-path-at-a-time engine traces each at once

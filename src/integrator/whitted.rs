@@ -14,7 +14,7 @@
 //! surface with both (the course's glossy over glass) does both, each at full weight.
 //! Light reaching a diffuse surface through glass or off other diffuse surfaces is
 //! missing: that is the `path` integrator's job.
-use super::toolkit::{next_hit, Immediate, PathState, ShadowSink};
+use super::toolkit::{next_hit, Carrier, Immediate, PathState, ShadowSink, Unpolarized, Vertex};
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::LobeFlags;
@@ -95,10 +95,50 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     counters: &mut TraceCounters,
     shadows: &mut S,
 ) -> bool {
+    step_carrying::<N, K, S, _>(
+        ctx,
+        s,
+        ray,
+        hit,
+        wl,
+        sampler,
+        counters,
+        shadows,
+        &mut Unpolarized,
+    )
+}
+
+/// [`step`] with what the path carries besides its scalar throughput (`carry`, as
+/// `path::step_carrying`'s): polarised, each light's contribution goes to it on its own.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn step_carrying<
+    const N: usize,
+    const K: KernelFlags,
+    S: ShadowSink<N>,
+    C: Carrier<N>,
+>(
+    ctx: &Context,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    hit: Option<Hit>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    shadows: &mut S,
+    carry: &mut C,
+) -> bool {
     let scene = ctx.scene;
     let Some(hit) = hit else {
         if on(K, ESCAPE) {
-            s.l += s.beta * scene.escaped_radiance(ray.dir, wl);
+            if C::POLARIZED {
+                for &i in &scene.infinite_lights {
+                    let le = scene.lights[i as usize].le(ray.dir, wl);
+                    carry.found(&mut s.l, s.beta * le, i as usize, ray.dir, wl);
+                }
+            } else {
+                s.l += s.beta * scene.escaped_radiance(ray.dir, wl);
+            }
         }
         return false;
     };
@@ -108,7 +148,8 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     if on(K, EMITTERS) {
         let emitter = scene.shapes[hit.geom_id as usize].light;
         if emitter != NO_LIGHT {
-            s.l += s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
+            let c = s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
+            carry.found(&mut s.l, c, emitter as usize, ray.dir, wl);
         }
     }
     let flags = material.flags();
@@ -116,10 +157,22 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     let wo_local = frame.to_local(wo);
     if on(K, SHADOWS) && flags.has_non_specular() {
         let bsdf_ctx = &s.bsdf_ctx;
-        let lr = direct_lighting(ctx, &it, wl, sampler, counters, shadows, |wi| {
-            material.eval(wo_local, frame.to_local(wi), wl, bsdf_ctx).f
-        });
-        shadows.add_scaled(&mut s.l, s.beta, lr);
+        let f = |wi| material.eval(wo_local, frame.to_local(wi), wl, bsdf_ctx).f;
+        if C::POLARIZED {
+            let v = Vertex::Surface {
+                material,
+                frame: &frame,
+                wo_local,
+            };
+            let (beta, l) = (s.beta, &mut s.l);
+            direct_lighting(ctx, &it, wl, sampler, counters, shadows, f, |c, wi, i| {
+                carry.lit(l, beta * c, &v, wi, frame.to_local(wi), i, wl)
+            });
+        } else {
+            let mut lr = SampledSpectrum::<N>::zero();
+            direct_lighting(ctx, &it, wl, sampler, counters, shadows, f, |c, _, _| lr += c);
+            shadows.add_scaled(&mut s.l, s.beta, lr);
+        }
     }
     if !on(K, SPECULAR) || !flags.is_specular() {
         return false;
@@ -141,14 +194,23 @@ pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
     if s.depth > ctx.settings.max_depth {
         return false;
     }
-    *ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
+    let wi = frame.to_world(bs.wi);
+    let v = Vertex::Surface {
+        material,
+        frame: &frame,
+        wo_local,
+    };
+    carry.scattered(&v, wi, bs.wi, bs.flags, wl);
+    *ray = ctx.offset.spawn(&it.spawn_point(), wi);
     true
 }
 
-/// The sum of f(ωi) L_i cos θi / pdf over every light but the environment that reaches
-/// the shading point unoccluded (as far as `shadows` knows now; the packet engine adds
-/// the rest later), ωi being the unit direction toward the light and `f` the BSDF
-/// there. Lights with extent (the sun's disk, area lights) are sampled at one point.
+/// f(ωi) L_i cos θi / pdf for every light but the environment that reaches the shading
+/// point unoccluded (as far as `shadows` knows now; the packet engine adds the rest
+/// later), given to `add` with ωi and the light's index, ωi being the unit direction
+/// toward the light and `f` the BSDF there. Lights with extent (the sun's disk, area
+/// lights) are sampled at one point.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 fn direct_lighting<const N: usize, S: ShadowSink<N>>(
     ctx: &Context,
@@ -158,12 +220,12 @@ fn direct_lighting<const N: usize, S: ShadowSink<N>>(
     counters: &mut TraceCounters,
     shadows: &mut S,
     f: impl Fn(Vec3) -> SampledSpectrum<N>,
-) -> SampledSpectrum<N> {
-    let mut lr = SampledSpectrum::<N>::zero();
+    mut add: impl FnMut(SampledSpectrum<N>, Vec3, usize),
+) {
     let x = it.position;
     let from = it.spawn_point();
     let n = it.normal;
-    for light in &ctx.scene.lights {
+    for (i, light) in ctx.scene.lights.iter().enumerate() {
         if matches!(light, Light::Environment(_)) {
             continue;
         }
@@ -181,8 +243,7 @@ fn direct_lighting<const N: usize, S: ShadowSink<N>>(
         }
         let q = ctx.offset.shadow(&from, ls.wi, ls.dist, &ls.target());
         if let Some(c) = shadows.test(ctx, q, counters, || f(ls.wi) * (ls.l * (cos / ls.pdf))) {
-            lr += c;
+            add(c, ls.wi, i);
         }
     }
-    lr
 }

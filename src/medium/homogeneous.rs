@@ -25,6 +25,25 @@
 //! σ_t and σ_s are then linear in λ between nodes (as 1 nm tables, so a lane costs a
 //! lookup), the phase function is the nodes' mixture (`phase_table`).
 //!
+//! **The phase matrix**, for polarised transport: a sphere's Mueller matrix of
+//! scattering, written in the frame x̂ perpendicular to the scattering plane for both
+//! beams (Collett's convention, `optics::mueller`; Bohren & Huffman 1983, eq. 4.77 with
+//! their parallel and perpendicular axes swapped, which flips the sign of S12), is
+//!
+//!   F11  F12   0    0
+//!   F12  F11   0    0
+//!    0    0   F33  F34
+//!    0    0  −F34  F33
+//!
+//! with F11 = (|S₁|² + |S₂|²)/2, F12 = (|S₁|² − |S₂|²)/2, F33 = Re(S₁S₂*), F34 =
+//! −Im(S₁S₂*) (Bohren & Huffman's S34, in their e^{−iωt} amplitudes): the matrix of a
+//! reflection with S₁ in the place of r_s and S₂ of r_p (`optics::mueller`, whose
+//! retardance takes the same conjugate for Collett's sign of S3; so
+//! backscattering, S₁ = −S₂, is a mirror's diag(1, 1, −1, −1), and the primary bow,
+//! |S₁| > |S₂|, polarises along x̂, tangentially). Each is summed over the population
+//! as F11 is, and the table keeps (F12, F33, F34)/F11 per bin and node
+//! (`PhaseTable::with_matrix`); truncation's cone has p = 0 and nothing to polarise.
+//!
 //! Optional truncation of the diffraction peak (`forward_cutoff_deg` > 0; off by
 //! default): the fraction f of the phase function within the cutoff angle θ_c of the
 //! forward direction is counted as unscattered light, the delta-M idea (Wiscombe 1977,
@@ -153,8 +172,9 @@ impl LorenzMieMedium {
         let x_max = 2.0 * PI * r_max / (LAMBDA_MIN as f64 * 1e-9);
         let theta = angle_grid(x_max);
         let mu: Vec<f64> = theta.iter().map(|t| t.cos()).collect();
-        // Per node: (σ_t, σ_s, unnormalised p at the θ edges).
-        let per_node: Vec<(f64, f64, Vec<f64>)> = lambdas
+        // Per node: (σ_t, σ_s, unnormalised p at the θ edges, and F12, F33, F34 there).
+        #[allow(clippy::type_complexity)]
+        let per_node: Vec<(f64, f64, Vec<f64>, Vec<[f64; 3]>)> = lambdas
             .par_iter()
             .map(|&lambda_nm| {
                 let lambda_m = lambda_nm * 1e-9;
@@ -168,6 +188,7 @@ impl LorenzMieMedium {
                 let m = Complex64::new(n, k);
                 let (mut st, mut ss) = (0.0f64, 0.0f64);
                 let mut p = vec![0.0f64; theta.len()];
+                let mut f = vec![[0.0f64; 3]; theta.len()];
                 for node in &spec.population {
                     let x = k_wave * node.radius_m;
                     let s = sphere(m, x);
@@ -175,16 +196,27 @@ impl LorenzMieMedium {
                     st += node.number_density * s.q_ext * geo;
                     ss += node.number_density * s.q_sca * geo;
                     let w = node.number_density / (k_wave * k_wave);
-                    for (pe, &mu) in p.iter_mut().zip(&mu) {
+                    for ((pe, fe), &mu) in p.iter_mut().zip(f.iter_mut()).zip(&mu) {
                         let (s1, s2) = amplitudes(&s.coefficients, mu);
                         *pe += w * 0.5 * (s1.norm_sqr() + s2.norm_sqr());
+                        // The phase matrix in the frame x̂ ⊥ the scattering plane
+                        // (module docs): S1 plays Fresnel's r_s, S2 its r_p.
+                        let c = s1.conj() * s2;
+                        fe[0] += w * 0.5 * (s1.norm_sqr() - s2.norm_sqr());
+                        fe[1] += w * c.re;
+                        fe[2] += w * c.im;
                     }
                 }
                 for pe in p.iter_mut() {
                     *pe /= ss;
                 }
+                for fe in f.iter_mut() {
+                    for c in fe.iter_mut() {
+                        *c /= ss;
+                    }
+                }
                 let (st, ss) = truncate(&theta, &mut p, st, ss, spec.forward_cutoff_deg);
-                (st, ss, p)
+                (st, ss, p, f)
             })
             .collect();
         let node_spectrum = |f: &dyn Fn(usize) -> f64| {
@@ -200,8 +232,10 @@ impl LorenzMieMedium {
         };
         let sigma_t = node_spectrum(&|i| per_node[i].0);
         let sigma_s = node_spectrum(&|i| per_node[i].1);
-        let values: Vec<Vec<f64>> = per_node.into_iter().map(|n| n.2).collect();
-        let phase = PhaseTable::from_values(LAMBDA_MIN, spec.lambda_step_nm, &theta, &values);
+        let (values, matrix): (Vec<Vec<f64>>, Vec<Vec<[f64; 3]>>) =
+            per_node.into_iter().map(|n| (n.2, n.3)).unzip();
+        let phase = PhaseTable::from_values(LAMBDA_MIN, spec.lambda_step_nm, &theta, &values)
+            .with_matrix(&values, &matrix);
         LorenzMieMedium {
             spec,
             sigma_t,
@@ -210,4 +244,56 @@ impl LorenzMieMedium {
             angles: theta.len(),
         }
     }
+}
+
+/// `heron sky mie-matrix` (hidden, for `tests/python/test_mie.py`): the phase table of a
+/// medium of one drop radius `radius_um` (μm; 1 drop per m³) at the wavelength node
+/// `lambda_nm` (a multiple of 10 nm from 360 nm: the table's nodes at `lambda_step_nm`
+/// = 10), without absorption unless `absorption`. Prints the relative index and size
+/// parameter, then one row per bin: `theta0_deg,theta1_deg,p,f12,f33,f34`, p the bin's
+/// phase function (sr⁻¹) and f_ij = F_ij/F11 its shape (module docs).
+pub fn matrix_csv(radius_um: f64, lambda_nm: f64, absorption: bool) -> crate::Result<String> {
+    use std::fmt::Write as _;
+    let bad = |m: String| crate::HeronError::Invalid(m);
+    if !(radius_um.is_finite() && radius_um > 0.0 && radius_um <= 100.0) {
+        return Err(bad(format!(
+            "--radius-um: expected a radius in (0, 100] μm, got {radius_um}"
+        )));
+    }
+    let node = (lambda_nm - LAMBDA_MIN as f64) / 10.0;
+    if !(lambda_nm.is_finite()
+        && node >= 0.0
+        && node.fract() == 0.0
+        && lambda_nm <= LAMBDA_MAX as f64)
+    {
+        return Err(bad(format!(
+            "--lambda: expected a wavelength node, 360 to 830 nm in steps of 10, got {lambda_nm}"
+        )));
+    }
+    let m = LorenzMieMedium::new(MieSpec {
+        population: vec![PopulationNode {
+            radius_m: radius_um * 1e-6,
+            number_density: 1.0,
+        }],
+        absorption,
+        lambda_step_nm: 10.0,
+        forward_cutoff_deg: 0.0,
+    });
+    let n = crate::spectrum::ior::named("water")
+        .expect("water in the catalogue")
+        .eval(lambda_nm as f32) as f64;
+    let k = if absorption { water_k(lambda_nm) } else { 0.0 };
+    let x = 2.0 * PI * radius_um * 1e-6 / (lambda_nm * 1e-9);
+    let mut out = format!("# m_re={n:.17e},m_im={k:.17e},x={x:.17e}\n");
+    out.push_str("theta0_deg,theta1_deg,p,f12,f33,f34\n");
+    // The table's θ edges in f64 (the same grid `new` built), not its f32 v.
+    let theta = angle_grid(2.0 * PI * radius_um * 1e-6 / (LAMBDA_MIN as f64 * 1e-9));
+    let rows = m.phase.rows(node as usize);
+    debug_assert_eq!(rows.len() + 1, theta.len());
+    for ((p, f), t) in rows.into_iter().zip(theta.windows(2)) {
+        let (t0, t1) = (t[0].to_degrees(), t[1].to_degrees());
+        writeln!(out, "{t0:.17e},{t1:.17e},{p:.9e},{:.9e},{:.9e},{:.9e}", f[0], f[1], f[2])
+            .unwrap();
+    }
+    Ok(out)
 }

@@ -34,7 +34,8 @@ pub use henyey_greenstein::HgMedium;
 pub use homogeneous::{LorenzMieMedium, MieSpec, PopulationNode};
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::{Vec2, Vec3};
+use crate::spectrum::stokes::{any_perpendicular, mueller_from_rows};
+use glam::{Mat4, Vec2, Vec3};
 use phase_table::{direction_at, v_between};
 
 /// `Shape::medium` of a shape without a medium (defined with the shape).
@@ -91,6 +92,44 @@ impl Medium {
             Medium::LorenzMie(m) => m.phase.eval(v, &wl.lambda),
             Medium::HenyeyGreenstein(m) => SampledSpectrum::splat(henyey_greenstein::hg(m.g, v)),
         }
+    }
+
+    /// The phase matrix for propagation `d_in` scattered into `d_out`, per lane divided
+    /// by the phase function, with the frame it is written in for both beams: x̂ =
+    /// d_in × d_out normalised, perpendicular to the scattering plane
+    /// (`homogeneous`'s module docs). None when the medium depolarises
+    /// (Henyey–Greenstein, which has no matrix, and a Lorenz–Mie table without one):
+    /// then only the intensity survives, diag(1, 0, 0, 0).
+    #[inline]
+    pub fn phase_matrix<const N: usize>(
+        &self,
+        d_in: Vec3,
+        d_out: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> Option<([Mat4; N], Vec3)> {
+        let Medium::LorenzMie(m) = self else {
+            return None;
+        };
+        if !m.phase.has_matrix() {
+            return None;
+        }
+        let r = m.phase.eval_matrix(v_between(d_in, d_out), &wl.lambda);
+        let n = d_in.cross(d_out);
+        let x = if n.length_squared() > 1e-12 {
+            n.normalize()
+        } else {
+            any_perpendicular(d_in)
+        };
+        let m = std::array::from_fn(|i| {
+            let [f12, f33, f34] = r[i];
+            mueller_from_rows([
+                [1.0, f12, 0.0, 0.0],
+                [f12, 1.0, 0.0, 0.0],
+                [0.0, 0.0, f33, f34],
+                [0.0, 0.0, -f34, f33],
+            ])
+        });
+        Some((m, x))
     }
 
     /// A new direction about `d_in` drawn from the hero wavelength's phase function

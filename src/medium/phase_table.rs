@@ -116,6 +116,10 @@ pub struct PhaseTable {
     /// Per node: the integral of the untruncated values before normalisation (1 when the
     /// grid resolves the function), for checks.
     pub raw_integral: Vec<f64>,
+    /// The phase matrix's shape per bin and node, laid out as `density`:
+    /// (F12, F33, F34) / F11, each the ratio of the bin's trapezoid averages (so that
+    /// F_ij's mass in the bin is the ratio times F11's); empty when not tabulated.
+    matrix: Vec<[f32; 3]>,
 }
 
 impl PhaseTable {
@@ -168,7 +172,72 @@ impl PhaseTable {
             nodes: values.len(),
             cdf,
             raw_integral,
+            matrix: Vec::new(),
         }
+    }
+
+    /// The table with the phase matrix's shape: `f11[i][e]` and `rest[i][e]` = (F12,
+    /// F33, F34) of node i at θ edge e, unnormalised like `from_values`' values (the
+    /// same F11).
+    pub fn with_matrix(mut self, f11: &[Vec<f64>], rest: &[Vec<[f64; 3]>]) -> Self {
+        let m = self.v.len() - 1;
+        let mut matrix = vec![[0.0f32; 3]; m * self.nodes];
+        for (i, (a, r)) in f11.iter().zip(rest).enumerate() {
+            for j in 0..m {
+                let d = a[j] + a[j + 1];
+                matrix[j * self.nodes + i] = std::array::from_fn(|c| {
+                    if d > 0.0 {
+                        ((r[j][c] + r[j + 1][c]) / d).clamp(-1.0, 1.0) as f32
+                    } else {
+                        0.0
+                    }
+                });
+            }
+        }
+        self.matrix = matrix;
+        self
+    }
+
+    /// Whether the phase matrix is tabulated.
+    pub fn has_matrix(&self) -> bool {
+        !self.matrix.is_empty()
+    }
+
+    /// (F12, F33, F34) / F11 at v for each lane's wavelength: the nodes' mixture of the
+    /// module docs, each node's F_ij weighted by its share of F11. Zero without a matrix.
+    #[inline]
+    pub fn eval_matrix<const N: usize>(&self, v: f32, lambda: &[f32; N]) -> [[f32; 3]; N] {
+        if self.matrix.is_empty() {
+            return [[0.0; 3]; N];
+        }
+        let j = self.bin(v);
+        let row = &self.density[j * self.nodes..(j + 1) * self.nodes];
+        let mat = &self.matrix[j * self.nodes..(j + 1) * self.nodes];
+        std::array::from_fn(|k| {
+            let (i, t) = self.node(lambda[k]);
+            if t == 0.0 {
+                return mat[i];
+            }
+            let (a, b) = (row[i] * (1.0 - t), row[i + 1] * t);
+            let d = a + b;
+            if !(d > 0.0) {
+                return mat[i];
+            }
+            std::array::from_fn(|c| (a * mat[i][c] + b * mat[i + 1][c]) / d)
+        })
+    }
+
+    /// At node `node`, each bin's p (sr⁻¹) and (F12, F33, F34) / F11: the table as a
+    /// polarised render looks it up, for checks (`heron sky mie-matrix`).
+    pub fn rows(&self, node: usize) -> Vec<(f32, [f32; 3])> {
+        (0..self.v.len() - 1)
+            .map(|j| {
+                (
+                    self.density[j * self.nodes + node],
+                    self.matrix.get(j * self.nodes + node).copied().unwrap_or([0.0; 3]),
+                )
+            })
+            .collect()
     }
 
     /// The number of wavelength nodes.

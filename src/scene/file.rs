@@ -680,6 +680,23 @@ pub struct SpotLightFile {
     /// Width of the falloff ring in degrees, in [0, cone_angle]; default 5.
     #[serde(default)]
     pub cone_delta: Option<NonNegativeNumber>,
+    #[serde(default)]
+    pub polarization: Option<LightPolarizationFile>,
+}
+
+/// `polarization = { axis = [x, y, z], linear = 1.0, circular = 0.0 }` on a point, spot
+/// or directional light: the light's Stokes vector S0 (1, linear, 0, circular) in the
+/// frame of `axis` projected across each ray (`light::polarization`). `linear` and
+/// `circular` are in [−1, 1] with linear² + circular² ≤ 1; `linear` defaults to 1
+/// without `circular`, else to 0; `circular` to 0. Read only by polarised renders.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightPolarizationFile {
+    pub axis: Direction3,
+    #[serde(default)]
+    pub linear: Option<f32>,
+    #[serde(default)]
+    pub circular: Option<f32>,
 }
 
 /// A finite number ≥ 0 (for angles that may be 0).
@@ -692,6 +709,8 @@ pub struct PointLightFile {
     pub position: Point3,
     /// Radiant intensity, a colour.
     pub intensity: Emission,
+    #[serde(default)]
+    pub polarization: Option<LightPolarizationFile>,
 }
 
 /// The sun: a directional light with the solar disk's extent.
@@ -726,6 +745,8 @@ pub struct DirectionalLightFile {
     /// The direction the light travels; normalised on load.
     pub direction: Direction3,
     pub radiance: Emission,
+    #[serde(default)]
+    pub polarization: Option<LightPolarizationFile>,
 }
 
 // ---------------------------------------------------------------------------------------

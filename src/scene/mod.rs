@@ -39,6 +39,9 @@ pub struct Scene {
     /// The file's lights in file order, then one area light per emitting shape, then
     /// the environment (background and sky), when it emits.
     pub lights: Vec<Light>,
+    /// Per light (by index, possibly shorter than `lights`): its polarisation, for
+    /// polarised transport; unpolarised where absent or None.
+    pub light_polarization: Vec<Option<crate::light::LightPolarization>>,
     /// The index of the environment light, if the background or sky emits.
     pub environment: Option<u32>,
     /// Lights a ray that leaves the scene can see (the environment first, then suns).
@@ -87,6 +90,13 @@ pub struct SceneParts {
 }
 
 impl Scene {
+    /// The polarisation of light `light` (by index into `lights`), None when it is
+    /// unpolarised (`light::polarization`).
+    #[inline]
+    pub fn light_polarization(&self, light: usize) -> Option<&crate::light::LightPolarization> {
+        self.light_polarization.get(light)?.as_ref()
+    }
+
     /// Completes `parts`: appends the environment light when the background or sky
     /// emits, lists the lights at infinity (environment first, then suns), bounds the
     /// shapes and builds the light sampler.
@@ -133,6 +143,7 @@ impl Scene {
             materials: p.materials,
             material_names: p.material_names,
             lights,
+            light_polarization: Vec::new(),
             environment,
             infinite_lights,
             background: p.background,

@@ -106,3 +106,87 @@ def test_mie_phase_rejects_bad_values() -> None:
         )
         assert out.returncode == 1
         assert len(out.stderr.strip().splitlines()) == 1
+
+
+def heron_matrix(radius_um: float, lambda_nm: int):
+    out = subprocess.run(
+        [
+            str(require_heron_bin()),
+            "sky",
+            "mie-matrix",
+            "--radius-um",
+            repr(radius_um),
+            "--lambda",
+            str(lambda_nm),
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    lines = out.stdout.strip().splitlines()
+    head = dict(kv.split("=") for kv in lines[0].lstrip("# ").split(","))
+    assert lines[1] == "theta0_deg,theta1_deg,p,f12,f33,f34"
+    a = np.array([[float(v) for v in line.split(",")] for line in lines[2:]])
+    return float(head["m_re"]), float(head["x"]), a
+
+
+@pytest.mark.parametrize(
+    "radius_um,lambda_nm", [(0.1, 550), (1.0, 400), (1.0, 550), (10.0, 700)]
+)
+def test_medium_phase_matrix_matches_miepython(radius_um: float, lambda_nm: int) -> None:
+    """The Lorenz–Mie medium's table for polarised transport (src/medium/homogeneous.rs,
+    `PhaseTable::with_matrix`): per bin of its angle grid, the phase function p and the
+    shape F12/F11, F33/F11, F34/F11, against the same bins built from miepython's S1, S2
+    at the bin edges (trapezoid averages; p normalised over the sphere as the table
+    is). One drop radius, no absorption; size parameters 1.1 to 99 at 400–700 nm.
+
+    Conventions: heron's matrix is written with x̂ perpendicular to the scattering
+    plane, F12 = (|S1|² − |S2|²)/2, F33 = Re(S1 S2*), F34 = −Im(S1 S2*) in Bohren &
+    Huffman's amplitudes (e^{−iωt}; their eq. 4.77's S34, and the sign Mitsuba's
+    Fresnel matrices give S3). miepython's amplitudes are their complex conjugates
+    (van de Hulst's e^{+iωt}; checked against `heron sky mie-phase` below).
+
+    Tolerances: p within 1e-5 relative (+1e-9 of its peak, the deep minima), the shapes
+    within 1e-5 absolute; they are f32 in the table, and heron's and miepython's series
+    agree to 1e-6 (test_mie_amplitudes_match_miepython). A sign error in any element, a
+    parallel/perpendicular swap (F12 → −F12) or a 0.5% error in x fails by orders of
+    magnitude.
+    """
+    m, x, a = heron_matrix(radius_um, lambda_nm)
+    t0, t1 = np.radians(a[:, 0]), np.radians(a[:, 1])
+    edges = np.append(t0, t1[-1])
+    assert np.all(np.diff(edges) > 0) and edges[0] == 0.0 and abs(edges[-1] - np.pi) < 1e-12
+    s1, s2 = miepython.S1_S2(m, x, np.cos(edges), norm="wiscombe")
+    s1, s2 = np.conj(s1), np.conj(s2)  # to Bohren & Huffman's convention
+    f11 = 0.5 * (np.abs(s1) ** 2 + np.abs(s2) ** 2)
+    f12 = 0.5 * (np.abs(s1) ** 2 - np.abs(s2) ** 2)
+    c = s1 * np.conj(s2)
+    v = 2.0 * np.sin(0.5 * edges) ** 2
+    bin_f11 = 0.5 * (f11[:-1] + f11[1:])
+    p = bin_f11 / np.sum(bin_f11 * 2.0 * np.pi * np.diff(v))
+    tol = 1e-5 * p + 1e-9 * p.max()
+    worst = int(np.argmax(np.abs(a[:, 2] - p) / tol))
+    assert np.all(np.abs(a[:, 2] - p) <= tol), (
+        f"p at {a[worst, 0]:.4f}°: heron {a[worst, 2]} vs {p[worst]}"
+    )
+    for col, name, f in ((3, "F12", f12), (4, "F33", c.real), (5, "F34", -c.imag)):
+        want = (f[:-1] + f[1:]) / (f11[:-1] + f11[1:])
+        err = np.abs(a[:, col] - want)
+        worst = int(np.argmax(err))
+        assert err[worst] <= 1e-5, (
+            f"{name}/F11 at {a[worst, 0]:.4f}°: heron {a[worst, col]} vs miepython {want[worst]}"
+        )
+    # The bow's tangential polarisation in the rainbow region for the larger drops.
+    if x > 50:
+        bow = (a[:, 0] > 135.0) & (a[:, 0] < 140.0)
+        assert np.mean(a[bow, 3]) > 0.5
+
+
+def test_miepython_amplitudes_are_conjugates_of_herons() -> None:
+    """The convention test_medium_phase_matrix_matches_miepython relies on: miepython's
+    S1, S2 are the complex conjugates of heron's (Bohren & Huffman's)."""
+    angles, s1, s2 = heron_amplitudes(1.3330, 10.0, 5.0, 175.0, 5.0)
+    r1, r2 = miepython.S1_S2(1.3330, 10.0, np.cos(np.radians(angles)), norm="wiscombe")
+    assert np.max(np.abs(np.conj(r1) - s1) / np.abs(s1)) < 1e-6
+    assert np.max(np.abs(np.conj(r2) - s2) / np.abs(s2)) < 1e-6
+    assert np.max(np.abs(r1 - s1) / np.abs(s1)) > 0.1

@@ -4,9 +4,12 @@ use super::errors::fmt_points;
 use super::shapes::{cross_overflows, is_degenerate};
 use crate::geometry::{Shape, ShapeKind};
 use crate::light::{
-    AreaLight, AreaShape, DirectionalLight, Light, PointLight, Portal, SpotLight, SunLight,
+    AreaLight, AreaShape, DirectionalLight, Light, LightPolarization, PointLight, Portal,
+    SpotLight, SunLight,
 };
-use crate::scene::file::{fmt_f32, LightFile, ShapeFile, SpotLightFile, SunLightFile};
+use crate::scene::file::{
+    fmt_f32, LightFile, LightPolarizationFile, ShapeFile, SpotLightFile, SunLightFile,
+};
 
 /// The file's lights, in file order.
 pub(super) fn build_lights(entries: &[LightFile]) -> Result<Vec<Light>, String> {
@@ -26,6 +29,50 @@ pub(super) fn build_lights(entries: &[LightFile]) -> Result<Vec<Light>, String> 
             LightFile::Spot(s) => spot(&format!("lights[{i}]"), s).map(Light::Spot),
         })
         .collect()
+}
+
+/// The polarisation of each `[[lights]]` entry, in file order (`light::polarization`).
+pub(super) fn build_light_polarization(
+    entries: &[LightFile],
+) -> Result<Vec<Option<LightPolarization>>, String> {
+    entries
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let p = match l {
+                LightFile::Point(p) => &p.polarization,
+                LightFile::Directional(d) => &d.polarization,
+                LightFile::Spot(s) => &s.polarization,
+                LightFile::Sun(_) => &None,
+            };
+            p.as_ref()
+                .map(|p| polarization(&format!("lights[{i}].polarization"), p))
+                .transpose()
+        })
+        .collect()
+}
+
+/// A light's `polarization` table at key path `at`.
+fn polarization(at: &str, p: &LightPolarizationFile) -> Result<LightPolarization, String> {
+    let circular = p.circular.unwrap_or(0.0);
+    let linear = p
+        .linear
+        .unwrap_or(if p.circular.is_some() { 0.0 } else { 1.0 });
+    for (key, v) in [("linear", linear), ("circular", circular)] {
+        if !(v.is_finite() && (-1.0..=1.0).contains(&v)) {
+            return Err(format!("{at}.{key}: expected a number in [-1, 1], got {v}"));
+        }
+    }
+    if linear * linear + circular * circular > 1.0 + 1e-6 {
+        return Err(format!(
+            "{at}: expected a degree of polarisation sqrt(linear^2 + circular^2) of at most 1, got linear = {linear} and circular = {circular}"
+        ));
+    }
+    Ok(LightPolarization {
+        axis: p.axis.unit(),
+        linear,
+        circular,
+    })
 }
 
 /// A sun entry at key path `at`.

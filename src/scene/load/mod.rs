@@ -143,6 +143,7 @@ pub(crate) fn build(
     .map_err(err)?;
     shapes::check_bounds(&shapes, &entry).map_err(err)?;
     let mut lights = lights::build_lights(&file.lights).map_err(err)?;
+    let light_polarization = lights::build_light_polarization(&file.lights).map_err(err)?;
     lights::add_area_lights(&file.shapes, &entry, &mut shapes, &mut lights);
     let background = file
         .background
@@ -177,7 +178,7 @@ pub(crate) fn build(
     };
     let camera = camera::build_camera(&file.camera, &base_dir, &mut inputs).map_err(err)?;
     let inputs = crate::files::hash_inputs(&base_dir, inputs).map_err(err)?;
-    Ok(Scene::from_parts(SceneParts {
+    let mut scene = Scene::from_parts(SceneParts {
         source: path.to_path_buf(),
         source_sha256,
         inputs,
@@ -191,5 +192,7 @@ pub(crate) fn build(
         envmap,
         settings,
         media,
-    }))
+    });
+    scene.light_polarization = light_polarization;
+    Ok(scene)
 }
