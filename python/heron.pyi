@@ -12,7 +12,7 @@ the CLI names a flag (``--lanes``) the message names the argument (``lanes``).
 """
 
 import os
-from typing import Any, Literal, Mapping, Optional, Sequence, TypedDict, Union
+from typing import Any, Literal, Mapping, NotRequired, Optional, Sequence, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -169,6 +169,8 @@ class TraceEvent(TypedDict):
     outgoing: Optional[list[float]]
     fresnel_r: Optional[float]
     distance: Optional[float]
+    stokes: NotRequired[list[float]]
+    stokes_x: NotRequired[list[float]]
 
 def trace(
     scene: Union[Scene, _Path],
@@ -176,12 +178,15 @@ def trace(
     direction: _Numbers,
     wavelength: float,
     path: Optional[str] = None,
+    stokes: Optional[_Numbers] = None,
 ) -> list[TraceEvent]:
     """Follows one ray at one wavelength through a scene, as ``heron trace`` does.
 
     path: R and T letters; at the k-th event at a surface that both reflects and
     transmits, R reflects and T transmits (default and past the end: transmit; total
     internal reflection forces R). "TRT" is the primary rainbow ray of a drop.
+    stokes: (S0, S1, S2, S3) to start from, as ``heron trace --stokes``; each event then
+    has ``stokes`` (after it, power) and ``stokes_x`` (its frame's x axis).
     """
 
 def sky_profile(

@@ -2,7 +2,8 @@
 """Cost of polarised against unpolarised transport per sample (BENCHMARKS.md,
 "Polarised transport"): each scene rendered with and without --polarization, the two
 interleaved round by round (this machine's timings drift by ±15% between runs, so each
-ratio is taken within a round), under the path integrator at the same spp and seed.
+ratio is taken within a round), at the same spp and seed: four scenes under the path
+integrator (fogbow with its Lorenz–Mie fog) and the default scene under whitted.
 
     scripts/bench_polarization.py [--rounds 5] [--spp 16] [--heron target/release/heron]
 
@@ -17,10 +18,11 @@ import subprocess
 import tempfile
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
-SCENES = ["cornell-box", "metals", "brewster"]
+SCENES = [("cornell-box", "path"), ("metals", "path"), ("brewster", "path"),
+          ("fogbow", "path"), ("default", "whitted")]
 
 
-def render(heron, scene, spp, polarized, tmp):
+def render(heron, scene, integrator, spp, polarized, tmp):
     # A copy with [render] polarization as asked (brewster.toml turns it on itself);
     # mesh and table paths are relative to scenes/, so the copy lives there too.
     text = (REPO / "scenes" / f"{scene}.toml").read_text()
@@ -29,7 +31,7 @@ def render(heron, scene, spp, polarized, tmp):
     path = REPO / "scenes" / f".bench-polarization-{scene}.toml"
     path.write_text(text)
     cmd = [heron, "render", str(path), "-o", str(pathlib.Path(tmp) / "b.exr"),
-           "--integrator", "path", "--spp", str(spp), "--seed", "1", "--no-png"]
+           "--integrator", integrator, "--spp", str(spp), "--seed", "1", "--no-png"]
     try:
         log = subprocess.run(cmd, check=True, capture_output=True, text=True).stderr
     finally:
@@ -45,16 +47,18 @@ def main():
     ap.add_argument("--heron", default=str(REPO / "target/release/heron"))
     a = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        print(f"{'scene':<12} {'unpolarised s':>14} {'polarised s':>12} {'ratio':>7}")
-        for scene in SCENES:
+        print(f"{'scene':<12} {'integrator':<10} {'unpolarised s':>14} {'polarised s':>12}"
+              f" {'ratio':>7}")
+        for scene, integrator in SCENES:
             plain, pol, ratio = [], [], []
             for _ in range(a.rounds):
-                t0 = render(a.heron, scene, a.spp, False, tmp)
-                t1 = render(a.heron, scene, a.spp, True, tmp)
+                t0 = render(a.heron, scene, integrator, a.spp, False, tmp)
+                t1 = render(a.heron, scene, integrator, a.spp, True, tmp)
                 plain.append(t0)
                 pol.append(t1)
                 ratio.append(t1 / t0)
-            print(f"{scene:<12} {statistics.median(plain):>14.3f} {statistics.median(pol):>12.3f}"
+            print(f"{scene:<12} {integrator:<10} {statistics.median(plain):>14.3f}"
+                  f" {statistics.median(pol):>12.3f}"
                   f" {statistics.median(ratio):>7.2f}")
 
 

@@ -320,7 +320,9 @@ fn render_with(
             // Checked above: the integrator has a polarised kernel.
             const WHY: &str = "a polarised kernel";
             return match n {
-                Lanes::One => SampleFn::StokesOne(integrator::stokes_kernel::<1>(kind, k).expect(WHY)),
+                Lanes::One => {
+                    SampleFn::StokesOne(integrator::stokes_kernel::<1>(kind, k).expect(WHY))
+                }
                 Lanes::Four => {
                     SampleFn::StokesFour(integrator::stokes_kernel::<4>(kind, k).expect(WHY))
                 }

@@ -423,7 +423,10 @@ fn a_polarised_light_is_reflected_at_brewsters_angle_as_its_state_says() {
     let s = y(Some("axis = [0.0, 0.0, 1.0]")) / unpolarised;
     let p = y(Some("axis = [0.0, 0.0, 1.0], linear = -1.0")) / unpolarised;
     let circular = y(Some("axis = [0.0, 0.0, 1.0], circular = 1.0")) / unpolarised;
-    assert!((s - 2.0).abs() < 0.01, "s-polarised: {s} of the unpolarised light");
+    assert!(
+        (s - 2.0).abs() < 0.01,
+        "s-polarised: {s} of the unpolarised light"
+    );
     assert!(p < 0.005, "p-polarised: {p} of the unpolarised light");
     assert!((circular - 1.0).abs() < 1e-4, "circular: {circular}");
     // The axis is projected across the ray: z tilted toward the light's direction of

@@ -14,7 +14,8 @@ use std::path::Path;
 /// does (the renderer's own intersection, materials and ray offsets); returns the
 /// events as a list of dicts with the keys of the CLI's JSON: kind ("reflect",
 /// "refract", "total-internal-reflection", "absorb", "escape"), position, normal,
-/// material, n_i, n_t, incoming, outgoing, fresnel_r, distance (None where absent).
+/// material, n_i, n_t, incoming, outgoing, fresnel_r, distance (None where absent),
+/// and with `stokes` also stokes and stokes_x.
 ///
 /// scene: a heron.Scene or a path to a scene file. origin, direction: three numbers
 /// (direction normalised here). wavelength: nm, 360–830. path: `heron trace --path`, a
@@ -23,9 +24,11 @@ use std::path::Path;
 /// and by default, rays transmit; total internal reflection forces R. "TRT" is the
 /// primary rainbow ray of a drop. The trace stops at absorption, escape, or after the
 /// scene's max_depth continuations (the last event then still has an outgoing
-/// direction).
+/// direction). stokes: `heron trace --stokes`, the light's Stokes vector (S0, S1, S2,
+/// S3) to start from, e.g. (1, 0, 0, 0); each event then reports the Stokes vector after
+/// it (power) and its frame's x̂ (stokes_x).
 #[pyfunction]
-#[pyo3(signature = (scene, origin, direction, wavelength, path=None))]
+#[pyo3(signature = (scene, origin, direction, wavelength, path=None, stokes=None))]
 pub fn trace<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -33,6 +36,7 @@ pub fn trace<'py>(
     direction: &Bound<'py, PyAny>,
     wavelength: f64,
     path: Option<&str>,
+    stokes: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
     guard(|| {
         // The CLI's flags, by the names of this function's arguments.
@@ -41,11 +45,24 @@ pub fn trace<'py>(
             ("--dir", "direction"),
             ("--lambda", "wavelength"),
             ("--path", "path"),
+            ("--stokes", "stokes"),
         ];
         let choices =
             heron_core::trace::parse_path(path.unwrap_or("")).map_err(|e| lib_err(e, RENAMES))?;
         let origin = vec3(origin, "origin")?;
         let direction = vec3(direction, "direction")?;
+        let stokes = match stokes {
+            None => None,
+            Some(s) => {
+                let v = numbers(s, "stokes")?;
+                Some(<[f64; 4]>::try_from(v.as_slice()).map_err(|_| {
+                    err(format!(
+                        "stokes: expected four numbers (S0, S1, S2, S3), got {}",
+                        v.len()
+                    ))
+                })?)
+            }
+        };
         let scene = crate::scene::scene_arg(py, scene)?;
         let report = py
             .detach(|| {
@@ -57,7 +74,7 @@ pub fn trace<'py>(
                     direction,
                     wavelength as f32,
                     &choices,
-                    None,
+                    stokes,
                 )
             })
             .map_err(|e| lib_err(e, RENAMES))?;

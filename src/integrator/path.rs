@@ -75,8 +75,8 @@
 //! index-matched boundaries), so ratio tracking, which estimates it in heterogeneous
 //! media, has nothing to add here.
 use super::toolkit::{
-    lane_mean, light_pdf, next_hit, roulette, sample_light, Carrier, Finish, Immediate,
-    PathState, ShadowSink, TransmittanceWalk, Unpolarized, Vertex, MAX_CROSSINGS,
+    lane_mean, light_pdf, next_hit, roulette, sample_light, Carrier, Finish, Immediate, PathState,
+    ShadowSink, TransmittanceWalk, Unpolarized, Vertex, MAX_CROSSINGS,
 };
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
@@ -188,8 +188,7 @@ pub(crate) fn step_carrying<
     if on(K, MEDIA) && s.medium != NO_MEDIUM {
         // A closed boundary always stops a ray inside; a ray that escapes it leaked.
         let Some(h) = &hit else { return false };
-        match medium_segment::<N, K, S, C>(ctx, s, ray, h, wl, sampler, counters, shadows, carry)
-        {
+        match medium_segment::<N, K, S, C>(ctx, s, ray, h, wl, sampler, counters, shadows, carry) {
             Segment::Scattered => return true,
             Segment::Ended => return false,
             Segment::Crossed => {}
@@ -235,7 +234,9 @@ pub(crate) fn step_carrying<
         }
         return false;
     };
-    surface_vertex::<N, K, S, C>(ctx, s, ray, &hit, mis, wl, sampler, counters, shadows, carry)
+    surface_vertex::<N, K, S, C>(
+        ctx, s, ray, &hit, mis, wl, sampler, counters, shadows, carry,
+    )
 }
 
 impl<const N: usize> PathState<N> {

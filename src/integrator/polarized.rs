@@ -36,8 +36,8 @@
 //!
 //! **What is not here yet.** Polarised area lights, light tracing, BDPT, the Whitted
 //! tracer and the packet engine of paths.
-use super::{path, whitted};
 use super::toolkit::{next_hit, Carrier, Immediate, PathState, Vertex};
+use super::{path, whitted};
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{LobeFlags, Polarizing};
@@ -79,7 +79,11 @@ impl<const N: usize> Polarized<'_, N> {
         let le = l.le(dir, wl);
         Some((
             std::array::from_fn(|i| {
-                let p = if le.0[i] > 0.0 { s1.0[i] / le.0[i] } else { 0.0 };
+                let p = if le.0[i] > 0.0 {
+                    s1.0[i] / le.0[i]
+                } else {
+                    0.0
+                };
                 Vec4::new(1.0, p, 0.0, 0.0)
             }),
             x,
@@ -165,9 +169,9 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
     ) {
         // Light samples reach the non-delta lobes only.
         let flags = match v {
-            Vertex::Surface { material, .. } => LobeFlags::from_bits(
-                material.flags().bits() & !LobeFlags::SPECULAR.bits(),
-            ),
+            Vertex::Surface { material, .. } => {
+                LobeFlags::from_bits(material.flags().bits() & !LobeFlags::SPECULAR.bits())
+            }
             Vertex::Medium { .. } => LobeFlags::NONE,
         };
         let (t, x_in) = self.through(v, wi, wi_local, flags, wl);

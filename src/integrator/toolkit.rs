@@ -511,7 +511,8 @@ impl<const N: usize> Carrier<N> for Unpolarized {
     }
 
     #[inline(always)]
-    fn scattered(&mut self, _: &Vertex, _: Vec3, _: Vec3, _: LobeFlags, _: &SampledWavelengths<N>) {}
+    fn scattered(&mut self, _: &Vertex, _: Vec3, _: Vec3, _: LobeFlags, _: &SampledWavelengths<N>) {
+    }
 }
 
 /// Where a vertex's shadow rays go. The one-path-at-a-time engine traces each at once

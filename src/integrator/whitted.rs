@@ -170,7 +170,9 @@ pub(crate) fn step_carrying<
             });
         } else {
             let mut lr = SampledSpectrum::<N>::zero();
-            direct_lighting(ctx, &it, wl, sampler, counters, shadows, f, |c, _, _| lr += c);
+            direct_lighting(ctx, &it, wl, sampler, counters, shadows, f, |c, _, _| {
+                lr += c
+            });
             shadows.add_scaled(&mut s.l, s.beta, lr);
         }
     }

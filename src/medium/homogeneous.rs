@@ -292,8 +292,12 @@ pub fn matrix_csv(radius_um: f64, lambda_nm: f64, absorption: bool) -> crate::Re
     debug_assert_eq!(rows.len() + 1, theta.len());
     for ((p, f), t) in rows.into_iter().zip(theta.windows(2)) {
         let (t0, t1) = (t[0].to_degrees(), t[1].to_degrees());
-        writeln!(out, "{t0:.17e},{t1:.17e},{p:.9e},{:.9e},{:.9e},{:.9e}", f[0], f[1], f[2])
-            .unwrap();
+        writeln!(
+            out,
+            "{t0:.17e},{t1:.17e},{p:.9e},{:.9e},{:.9e},{:.9e}",
+            f[0], f[1], f[2]
+        )
+        .unwrap();
     }
     Ok(out)
 }

@@ -33,8 +33,8 @@ pub mod phase_table;
 pub use henyey_greenstein::HgMedium;
 pub use homogeneous::{LorenzMieMedium, MieSpec, PopulationNode};
 
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::spectrum::stokes::{any_perpendicular, mueller_from_rows};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Mat4, Vec2, Vec3};
 use phase_table::{direction_at, v_between};
 
@@ -42,6 +42,9 @@ use phase_table::{direction_at, v_between};
 pub use crate::geometry::NO_MEDIUM;
 
 /// A participating medium.
+// A scene holds a handful of media, so the variants' sizes cost nothing; boxing the
+// tabulated one would put an indirection in every phase lookup.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 pub enum Medium {
     LorenzMie(LorenzMieMedium),

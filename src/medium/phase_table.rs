@@ -234,7 +234,10 @@ impl PhaseTable {
             .map(|j| {
                 (
                     self.density[j * self.nodes + node],
-                    self.matrix.get(j * self.nodes + node).copied().unwrap_or([0.0; 3]),
+                    self.matrix
+                        .get(j * self.nodes + node)
+                        .copied()
+                        .unwrap_or([0.0; 3]),
                 )
             })
             .collect()

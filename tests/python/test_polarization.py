@@ -231,7 +231,8 @@ def test_light_scattered_by_a_thin_fog_is_polarised_as_mie_theory_says(theta, fo
     Optical depth 0.01: light scattered twice is about 0.5% of the image, so it moves
     S1/S0 by less than 0.005; 8 × 8 pixels × 64 spp put the statistical error of the
     ratio near 1e-4 (forced next-event estimation samples every camera ray's segment;
-    measured: heron − Mie between −0.003 and +0.0004 over the six cases). The
+    measured heron − Mie: −0.0001, −0.0003, −0.0001 for 0.1 µm, 0.0000, +0.0030,
+    −0.0035 for 0.25 µm, whose double scattering is less depolarised). The
     tolerance, 0.01, is below the difference between the angles' fractions, and a sign
     or frame error (S1 ↔ −S1, or S1 ↔ S2) fails by many times it."""
     radius, density = FOGS[fog]
@@ -244,3 +245,29 @@ def test_light_scattered_by_a_thin_fog_is_polarised_as_mie_theory_says(theta, fo
     assert abs(s2) < 0.003 * s0 and abs(s3) < 0.003 * s0, (s2 / s0, s3 / s0)
     if fog == "0.1 µm" and theta == 90.0:
         assert want > 0.95
+
+
+def test_trace_reports_the_stokes_vector_from_python():
+    """heron.trace(stokes=...) is `heron trace --stokes`: unpolarised light reflected by
+    the Brewster scene's glass at Brewster's angle leaves as (R, R, 0, 0) in the s frame
+    (R = R_s/2), and the argument is checked."""
+    tb = np.arctan(1.5)
+    c, s = np.cos(tb), np.sin(tb)
+    ev = heron.trace(str(BREWSTER), [0.0, 4.0 * c, -4.0 * s], [0.0, -c, s], 550.0,
+                     path="R", stokes=[1.0, 0.0, 0.0, 0.0])
+    first = ev[0]
+    assert first["kind"] == "reflect"
+    s0, s1, s2, s3 = first["stokes"]
+    ct = np.sqrt(1.0 - (s / 1.5) ** 2)
+    r_s = ((c - 1.5 * ct) / (c + 1.5 * ct)) ** 2
+    assert abs(s0 - 0.5 * r_s) < 1e-5 and abs(s1 - s0) < 1e-5, first["stokes"]
+    assert abs(s2) < 1e-6 and abs(s3) < 1e-6
+    assert len(first["stokes_x"]) == 3
+    assert "stokes" not in heron.trace(str(BREWSTER), [0.0, 4.0 * c, -4.0 * s],
+                                       [0.0, -c, s], 550.0)[0]
+    msg = heron_error(heron.trace, scene=str(BREWSTER), origin=[0, 1, 0], direction=[0, -1, 0],
+                      wavelength=550.0, stokes=[1.0, 0.0])
+    assert "stokes" in msg and "four numbers" in msg, msg
+    msg = heron_error(heron.trace, scene=str(BREWSTER), origin=[0, 1, 0], direction=[0, -1, 0],
+                      wavelength=550.0, stokes=[1.0, 2.0, 0.0, 0.0])
+    assert "stokes" in msg and "physical" in msg, msg

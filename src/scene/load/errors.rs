@@ -6,8 +6,9 @@
 use crate::error::HeronError;
 use crate::scene::file::{
     show, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile,
-    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, PolarizerFile, QuadFile,
-    RetarderFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile, TriangleFile, WavesFile,
+    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, PolarizerFile,
+    QuadFile, RetarderFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile, TriangleFile,
+    WavesFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
