@@ -126,6 +126,11 @@ class RenderResult:
         """Stokes vectors in linear sRGB, H x W x 4 x 3: [..., k, c] is S_k of channel c,
         in the camera's frame (S1 > 0 horizontal, S2 > 0 at +45° counter-clockwise, S3 > 0
         right-circular; the EXR's R, G, B and S1.R ... S3.B), or None unpolarised."""
+    @property
+    def stokes_spectral(self) -> Optional[npt.NDArray[np.float32]]:
+        """Stokes vectors per spectral bin, H x W x 4 x bins: [..., k, b] is S_k's mean
+        spectral radiance in bin b (the EXR's S0.* ... S3.* channels; [..., 0, :] is
+        `spectral`), or None without polarization or spectral bins."""
     spp: int
     """Samples per pixel in the image."""
     rays: int

@@ -121,6 +121,9 @@ pub struct Checkpoint {
     /// Polarised renders: per pixel, the sums of S1, S2, S3 as XYZ over the finite
     /// samples (empty otherwise).
     pub sum_stokes: Vec<[i128; 9]>,
+    /// Polarised renders with spectral bins: per pixel, the bins of S1, then of S2, then
+    /// of S3 (3 × bins per pixel, as `sum_bins` holds S0's; empty otherwise).
+    pub sum_stokes_bins: Vec<i128>,
 }
 
 fn err(path: &Path, message: impl Into<String>) -> HeronError {
@@ -192,7 +195,12 @@ impl Checkpoint {
                 b.extend_from_slice(&v.to_le_bytes());
             }
         }
-        for v in self.sum_stokes.iter().flatten() {
+        for v in self
+            .sum_stokes
+            .iter()
+            .flatten()
+            .chain(&self.sum_stokes_bins)
+        {
             b.extend_from_slice(&v.to_le_bytes());
         }
         b
@@ -336,6 +344,15 @@ impl Checkpoint {
         } else {
             Vec::new()
         };
+        // S1–S3's bins follow their XYZ sums, three per bin of S0 (the header's flag and
+        // the bins' count say how many).
+        let sum_stokes_bins = if has_stokes {
+            (0..3 * n_bins)
+                .map(|_| r.i128())
+                .collect::<std::result::Result<Vec<_>, String>>()?
+        } else {
+            Vec::new()
+        };
         if !r.b.is_empty() {
             return Err(format!("{} bytes after the data", r.b.len()));
         }
@@ -361,6 +378,7 @@ impl Checkpoint {
             splat_sq,
             sppm,
             sum_stokes,
+            sum_stokes_bins,
         })
     }
 
@@ -462,6 +480,13 @@ impl Checkpoint {
                 })
                 .collect()
         });
+        // S1–S3's bins: per pixel, 3 × nb means (no splats: polarised integrators do
+        // not splat).
+        let stokes_spectral = (nb > 0 && !self.sum_stokes_bins.is_empty()).then(|| {
+            (0..3 * npix * nb)
+                .map(|j| mean(self.sum_stokes_bins[j], self.good[j / (3 * nb)], None))
+                .collect()
+        });
         Film {
             width: self.width,
             height: self.height,
@@ -469,6 +494,7 @@ impl Checkpoint {
             spectral,
             variance: self.variance.then(|| self.variance_image()),
             stokes,
+            stokes_spectral,
         }
     }
 
@@ -529,6 +555,9 @@ impl Checkpoint {
             for (x, y) in a.iter_mut().zip(b) {
                 *x = x.wrapping_add(*y);
             }
+        }
+        for (a, b) in self.sum_stokes_bins.iter_mut().zip(&o.sum_stokes_bins) {
+            *a = a.wrapping_add(*b);
         }
         for (a, b) in self
             .sum_sq
@@ -606,6 +635,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
             || (c.sum_sq.len(), c.splat_sq.len()) != (first.sum_sq.len(), first.splat_sq.len())
             || c.xyz_channels != first.xyz_channels
             || c.sum_stokes.len() != first.sum_stokes.len()
+            || c.sum_stokes_bins.len() != first.sum_stokes_bins.len()
         {
             return Err(err(
                 p,
@@ -661,6 +691,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
         splat_sq: vec![Default::default(); first.splat_sq.len()],
         sppm: None,
         sum_stokes: vec![[0; 9]; first.sum_stokes.len()],
+        sum_stokes_bins: vec![0; first.sum_stokes_bins.len()],
         ..first.clone()
     };
     for (_, c) in parts {
@@ -738,6 +769,7 @@ mod tests {
             splat_sq: vec![],
             sppm: None,
             sum_stokes: vec![],
+            sum_stokes_bins: vec![],
         };
         let b = c.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&b).unwrap(), c);
@@ -756,6 +788,13 @@ mod tests {
         let p = Checkpoint {
             sum_stokes: vec![[-1, 2, -3, 4, -5, 6, -7, 8, i128::MIN], [9; 9]],
             ..c.clone()
+        };
+        let pb = p.to_bytes();
+        // c has bins (2 per pixel), so a polarised film has S1–S3's too: 3 × 4 of them.
+        assert!(Checkpoint::from_bytes(&pb).is_err());
+        let p = Checkpoint {
+            sum_stokes_bins: (0..12).map(|k| k * (-1i128).pow(k as u32) << 70).collect(),
+            ..p
         };
         let pb = p.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&pb).unwrap(), p);

@@ -13,7 +13,8 @@ use crate::camera::CameraRay;
 use crate::checkpoint::{Checkpoint, Shard};
 use crate::film::fixed::{to_fixed, to_fixed3, SquareSum};
 use crate::film::{
-    add_splat_squares, add_to_bins, rgb_squares, xyz_of_sample, Film, SpectralBins, Splats,
+    add_splat_squares, add_stokes_to_bins, add_to_bins, rgb_squares, xyz_of_sample, Film,
+    SpectralBins, Splats,
 };
 use crate::geometry::{Ray, ShapeKind};
 use crate::integrator::{self, Context, Deferred, PathState, TraceCounters, WALKS};
@@ -254,11 +255,6 @@ fn render_with(
     }
     if opts.settings.polarization {
         integrator::stokes_kernel::<1>(kind, 0).map_err(HeronError::Invalid)?;
-        if opts.settings.spectral_bins > 0 {
-            return Err(HeronError::Invalid(
-                "polarization: spectral bins of S1-S3 are not written yet; render with spectral_bins = 0 (the EXR has S0-S3 in linear sRGB)".into(),
-            ));
-        }
         // The sky's polarisation is tabulated here, before the workers start.
         if let Some(sky) = &scene.sky {
             sky.linear_table();
@@ -433,6 +429,8 @@ pub(crate) trait SampleValue<const N: usize>: Copy {
     fn s0(&self) -> SampledSpectrum<N>;
     /// S1, S2, S3 as XYZ, in fixed point; None when any is out of the film's range.
     fn stokes_fixed(&self, wl: &SampledWavelengths<N>) -> Option<[i128; 9]>;
+    /// S1, S2, S3 (zero for radiance).
+    fn stokes_components(&self) -> [SampledSpectrum<N>; 3];
 }
 
 impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
@@ -448,6 +446,10 @@ impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
     #[inline(always)]
     fn stokes_fixed(&self, _: &SampledWavelengths<N>) -> Option<[i128; 9]> {
         Some([0; 9])
+    }
+    #[inline(always)]
+    fn stokes_components(&self) -> [SampledSpectrum<N>; 3] {
+        [SampledSpectrum::zero(); 3]
     }
 }
 
@@ -473,6 +475,10 @@ impl<const N: usize> SampleValue<N> for StokesSpectrum<N> {
             out[3 * (k - 1)..3 * k].copy_from_slice(&f);
         }
         Some(out)
+    }
+    #[inline]
+    fn stokes_components(&self) -> [SampledSpectrum<N>; 3] {
+        std::array::from_fn(|k| self.component(k + 1))
     }
 }
 
@@ -807,6 +813,14 @@ fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, widt
             {
                 *a = a.wrapping_add(*b);
             }
+            if !t.stokes_bins.is_empty() {
+                for (a, b) in state.sum_stokes_bins[3 * dst * nb..3 * (dst + 1) * nb]
+                    .iter_mut()
+                    .zip(&t.stokes_bins[3 * src * nb..3 * (src + 1) * nb])
+                {
+                    *a = a.wrapping_add(*b);
+                }
+            }
         }
     }
     for &(p, c) in &t.splats.list {
@@ -887,6 +901,12 @@ fn initial_state(
                 || c.splat_sq.len() != splat_sq_len
                 || c.passes_done as usize > passes
                 || c.sum_stokes.len() != if opts.settings.polarization { npix } else { 0 }
+                || c.sum_stokes_bins.len()
+                    != if opts.settings.polarization {
+                        3 * npix * nb
+                    } else {
+                        0
+                    }
                 || c.sppm.as_ref().map(|s| s.n.len()) != sppm.then_some(npix)
             {
                 return Err(HeronError::Invalid(
@@ -913,6 +933,14 @@ fn initial_state(
             splat_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).1],
             sppm: sppm.then(|| integrator::sppm::SppmPixels::new(npix)),
             sum_stokes: vec![[0; 9]; if opts.settings.polarization { npix } else { 0 }],
+            sum_stokes_bins: vec![
+                0;
+                if opts.settings.polarization {
+                    3 * npix * nb
+                } else {
+                    0
+                }
+            ],
             ..Default::default()
         },
     })
@@ -938,8 +966,10 @@ struct TileResult {
     xyz: Vec<[i128; 3]>,
     spectral: Vec<i128>,
     good: Vec<u32>,
-    /// Polarised renders: per pixel, the sums of S1, S2, S3 as XYZ (empty otherwise).
+    /// Polarised renders: per pixel, the sums of S1, S2, S3 as XYZ (empty otherwise),
+    /// and with spectral bins those of S1, S2 and S3 (3 × bins per pixel).
     stokes: Vec<[i128; 9]>,
+    stokes_bins: Vec<i128>,
     /// With `--variance`: per pixel, the sums of the squares of the samples' linear sRGB
     /// (empty otherwise); and per sample that splatted, the squares of its splats summed
     /// per pixel.
@@ -960,6 +990,7 @@ struct TileSums {
     spectral: Vec<i128>,
     good: Vec<u32>,
     stokes: Vec<[i128; 9]>,
+    stokes_bins: Vec<i128>,
     sq: Vec<[SquareSum; 3]>,
     nonfinite: u64,
     /// The first sample left out, in the one-path-at-a-time engine's order (its key:
@@ -978,6 +1009,11 @@ impl TileSums {
             spectral: vec![0i128; n * nb],
             good: vec![0u32; n],
             stokes: if stokes { vec![[0; 9]; n] } else { Vec::new() },
+            stokes_bins: if stokes {
+                vec![0; 3 * n * nb]
+            } else {
+                Vec::new()
+            },
             sq: if variance {
                 vec![[SquareSum::default(); 3]; n]
             } else {
@@ -1017,10 +1053,22 @@ impl TileSums {
         };
         // The bins are added only when the XYZ is in range, and the XYZ only when the
         // bins were.
+        // A polarised sample's four components go into their bins together.
         let ok = c.is_some()
             && st.is_some()
             && (nb == 0
-                || add_to_bins(&self.bins, &mut self.spectral[i * nb..(i + 1) * nb], l, wl));
+                || if O::STOKES {
+                    let [s1, s2, s3] = value.stokes_components();
+                    add_stokes_to_bins(
+                        &self.bins,
+                        &mut self.spectral[i * nb..(i + 1) * nb],
+                        &mut self.stokes_bins[3 * i * nb..3 * (i + 1) * nb],
+                        [*l, s1, s2, s3],
+                        wl,
+                    )
+                } else {
+                    add_to_bins(&self.bins, &mut self.spectral[i * nb..(i + 1) * nb], l, wl)
+                });
         let (Some(c), true) = (c, ok) else {
             self.nonfinite += 1;
             let key = [y, x / PACKET as u32, s, x % PACKET as u32];
@@ -1066,6 +1114,7 @@ impl TileSums {
             spectral: self.spectral,
             good: self.good,
             stokes: self.stokes,
+            stokes_bins: self.stokes_bins,
             sq: self.sq,
             splat_sq,
             splats,

@@ -123,6 +123,38 @@ fn physically_based_shards_merge_to_the_bytes_of_one_render() {
     }
 }
 
+/// Polarised renders (their Stokes sums and, with spectral bins, Stokes bins) merge to
+/// the bytes of one render too, under the path tracer and the Whitted tracer (with the
+/// camera's analyser). The EXR holds S0–S3 per bin; the DoLP and AoLP previews are written
+/// beside the PNG of both.
+#[test]
+fn polarised_shards_merge_to_the_bytes_of_one_render() {
+    let d = tempfile::tempdir().unwrap();
+    let set = [
+        "--spp",
+        "3",
+        "--spectral-bins",
+        "5",
+        "--lanes",
+        "4",
+        "--xyz",
+    ];
+    merged_equals_whole(d.path(), &scene("brewster.toml"), &set, 3, &[1, 2, 0]);
+    let mut w = set.to_vec();
+    w.extend_from_slice(&["--integrator", "whitted", "--polarizer", "30"]);
+    merged_equals_whole(d.path(), &scene("brewster.toml"), &w, 2, &[1, 0]);
+    for which in ["dolp", "aolp"] {
+        let (x, y) = (
+            d.path().join(format!("whole-2.{which}.png")),
+            d.path().join(format!("merged-2.{which}.png")),
+        );
+        assert!(
+            std::fs::read(&x).unwrap() == std::fs::read(&y).unwrap(),
+            "the merged {which} preview differs"
+        );
+    }
+}
+
 /// A shard stopped early (here by a time limit of zero: one pass) writes a film that
 /// --resume finishes; the merge refuses it before that and equals one render after.
 #[test]

@@ -323,6 +323,7 @@ pub struct RenderResult {
     wavelengths: Option<Py<PyArray1<f32>>>,
     variance: Option<Py<PyArray3<f32>>>,
     stokes: Option<Py<PyArray4<f32>>>,
+    stokes_spectral: Option<Py<PyArray4<f32>>>,
     /// Samples per pixel in the image.
     #[pyo3(get)]
     spp: u32,
@@ -424,6 +425,22 @@ impl RenderResult {
             }
             None => None,
         };
+        // H × W × 4 × bins: S0's bins (`spectral`), then S1's, S2's, S3's.
+        let stokes_spectral = match (&film.spectral, &film.stokes_spectral) {
+            (Some((bins, s0)), Some(rest)) => {
+                let nb = bins.count;
+                let data: Vec<f32> = (0..w * h)
+                    .flat_map(|i| {
+                        s0[i * nb..(i + 1) * nb]
+                            .iter()
+                            .chain(&rest[3 * i * nb..3 * (i + 1) * nb])
+                            .copied()
+                    })
+                    .collect();
+                Some(data.into_pyarray(py).reshape([h, w, 4, nb])?.unbind())
+            }
+            _ => None,
+        };
         Ok(RenderResult {
             rgb,
             xyz,
@@ -431,6 +448,7 @@ impl RenderResult {
             wavelengths,
             variance,
             stokes,
+            stokes_spectral,
             spp: stats.spp,
             rays: stats.total_rays(),
             camera_rays: stats.counters.rays,
@@ -487,6 +505,14 @@ impl RenderResult {
     #[getter]
     fn stokes(&self, py: Python<'_>) -> Option<Py<PyArray4<f32>>> {
         self.stokes.as_ref().map(|a| a.clone_ref(py))
+    }
+
+    /// The Stokes vector of each pixel per spectral bin, H×W×4×bins float32: [..., k, b]
+    /// is the mean spectral radiance of S_k in bin b (the EXR's S0.* … S3.* channels;
+    /// [..., 0, :] is `spectral`), or None without polarization or spectral bins.
+    #[getter]
+    fn stokes_spectral(&self, py: Python<'_>) -> Option<Py<PyArray4<f32>>> {
+        self.stokes_spectral.as_ref().map(|a| a.clone_ref(py))
     }
 
     /// The spectral bins' centres in nm (float32), or None without spectral bins.

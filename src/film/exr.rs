@@ -8,7 +8,10 @@
 //! --variance`), the channels `variance.R`, `variance.G`, `variance.B`: the variance of
 //! each pixel's R, G, B value (of the mean over its samples, not of one sample; the
 //! layer `variance` in OpenEXR's `layer.channel` naming), which `heron compare` reads.
-//! A polarised render adds the Stokes components `S1.R` … `S3.B` ([`STOKES_CHANNELS`]).
+//! A polarised render adds the Stokes components `S1.R` … `S3.B` ([`STOKES_CHANNELS`]),
+//! and with spectral bins Fichet et al.'s polarised layout: `S1.<λ>nm`, `S2.<λ>nm`,
+//! `S3.<λ>nm` beside `S0.<λ>nm`, and the attribute `polarisationHandedness` "right"
+//! (S3 > 0 is right-circular light, Collett's convention).
 use super::Film;
 use crate::files::Staged;
 use crate::provenance::{Provenance, PREFIX};
@@ -39,7 +42,13 @@ pub struct ExrChannels {
 
 /// The Fichet et al. 2021 channel name of an emissive bin centred at `lambda` nm.
 pub fn spectral_channel_name(lambda: f32) -> String {
-    format!("S0.{}nm", format!("{lambda:.6}").replace('.', ","))
+    stokes_channel_name(0, lambda)
+}
+
+/// The Fichet et al. 2021 channel name of Stokes component `k` (0–3) of a bin centred
+/// at `lambda` nm.
+pub fn stokes_channel_name(k: usize, lambda: f32) -> String {
+    format!("S{k}.{}nm", format!("{lambda:.6}").replace('.', ","))
 }
 
 /// Writes the EXR file to a temporary file, to be committed later. `provenance` goes
@@ -103,6 +112,22 @@ pub fn stage_exr(
             Text::from("emissiveUnits"),
             attribute::AttributeValue::Text(Text::from("W.m^-2.sr^-1")),
         );
+        if let Some(st) = &film.stokes_spectral {
+            let nb = bins.count;
+            for k in 1..4 {
+                for b in 0..nb {
+                    let name = stokes_channel_name(k, bins.centre(b));
+                    list.push(AnyChannel::new(
+                        name.as_str(),
+                        plane(&|i| st[(3 * i + k - 1) * nb + b]),
+                    ));
+                }
+            }
+            layer_attrs.other.insert(
+                Text::from("polarisationHandedness"),
+                attribute::AttributeValue::Text(Text::from("right")),
+            );
+        }
     }
     let layer = Layer::new(
         (w, h),

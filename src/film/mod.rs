@@ -101,6 +101,48 @@ pub fn add_to_bins<const N: usize>(
     true
 }
 
+/// [`add_to_bins`] for the four Stokes components `s` of a polarised sample: S0's bins
+/// to `s0`, S1's, S2's and S3's one after the other to `rest`. Adds nothing and returns
+/// false if any value is out of the fixed-point range, so the components stay together.
+#[inline]
+pub fn add_stokes_to_bins<const N: usize>(
+    bins: &SpectralBins,
+    s0: &mut [i128],
+    rest: &mut [i128],
+    s: [SampledSpectrum<N>; 4],
+    wl: &SampledWavelengths<N>,
+) -> bool {
+    let w = 1.0 / (N as f32 * bins.width());
+    let v: [[f32; N]; 4] = s.map(|l| {
+        std::array::from_fn(|i| {
+            if wl.pdf[i] > 0.0 {
+                l.0[i] * w / wl.pdf[i]
+            } else {
+                0.0
+            }
+        })
+    });
+    if !v.iter().flatten().all(|x| x.abs() < fixed::LIMIT) {
+        return false;
+    }
+    let nb = bins.count;
+    for (k, v) in v.iter().enumerate() {
+        let out = if k == 0 {
+            &mut s0[..]
+        } else {
+            &mut rest[(k - 1) * nb..k * nb]
+        };
+        for (i, &v) in v.iter().enumerate() {
+            if v != 0.0 {
+                let a = &mut out[bins.index(wl.lambda[i])];
+                // In range: checked above.
+                *a = a.wrapping_add(fixed::to_fixed(v).unwrap_or(0));
+            }
+        }
+    }
+    true
+}
+
 /// Contributions an integrator makes to pixels other than the one it samples (light
 /// tracing, bidirectional connections to the camera): kept in the order they are made,
 /// per tile and pass, and added to the film in tile order by `render.rs`, so splatting
@@ -235,6 +277,10 @@ pub struct Film {
     /// Polarised renders: per pixel, the Stokes components S1, S2, S3 as CIE XYZ (signed;
     /// S0 is `xyz`), in the camera's frame (`Camera::stokes_x`: S1 > 0 horizontal).
     pub stokes: Option<Vec<[[f32; 3]; 3]>>,
+    /// Polarised renders with spectral bins: per pixel, the mean of S1 in each of
+    /// `spectral`'s bins, then of S2, then of S3 (3 × bins per pixel, pixel-major; S0's
+    /// are `spectral`'s).
+    pub stokes_spectral: Option<Vec<f32>>,
 }
 
 impl Film {

@@ -234,27 +234,28 @@ pub fn radiance<const N: usize, const K: KernelFlags>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
 ) -> StokesSpectrum<N> {
-    let mut carry = Polarized::at_camera(ctx, &cam);
-    let mut s = PathState::<N>::at_camera(&cam);
-    let mut ray = cam.ray;
-    let mut pending = first_hit;
-    loop {
-        let hit = next_hit(ctx, &ray, &mut pending, counters);
-        if !path::step_carrying::<N, K, _, _>(
-            ctx,
-            &mut s,
-            &mut ray,
-            hit,
-            wl,
-            sampler,
-            counters,
-            &mut Immediate,
-            &mut carry,
-        ) {
-            break;
-        }
-    }
-    carry.out
+    let s = PathState::<N>::at_camera(&cam);
+    follow(
+        ctx,
+        cam,
+        s,
+        first_hit,
+        sampler,
+        counters,
+        |s, ray, hit, sampler, c, carry| {
+            path::step_carrying::<N, K, _, _>(
+                ctx,
+                s,
+                ray,
+                hit,
+                wl,
+                sampler,
+                c,
+                &mut Immediate,
+                carry,
+            )
+        },
+    )
 }
 
 /// The same from the seed's Whitted tracer (`whitted::step_carrying`): its direct
@@ -268,23 +269,55 @@ pub fn whitted_radiance<const N: usize, const K: KernelFlags>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
 ) -> StokesSpectrum<N> {
+    let s = whitted::start::<N>(&cam);
+    follow(
+        ctx,
+        cam,
+        s,
+        first_hit,
+        sampler,
+        counters,
+        |s, ray, hit, sampler, c, carry| {
+            whitted::step_carrying::<N, K, _, _>(
+                ctx,
+                s,
+                ray,
+                hit,
+                wl,
+                sampler,
+                c,
+                &mut Immediate,
+                carry,
+            )
+        },
+    )
+}
+
+/// The one-path-at-a-time loop over an integrator's `step` from the camera ray `cam`
+/// and the path state `s` at it, with the polarised carrier; its Stokes radiance.
+#[inline(always)]
+fn follow<const N: usize>(
+    ctx: &Context,
+    cam: CameraRay,
+    mut s: PathState<N>,
+    first_hit: Option<Option<Hit>>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    mut step: impl FnMut(
+        &mut PathState<N>,
+        &mut crate::geometry::Ray,
+        Option<Hit>,
+        &mut Sampler,
+        &mut TraceCounters,
+        &mut Polarized<'_, N>,
+    ) -> bool,
+) -> StokesSpectrum<N> {
     let mut carry = Polarized::at_camera(ctx, &cam);
-    let mut s = whitted::start::<N>(&cam);
     let mut ray = cam.ray;
     let mut pending = first_hit;
     loop {
         let hit = next_hit(ctx, &ray, &mut pending, counters);
-        if !whitted::step_carrying::<N, K, _, _>(
-            ctx,
-            &mut s,
-            &mut ray,
-            hit,
-            wl,
-            sampler,
-            counters,
-            &mut Immediate,
-            &mut carry,
-        ) {
+        if !step(&mut s, &mut ray, hit, sampler, counters, &mut carry) {
             break;
         }
     }

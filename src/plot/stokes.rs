@@ -438,6 +438,7 @@ mod tests {
             xyz: pixels.iter().map(|p| xyz3(p[0])).collect(),
             spectral: None,
             variance: None,
+            stokes_spectral: None,
             stokes: Some(
                 pixels
                     .iter()

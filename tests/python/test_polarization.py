@@ -271,3 +271,38 @@ def test_trace_reports_the_stokes_vector_from_python():
     msg = heron_error(heron.trace, scene=str(BREWSTER), origin=[0, 1, 0], direction=[0, -1, 0],
                       wavelength=550.0, stokes=[1.0, 2.0, 0.0, 0.0])
     assert "stokes" in msg and "physical" in msg, msg
+
+
+def test_spectral_stokes_bins_are_fichets_polarised_layout(tmp_path):
+    """With spectral bins a polarised render writes S0-S3 per bin in the layout of
+    Fichet, Pacanowski & Wilkie 2021, read back by colour-science's own reader
+    (`colour.read_spectral_image_Fichet2021`, which reads the S1-S3 components of a
+    polarised image); they are RenderResult.stokes_spectral, [..., 0, :] is .spectral,
+    and the window's reflection near Brewster's angle is s-polarised (S1 close to S0,
+    horizontal in the picture) bin by bin."""
+    out = tmp_path / "b.exr"
+    subprocess.run(
+        [str(require_heron_bin()), "render", str(BREWSTER), "-o", str(out), "--spp", "4",
+         "--spectral-bins", "8", "--quiet", "--no-png"],
+        check=True,
+    )
+    components, spec = colour.read_spectral_image_Fichet2021(str(out), additional_data=True)
+    assert sorted(components) == ["S0", "S1", "S2", "S3"]
+    assert spec.is_polarised and spec.is_emissive
+    attrs = {a.name: a.value for a in spec.attributes}
+    assert attrs.get("polarisationHandedness") == "right", attrs
+    wl, s0 = components["S0"]
+    assert len(wl) == 8
+    r = heron.load_scene(str(BREWSTER)).render(spp=4, spectral_bins=8)
+    st = r.stokes_spectral
+    assert st.shape == (240, 320, 4, 8)
+    assert np.array_equal(st[..., 0, :], r.spectral)
+    for k in range(4):
+        wl_k, v = components[f"S{k}"]
+        assert np.allclose(wl_k, wl)
+        assert np.array_equal(np.asarray(v, dtype=np.float32), st[..., k, :]), k
+    window = st[100:112, 140:152].mean(axis=(0, 1))  # 4 × 8
+    assert np.all(window[0] > 0)
+    # As the XYZ test above: the scene's wide field sees the plate from 50° to 62°.
+    assert np.all(window[1] / window[0] > 0.9), window[1] / window[0]
+    assert np.all(np.abs(window[3]) < 1e-3 * window[0])
