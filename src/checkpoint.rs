@@ -793,7 +793,9 @@ mod tests {
         // c has bins (2 per pixel), so a polarised film has S1–S3's too: 3 × 4 of them.
         assert!(Checkpoint::from_bytes(&pb).is_err());
         let p = Checkpoint {
-            sum_stokes_bins: (0..12).map(|k| (k * (-1i128).pow(k as u32)) << 70).collect(),
+            sum_stokes_bins: (0..12)
+                .map(|k| (k * (-1i128).pow(k as u32)) << 70)
+                .collect(),
             ..p
         };
         let pb = p.to_bytes();
