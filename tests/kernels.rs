@@ -26,6 +26,10 @@ fn image(s: &Scene, kind: IntegratorKind, kernel: KernelChoice) -> (Vec<u32>, Ke
     o.settings.spp = 3;
     o.settings.lanes = 4;
     o.threads = 2;
+    // The specialised kernels are the unpolarised ones: a polarised scene (brewster,
+    // polarized-*) is rendered unpolarised here; polarised renders have their own two
+    // kernels (`integrator::stokes_flags`), whatever `kernel` says.
+    o.settings.polarization = false;
     let (film, stats) = render(s, &o).unwrap();
     let bits = film.xyz.iter().flatten().map(|v| v.to_bits()).collect();
     (bits, stats.kernel)
