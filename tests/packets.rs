@@ -36,6 +36,9 @@ fn image(s: &Scene, kind: IntegratorKind, packets: Packets, threads: usize) -> I
     o.settings.spp = 4;
     o.settings.lanes = 8;
     o.threads = threads;
+    // Packets of paths carry scalar throughputs: polarised scenes are compared
+    // unpolarised (a polarised render runs camera packets only, `render.rs`).
+    o.settings.polarization = false;
     let (film, stats) = render(s, &o).unwrap();
     Image {
         xyz: film.xyz,

@@ -368,7 +368,7 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[materials.x]\ntype = \"mirror\"\nior = 1.5\n",
      &["unknown key \"ior\" at materials.x (expected one of type, rho_s)"]),
     ("", "[render]\nsamples = 4\n",
-     &["unknown key \"samples\" at render (expected one of spp, max_depth, epsilon, seed, integrator, rr_depth, light_sampler, offset, medium_nee, sun_guide, sppm_photons, sppm_alpha, sppm_radius, spectral_bins)"]),
+     &["unknown key \"samples\" at render (expected one of spp, max_depth, epsilon, seed, integrator, rr_depth, light_sampler, offset, medium_nee, sun_guide, sppm_photons, sppm_alpha, sppm_radius, spectral_bins, polarization)"]),
     ("backgroun = 1\n", "", &["unknown key \"backgroun\" at the top level", "background"]),
     ("", "[camera.extra]\nx = 1\n", &["unknown key \"extra\" at camera (expected one of eye, "]),
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { spectrum = \"E\", scal = 1 }\n",
@@ -597,7 +597,7 @@ fn bad_cameras() {
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 0, 0]\nresolution = [4, 4]\n",
          "camera.up: expected a non-zero vector"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\nfov = 40\n",
-         "unknown key \"fov\" at camera (expected one of eye, look_at, up, d, resolution, type, lens, surface, film_diagonal, film_distance, focus_distance, focus_wavelength, mm_per_unit, f_number, pupil, film_offset)"),
+         "unknown key \"fov\" at camera (expected one of eye, look_at, up, d, resolution, type, lens, surface, film_diagonal, film_distance, focus_distance, focus_wavelength, mm_per_unit, f_number, polarizer, pupil, film_offset)"),
     ];
     for (cam, want) in cases {
         let (_, msg) = dir.err(&format!("[camera]\n{cam}"));
