@@ -80,7 +80,7 @@ pub fn s_of_pair(wi: Vec3, wo: Vec3) -> Vec3 {
 /// Jones matrix method", to first order). At normal incidence it is the sheet axis.
 /// Polarisers use [`polarizer_axis`].
 #[inline]
-pub fn sheet_axis(axis: Vec3, angle: f32, k: Vec3) -> Vec3 {
+pub fn retarder_axis(axis: Vec3, angle: f32, k: Vec3) -> Vec3 {
     let x = in_plane_axis(axis, angle);
     let p = x - k * x.dot(k);
     if p.length_squared() > 1e-12 {
@@ -92,7 +92,7 @@ pub fn sheet_axis(axis: Vec3, angle: f32, k: Vec3) -> Vec3 {
 
 /// A polariser sheet's transmission axis for a ray along ±`k` (local frame), from its
 /// in-sheet transmission axis (`axis` projected onto the sheet and turned by `angle`,
-/// as [`sheet_axis`]): the sheet absorbs along the in-sheet axis across it, ẑ × x̂ (the
+/// as [`retarder_axis`]): the sheet absorbs along the in-sheet axis across it, ẑ × x̂ (the
 /// aligned absorbers of a dichroic sheet, the wires of a wire grid), so an oblique ray
 /// loses the field along that absorption axis projected perpendicular to the ray, and
 /// transmits what is perpendicular to both: k̂ × (the projected absorption axis)

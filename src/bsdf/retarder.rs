@@ -16,7 +16,7 @@
 //! 1/λ, which this model does not follow). The fast axis is given as the polariser's
 //! transmission axis is ([`super::polarizer`]). As a BSDF it is a delta transmission
 //! ωi = −ωo of weight 1.
-use super::polarization::{normalized, sheet_axis, Polarizing};
+use super::polarization::{normalized, retarder_axis, Polarizing};
 use super::polarizer::pass_through;
 use super::{BsdfContext, BsdfModel, BsdfSample, LobeFlags};
 use crate::math::Frame;
@@ -63,7 +63,7 @@ impl BsdfModel for Retarder {
         _: &SampledWavelengths<N>,
         frame: &Frame,
     ) -> Polarizing<N> {
-        let x = sheet_axis(frame.to_local(self.axis), self.angle, wi);
+        let x = retarder_axis(frame.to_local(self.axis), self.angle, wi);
         let m = normalized(&Mueller::linear_retarder(self.retardance as f64, 0.0));
         Polarizing::Mueller {
             m: [m; N],

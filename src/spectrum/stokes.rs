@@ -21,12 +21,6 @@ impl<const N: usize> StokesSpectrum<N> {
         StokesSpectrum([Vec4::ZERO; N])
     }
 
-    /// Unpolarised light of intensity `l` per lane: (l, 0, 0, 0).
-    #[inline]
-    pub fn unpolarized(l: SampledSpectrum<N>) -> Self {
-        StokesSpectrum(std::array::from_fn(|i| Vec4::new(l.0[i], 0.0, 0.0, 0.0)))
-    }
-
     /// Component `k` (0 to 3) of every lane.
     #[inline]
     pub fn component(&self, k: usize) -> SampledSpectrum<N> {
