@@ -415,7 +415,13 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         v.infinite = light.is_infinite();
         v.beta = le.l;
         v.pdf_fwd = le.pdf_pos * pmf;
-        v.delta = light.is_delta();
+        // A delta light's vertex is not a delta *vertex*: the light itself cannot be
+        // hit (s = 0, which `mis_weight` leaves out by `is_delta_light`), but its first
+        // bounce can be reached by next-event estimation (s = 1), so the strategies
+        // beyond it count (pbrt-v3's `Vertex::CreateLight` leaves `delta` false too).
+        // Setting it here gave (s ≥ 2, t) under a point or spot light the weight of a
+        // lone strategy, counting those paths twice.
+        v.delta = false;
         path[0] = v;
         let beta = start.beta();
         let ray = self.ctx.offset.spawn(&le.spawn_point(), le.dir);
