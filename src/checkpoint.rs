@@ -24,7 +24,10 @@
 //! integers, `film::fixed::SquareSum`) and of the splats' (the same per pixel for a
 //! splatting integrator, else empty); with `sppm: true` in the header (photon
 //! mapping's checkpoints), then the pixel count (u64) and per pixel the photon count N,
-//! then per pixel the squared radius R² (f32 each), from which a resumed render goes on.
+//! then per pixel the squared radius R² (f32 each), from which a resumed render goes on;
+//! with `stokes: true` (polarised renders), then per pixel the sums of S1, S2, S3 as XYZ
+//! (9 × i128) and their spectral bins (3 × bins per pixel); with `stokesSplats: true`
+//! (polarised light tracing and BDPT), then the same two arrays of the splats.
 //!
 //! Variance (`Checkpoint::film`): a pixel's value is the mean of its n finite samples,
 //! so its variance is estimated from their sums S₁ = Σ c and S₂ = Σ c² as
@@ -124,6 +127,11 @@ pub struct Checkpoint {
     /// Polarised renders with spectral bins: per pixel, the bins of S1, then of S2, then
     /// of S3 (3 × bins per pixel, as `sum_bins` holds S0's; empty otherwise).
     pub sum_stokes_bins: Vec<i128>,
+    /// Polarised renders of a splatting integrator (light tracing, BDPT): per pixel, the
+    /// splatted S1, S2, S3 as XYZ, and with spectral bins their splatted bins (3 ×
+    /// bins per pixel); empty otherwise.
+    pub splat_stokes: Vec<[i128; 9]>,
+    pub splat_stokes_bins: Vec<i128>,
 }
 
 fn err(path: &Path, message: impl Into<String>) -> HeronError {
@@ -155,6 +163,9 @@ impl Checkpoint {
         // Only when polarised, so that other films keep their bytes.
         if !self.sum_stokes.is_empty() {
             header["stokes"] = true.into();
+        }
+        if !self.splat_stokes.is_empty() {
+            header["stokesSplats"] = true.into();
         }
         b.extend_from_slice(header.to_string().as_bytes());
         b.push(b'\n');
@@ -200,6 +211,8 @@ impl Checkpoint {
             .iter()
             .flatten()
             .chain(&self.sum_stokes_bins)
+            .chain(self.splat_stokes.iter().flatten())
+            .chain(&self.splat_stokes_bins)
         {
             b.extend_from_slice(&v.to_le_bytes());
         }
@@ -273,6 +286,10 @@ impl Checkpoint {
         };
         let (variance, has_sppm) = (flag("variance")?, flag("sppm")?);
         let has_stokes = flag("stokes")?;
+        let has_stokes_splats = flag("stokesSplats")?;
+        if has_stokes_splats && !has_stokes {
+            return Err("its header has stokesSplats without stokes".into());
+        }
         let mut r = Reader { b: &rest[nl + 1..] };
         let passes_done = r.u32()?;
         let spp_done = r.u32()?;
@@ -331,7 +348,10 @@ impl Checkpoint {
         } else {
             None
         };
-        let sum_stokes = if has_stokes {
+        let nines = |r: &mut Reader, on: bool| -> std::result::Result<Vec<[i128; 9]>, String> {
+            if !on {
+                return Ok(Vec::new());
+            }
             (0..n_xyz)
                 .map(|_| {
                     let mut v = [0i128; 9];
@@ -340,19 +360,25 @@ impl Checkpoint {
                     }
                     Ok(v)
                 })
-                .collect::<std::result::Result<Vec<_>, String>>()?
-        } else {
-            Vec::new()
+                .collect()
         };
+        let ints = |r: &mut Reader, n: usize| -> std::result::Result<Vec<i128>, String> {
+            (0..n).map(|_| r.i128()).collect()
+        };
+        let sum_stokes = nines(&mut r, has_stokes)?;
         // S1–S3's bins follow their XYZ sums, three per bin of S0 (the header's flag and
-        // the bins' count say how many).
-        let sum_stokes_bins = if has_stokes {
-            (0..3 * n_bins)
-                .map(|_| r.i128())
-                .collect::<std::result::Result<Vec<_>, String>>()?
-        } else {
-            Vec::new()
-        };
+        // the bins' count say how many); then, for a splatting integrator, the same of
+        // the splats.
+        let sum_stokes_bins = ints(&mut r, if has_stokes { 3 * n_bins } else { 0 })?;
+        let splat_stokes = nines(&mut r, has_stokes_splats)?;
+        let splat_stokes_bins = ints(
+            &mut r,
+            if has_stokes_splats {
+                3 * n_splat_bins
+            } else {
+                0
+            },
+        )?;
         if !r.b.is_empty() {
             return Err(format!("{} bytes after the data", r.b.len()));
         }
@@ -379,6 +405,8 @@ impl Checkpoint {
             sppm,
             sum_stokes,
             sum_stokes_bins,
+            splat_stokes,
+            splat_stokes_bins,
         })
     }
 
@@ -474,17 +502,26 @@ impl Checkpoint {
                 .map(|i| {
                     std::array::from_fn(|k| {
                         std::array::from_fn(|j| {
-                            mean(self.sum_stokes[i][3 * k + j], self.good[i], None)
+                            mean(
+                                self.sum_stokes[i][3 * k + j],
+                                self.good[i],
+                                self.splat_stokes.get(i).map(|s| s[3 * k + j]),
+                            )
                         })
                     })
                 })
                 .collect()
         });
-        // S1–S3's bins: per pixel, 3 × nb means (no splats: polarised integrators do
-        // not splat).
+        // S1–S3's bins: per pixel, 3 × nb means.
         let stokes_spectral = (nb > 0 && !self.sum_stokes_bins.is_empty()).then(|| {
             (0..3 * npix * nb)
-                .map(|j| mean(self.sum_stokes_bins[j], self.good[j / (3 * nb)], None))
+                .map(|j| {
+                    mean(
+                        self.sum_stokes_bins[j],
+                        self.good[j / (3 * nb)],
+                        self.splat_stokes_bins.get(j).copied(),
+                    )
+                })
                 .collect()
         });
         Film {
@@ -556,7 +593,17 @@ impl Checkpoint {
                 *x = x.wrapping_add(*y);
             }
         }
-        for (a, b) in self.sum_stokes_bins.iter_mut().zip(&o.sum_stokes_bins) {
+        for (a, b) in self.splat_stokes.iter_mut().zip(&o.splat_stokes) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.wrapping_add(*y);
+            }
+        }
+        for (a, b) in self
+            .sum_stokes_bins
+            .iter_mut()
+            .zip(&o.sum_stokes_bins)
+            .chain(self.splat_stokes_bins.iter_mut().zip(&o.splat_stokes_bins))
+        {
             *a = a.wrapping_add(*b);
         }
         for (a, b) in self
@@ -636,6 +683,8 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
             || c.xyz_channels != first.xyz_channels
             || c.sum_stokes.len() != first.sum_stokes.len()
             || c.sum_stokes_bins.len() != first.sum_stokes_bins.len()
+            || c.splat_stokes.len() != first.splat_stokes.len()
+            || c.splat_stokes_bins.len() != first.splat_stokes_bins.len()
         {
             return Err(err(
                 p,
@@ -692,6 +741,8 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
         sppm: None,
         sum_stokes: vec![[0; 9]; first.sum_stokes.len()],
         sum_stokes_bins: vec![0; first.sum_stokes_bins.len()],
+        splat_stokes: vec![[0; 9]; first.splat_stokes.len()],
+        splat_stokes_bins: vec![0; first.splat_stokes_bins.len()],
         ..first.clone()
     };
     for (_, c) in parts {
@@ -770,6 +821,8 @@ mod tests {
             sppm: None,
             sum_stokes: vec![],
             sum_stokes_bins: vec![],
+            splat_stokes: vec![],
+            splat_stokes_bins: vec![],
         };
         let b = c.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&b).unwrap(), c);
@@ -801,6 +854,19 @@ mod tests {
         let pb = p.to_bytes();
         assert_eq!(Checkpoint::from_bytes(&pb).unwrap(), p);
         assert!(Checkpoint::from_bytes(&pb[..pb.len() - 16]).is_err());
+        // With a polarised splatting integrator's splats of S1–S3 (and of their bins:
+        // none, as c's splats have none).
+        let q = Checkpoint {
+            splat_stokes: vec![[3 << 100; 9], [-4; 9]],
+            ..p.clone()
+        };
+        let qb = q.to_bytes();
+        assert_eq!(Checkpoint::from_bytes(&qb).unwrap(), q);
+        assert_eq!(
+            qb.len(),
+            pb.len() + 2 * 9 * 16 + r#","stokesSplats":true"#.len()
+        );
+        assert!(Checkpoint::from_bytes(&qb[..qb.len() - 16]).is_err());
         for cut in [0, 5, MAGIC.len() + 3, b.len() - 1] {
             assert!(Checkpoint::from_bytes(&b[..cut]).is_err(), "{cut}");
         }

@@ -304,8 +304,12 @@ fn render_with(
     };
     // Light tracing and BDPT have no steps: with `paths`, each pixel sample sends its
     // connections' shadow rays 8 at a time (toolkit `Connections`).
-    if opts.settings.polarization && opts.settings.packets == Packets::Paths {
-        // The packet engine's steps carry scalar throughputs: camera packets only.
+    if opts.settings.polarization
+        && opts.settings.packets == Packets::Paths
+        && integrator::path_fns::<1>(kind, 0).is_some()
+    {
+        // The packet engine's steps carry scalar throughputs: camera packets only (light
+        // tracing's and BDPT's connections carry Stokes vectors in their packets).
         opts.settings.packets = Packets::Camera;
     }
     let paths =
@@ -823,15 +827,39 @@ fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, widt
             }
         }
     }
-    for &(p, c) in &t.splats.list {
+    let stokes_splats = !t.splats.stokes.is_empty();
+    if stokes_splats && state.splat_stokes.is_empty() {
+        // Polarised splats from an integrator not known to splat.
+        state.splat_stokes = vec![[0; 9]; npix];
+        state.splat_stokes_bins = vec![0; 3 * state.splat_bins.len()];
+    }
+    for (j, &(p, c)) in t.splats.list.iter().enumerate() {
         state.any_splat = true;
-        match to_fixed3(c) {
-            Some(f) => {
+        // A polarised splat's four components count together.
+        let st = if stokes_splats {
+            let s = &t.splats.stokes[j];
+            match (to_fixed3(s[0]), to_fixed3(s[1]), to_fixed3(s[2])) {
+                (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+                _ => None,
+            }
+        } else {
+            Some([[0; 3]; 3])
+        };
+        match (to_fixed3(c), st) {
+            (Some(f), Some(st)) => {
                 for (a, b) in state.splat[p as usize].iter_mut().zip(f) {
                     *a = a.wrapping_add(b);
                 }
+                if stokes_splats {
+                    for (a, b) in state.splat_stokes[p as usize]
+                        .iter_mut()
+                        .zip(st.iter().flatten())
+                    {
+                        *a = a.wrapping_add(*b);
+                    }
+                }
             }
-            None => state.nonfinite += 1,
+            _ => state.nonfinite += 1,
         }
     }
     if state.splat_sq.is_empty() && !t.splat_sq.is_empty() {
@@ -843,12 +871,21 @@ fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, widt
             a.add(*b);
         }
     }
-    for &(p, k, v) in &t.splats.spectral {
+    for (j, &(p, k, v)) in t.splats.spectral.iter().enumerate() {
         // A splat too large for the film was counted with its XYZ above.
-        if let Some(f) = to_fixed(v) {
-            let a = &mut state.splat_bins[p as usize * nb + k as usize];
-            *a = a.wrapping_add(f);
+        let Some(f) = to_fixed(v) else { continue };
+        if stokes_splats {
+            let s = t.splats.stokes_spectral[j].map(to_fixed);
+            let [Some(s1), Some(s2), Some(s3)] = s else {
+                continue;
+            };
+            for (c, v) in [s1, s2, s3].into_iter().enumerate() {
+                let a = &mut state.splat_stokes_bins[(3 * p as usize + c) * nb + k as usize];
+                *a = a.wrapping_add(v);
+            }
         }
+        let a = &mut state.splat_bins[p as usize * nb + k as usize];
+        *a = a.wrapping_add(f);
     }
     state.rays += t.counters.rays;
     state.shadow_rays += t.counters.shadow_rays;
@@ -869,6 +906,7 @@ fn initial_state(
     let npix = (cam.width * cam.height) as usize;
     let nb = opts.settings.spectral_bins;
     let sppm = opts.settings.integrator == IntegratorKind::Sppm;
+    let stokes_splats = opts.settings.polarization && kind_splats(opts);
     Ok(match &opts.resume {
         Some(c) => {
             if c.variance != opts.variance {
@@ -907,6 +945,8 @@ fn initial_state(
                     } else {
                         0
                     }
+                || c.splat_stokes.len() != if stokes_splats { npix } else { 0 }
+                || c.splat_stokes_bins.len() != if stokes_splats { 3 * npix * nb } else { 0 }
                 || c.sppm.as_ref().map(|s| s.n.len()) != sppm.then_some(npix)
             {
                 return Err(HeronError::Invalid(
@@ -941,6 +981,8 @@ fn initial_state(
                     0
                 }
             ],
+            splat_stokes: vec![[0; 9]; if stokes_splats { npix } else { 0 }],
+            splat_stokes_bins: vec![0; if stokes_splats { 3 * npix * nb } else { 0 }],
             ..Default::default()
         },
     })

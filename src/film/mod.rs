@@ -10,6 +10,7 @@ pub mod png;
 
 use crate::spectrum::cie::cie1931;
 use crate::spectrum::color::{xyz_to_linear_srgb, XYZ_TO_SRGB};
+use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
 use fixed::SquareSum;
 
@@ -148,13 +149,19 @@ pub fn add_stokes_to_bins<const N: usize>(
 /// per tile and pass, and added to the film in tile order by `render.rs`, so splatting
 /// keeps the image independent of the thread count. A splat is an estimate of the
 /// image's value per pixel sample: the film adds Σ splats / spp. With spectral output,
-/// each splat also keeps its lanes' bin contributions.
+/// each splat also keeps its lanes' bin contributions. A polarised render's splats
+/// (polarised light tracing and BDPT) keep S1, S2 and S3 beside each of them.
 #[derive(Clone, Debug, Default)]
 pub struct Splats {
-    /// (pixel index, row-major from the top-left; CIE XYZ).
+    /// (pixel index, row-major from the top-left; CIE XYZ; of S0 in a polarised render).
     pub list: Vec<(u32, [f32; 3])>,
     /// (pixel index, bin, value) for spectral output.
     pub spectral: Vec<(u32, u16, f32)>,
+    /// Polarised renders: S1, S2 and S3 as XYZ of each splat of `list`, in its order
+    /// (empty otherwise).
+    pub stokes: Vec<[[f32; 3]; 3]>,
+    /// Polarised renders with spectral bins: S1, S2 and S3 of each entry of `spectral`.
+    pub stokes_spectral: Vec<[f32; 3]>,
     /// Splats left out because they were NaN or infinite.
     pub nonfinite: u64,
     pixels: u32,
@@ -203,6 +210,45 @@ impl Splats {
                 if wl.pdf[i] > 0.0 && l.0[i] != 0.0 {
                     let k = b.index(wl.lambda[i]) as u16;
                     self.spectral.push((pixel, k, l.0[i] * w / wl.pdf[i]));
+                }
+            }
+        }
+    }
+
+    /// Adds the Stokes radiance `s` at wavelengths `wl` to `pixel` (outside the image:
+    /// ignored): its S0 as [`Splats::add`] adds radiance, and S1–S3 beside it. A splat
+    /// any of whose components is not finite is left out whole.
+    #[inline]
+    pub fn add_stokes<const N: usize>(
+        &mut self,
+        pixel: u32,
+        s: &StokesSpectrum<N>,
+        wl: &SampledWavelengths<N>,
+    ) {
+        if pixel >= self.pixels {
+            return;
+        }
+        if !s.is_finite() {
+            self.nonfinite += 1;
+            return;
+        }
+        let [s0, s1, s2, s3] = [0, 1, 2, 3].map(|k| s.component(k));
+        // |S1..S3| ≤ S0: light with no intensity has no polarisation either.
+        if s0.is_zero() {
+            return;
+        }
+        self.list.push((pixel, xyz_of_sample(&s0, wl)));
+        self.stokes
+            .push([s1, s2, s3].map(|c| xyz_of_sample(&c, wl)));
+        if let Some(b) = &self.bins {
+            let w = 1.0 / (N as f32 * b.width());
+            for i in 0..N {
+                if wl.pdf[i] > 0.0 && s0.0[i] != 0.0 {
+                    let k = b.index(wl.lambda[i]) as u16;
+                    let q = w / wl.pdf[i];
+                    self.spectral.push((pixel, k, s0.0[i] * q));
+                    self.stokes_spectral
+                        .push([s1.0[i] * q, s2.0[i] * q, s3.0[i] * q]);
                 }
             }
         }
