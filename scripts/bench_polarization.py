@@ -3,9 +3,11 @@
 "Polarised transport"): each scene rendered with and without --polarization, the two
 interleaved round by round (this machine's timings drift by ±15% between runs, so each
 ratio is taken within a round), at the same spp and seed: four scenes under the path
-integrator (fogbow with its Lorenz–Mie fog) and the default scene under whitted.
+integrator (fogbow with its Lorenz–Mie fog), the default scene under whitted, the
+Cornell box under light tracing and BDPT, and metals under BDPT.
 
     scripts/bench_polarization.py [--rounds 5] [--spp 16] [--heron target/release/heron]
+                                  [--only cornell-box:bdpt,metals:bdpt]
 
 Prints, per scene, the median wall time of each and the median of the per-round
 ratios. heron's own "in X s" (the render loop, without loading) is what is timed.
@@ -19,7 +21,8 @@ import tempfile
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
 SCENES = [("cornell-box", "path"), ("metals", "path"), ("brewster", "path"),
-          ("fogbow", "path"), ("default", "whitted")]
+          ("fogbow", "path"), ("default", "whitted"), ("cornell-box", "lighttrace"),
+          ("cornell-box", "bdpt"), ("metals", "bdpt")]
 
 
 def render(heron, scene, integrator, spp, polarized, tmp):
@@ -45,11 +48,15 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--heron", default=str(REPO / "target/release/heron"))
+    ap.add_argument("--only", default="", help="scene:integrator pairs, comma-separated")
     a = ap.parse_args()
+    only = {tuple(p.split(":")) for p in a.only.split(",") if p}
     with tempfile.TemporaryDirectory() as tmp:
         print(f"{'scene':<12} {'integrator':<10} {'unpolarised s':>14} {'polarised s':>12}"
               f" {'ratio':>7}")
         for scene, integrator in SCENES:
+            if only and (scene, integrator) not in only:
+                continue
             plain, pol, ratio = [], [], []
             for _ in range(a.rounds):
                 t0 = render(a.heron, scene, integrator, a.spp, False, tmp)

@@ -153,6 +153,27 @@ fn polarised_shards_merge_to_the_bytes_of_one_render() {
             "the merged {which} preview differs"
         );
     }
+    // Polarised light tracing and BDPT splat Stokes radiance (their films keep the
+    // splats' S1–S3 and bins): a rough gold floor under a linearly polarised spot,
+    // whose light it reflects to the camera still polarised.
+    let sc = d.path().join("rough-gold.toml");
+    std::fs::write(
+        &sc,
+        "[camera]\neye = [0.0, 2.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nd = 1.5\nresolution = [24, 16]\n\
+[render]\npolarization = true\nmax_depth = 3\n\
+[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\nroughness = 0.3\n\
+[[shapes]]\ntype = \"quad\"\norigin = [-2.0, 0.0, 2.0]\nedge1 = [4.0, 0.0, 0.0]\nedge2 = [0.0, 0.0, -4.0]\nmaterial = \"gold\"\n\
+[[lights]]\ntype = \"spot\"\nposition = [-1.0, 2.0, -1.0]\ndirection = [0.4, -1.0, 0.4]\nintensity = 6.0\ncone_angle = 60.0\n\
+polarization = { axis = [1.0, 0.0, 0.0], linear = 0.8, circular = 0.3 }\n",
+    )
+    .unwrap();
+    for integrator in ["lighttrace", "bdpt"] {
+        let dir = d.path().join(integrator);
+        std::fs::create_dir(&dir).unwrap();
+        let mut w = set.to_vec();
+        w.extend_from_slice(&["--integrator", integrator, "--variance"]);
+        merged_equals_whole(&dir, s(&sc), &w, 3, &[2, 0, 1]);
+    }
 }
 
 /// A shard stopped early (here by a time limit of zero: one pass) writes a film that

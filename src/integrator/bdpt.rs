@@ -30,7 +30,11 @@
 //! bounce), then per camera bounce lobe 1D and direction 2D, then for each (s = 1, t)
 //! connection the light choice 1D and point 2D. Subpaths are at most [`MAX_VERTICES`]
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
-use super::toolkit::{next_hit, pixel_of, Connection, Connections, LightPathStart};
+use super::polarized::{non_delta, Beam, Chain};
+use super::toolkit::{
+    next_hit, pixel_of, Connection, ConnectionValue, Connections, LightPathStart, Unpolarized,
+    Vertex as Event,
+};
 use super::{Context, TraceCounters};
 use crate::accel::embree::{Hit, RayQuery};
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
@@ -42,6 +46,7 @@ use crate::math::Frame;
 use crate::sampler::Sampler;
 use crate::scene::{Scene, NO_LIGHT};
 use crate::settings::Packets;
+use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -81,6 +86,9 @@ struct Vertex<const N: usize> {
     delta: bool,
     /// The companions were ended on this subpath at or before this vertex's β.
     ended: bool,
+    /// The lobe its subpath continued by (a surface's sample's flags), for the Mueller
+    /// matrices of a polarised render.
+    lobe: LobeFlags,
     pdf_fwd: f32,
     pdf_rev: f32,
 }
@@ -104,6 +112,7 @@ impl<const N: usize> Vertex<N> {
         infinite: false,
         delta: false,
         ended: false,
+        lobe: LobeFlags::NONE,
         pdf_fwd: 0.0,
         pdf_rev: 0.0,
     };
@@ -364,6 +373,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
                 break;
             };
             beta *= bs.weight();
+            path[bounces].lobe = bs.flags;
             if bs.ended_companions {
                 ended = true;
                 bsdf_ctx.companions_alive = false;
@@ -487,11 +497,11 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     /// Geometry term between two vertices with their visibility: 0 when blocked (or
     /// degenerate), else the term and the shadow ray still to trace (deferred by
     /// `conns`).
-    fn g(
+    fn g<V: ConnectionValue<N>>(
         &self,
         a: &Vertex<N>,
         b: &Vertex<N>,
-        conns: &Connections<N>,
+        conns: &Connections<N, V>,
         counters: &mut TraceCounters,
     ) -> (f32, Option<RayQuery>) {
         let w = b.p - a.p;
@@ -520,13 +530,13 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     /// The shadow ray between two points, with the render's `RayOffset` cutoffs (points
     /// too close to tell apart count as blocked): `Err` when it is known to be blocked,
     /// else the query still to trace (`None`: traced and clear).
-    fn shadow(
+    fn shadow<V: ConnectionValue<N>>(
         &self,
         from: &SpawnPoint,
         w: Vec3,
         dist: f32,
         to: &SpawnPoint,
-        conns: &Connections<N>,
+        conns: &Connections<N, V>,
         counters: &mut TraceCounters,
     ) -> Result<Option<RayQuery>, ()> {
         let q = self.ctx.offset.shadow(from, w, dist, to);
@@ -642,16 +652,17 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     /// t = 1) a splat; None when it adds nothing. Its shadow ray is traced now or
     /// deferred, as `conns` does.
     #[allow(clippy::too_many_arguments)]
-    fn connect(
+    fn connect<C: BdptCarrier<N>>(
         &self,
+        carry: &C,
         light: &mut [Vertex<N>],
         camera: &mut [Vertex<N>],
         s: usize,
         t: usize,
         sampler: &mut Sampler,
-        conns: &Connections<N>,
+        conns: &Connections<N, C::Value>,
         counters: &mut TraceCounters,
-    ) -> Option<Connection<N>> {
+    ) -> Option<Connection<N, C::Value>> {
         let scene = self.scene();
         // A camera path that reached a light is only used as such (s = 0).
         if t > 1 && s != 0 && camera[t - 1].kind == Kind::Light {
@@ -692,7 +703,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             sampled = Some(cv);
             let w = self.mis_weight(light, camera, sampled, s, t);
             return Some(Connection {
-                c: c * w,
+                c: carry.value(self, light, camera, (s, t), sampled.as_ref(), c * w),
                 splat: Some(pixel_of(cam, cs.raster)),
                 shadow,
             });
@@ -764,8 +775,9 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         if l.is_zero() {
             return None;
         }
+        let c = l * self.mis_weight(light, camera, sampled, s, t);
         Some(Connection {
-            c: l * self.mis_weight(light, camera, sampled, s, t),
+            c: carry.value(self, light, camera, (s, t), sampled.as_ref(), c),
             splat: None,
             shadow,
         })
@@ -788,6 +800,35 @@ pub fn radiance<const N: usize>(
     counters: &mut TraceCounters,
     splats: &mut Splats,
 ) -> SampledSpectrum<N> {
+    radiance_carrying::<N, Unpolarized>(ctx, cam, first_hit, wl, sampler, counters, splats)
+}
+
+/// The Stokes radiance of one pixel sample of polarised BDPT, in the camera's frame;
+/// t = 1 strategies splat Stokes radiance.
+pub(crate) fn polarized_radiance<const N: usize>(
+    ctx: &Context,
+    cam: CameraRay,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    splats: &mut Splats,
+) -> StokesSpectrum<N> {
+    radiance_carrying::<N, Polarized<N>>(ctx, cam, first_hit, wl, sampler, counters, splats)
+}
+
+/// [`radiance`] with what the subpaths carry besides their scalar throughputs: nothing
+/// ([`Unpolarized`]), or their Mueller matrices and Stokes vectors ([`Polarized`]).
+/// Both trace the same subpaths and strategies with the same random numbers.
+fn radiance_carrying<const N: usize, C: BdptCarrier<N>>(
+    ctx: &Context,
+    cam: CameraRay,
+    first_hit: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    splats: &mut Splats,
+) -> C::Value {
     // The pinhole's ray (render.rs refuses BDPT with a lens camera).
     let ray = cam.ray;
     let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
@@ -803,19 +844,210 @@ pub fn radiance<const N: usize>(
         sampler,
         counters,
     );
-    let mut l = SampledSpectrum::<N>::zero();
-    let mut conns = Connections::new(ctx.settings.packets == Packets::Paths);
+    let carry = C::new(&b, &light[..n_light], &camera[..n_camera], ray.dir);
+    let mut l = C::zero();
+    let mut conns = Connections::<N, C::Value>::new(ctx.settings.packets == Packets::Paths);
     for t in 1..=n_camera {
         for s in 0..=n_light {
             let depth = s as isize + t as isize - 2;
             if (s == 1 && t == 1) || depth < 0 || depth > max_depth as isize {
                 continue;
             }
-            if let Some(c) = b.connect(&mut light, &mut camera, s, t, sampler, &conns, counters) {
+            if let Some(c) = b.connect(
+                &carry,
+                &mut light,
+                &mut camera,
+                s,
+                t,
+                sampler,
+                &conns,
+                counters,
+            ) {
                 conns.push(ctx, c, (&mut l, splats), wl, counters);
             }
         }
     }
     conns.flush(ctx, (&mut l, splats), wl, counters);
     l
+}
+
+/// What BDPT's subpaths carry besides their scalar throughputs, and what a strategy's
+/// connection then carries.
+trait BdptCarrier<const N: usize>: Sized {
+    type Value: ConnectionValue<N>;
+
+    fn zero() -> Self::Value;
+
+    /// From the two subpaths, once traced; `dir` is the camera ray's direction.
+    fn new(b: &Bdpt<N>, light: &[Vertex<N>], camera: &[Vertex<N>], dir: Vec3) -> Self;
+
+    /// The value of strategy (s, t) whose scalar contribution is `c`, with the vertex
+    /// `sampled` for it (s = 1: the light's; t = 1: the camera's).
+    fn value(
+        &self,
+        b: &Bdpt<N>,
+        light: &[Vertex<N>],
+        camera: &[Vertex<N>],
+        st: (usize, usize),
+        sampled: Option<&Vertex<N>>,
+        c: SampledSpectrum<N>,
+    ) -> Self::Value;
+}
+
+impl<const N: usize> BdptCarrier<N> for Unpolarized {
+    type Value = SampledSpectrum<N>;
+
+    #[inline(always)]
+    fn zero() -> SampledSpectrum<N> {
+        SampledSpectrum::zero()
+    }
+
+    #[inline(always)]
+    fn new(_: &Bdpt<N>, _: &[Vertex<N>], _: &[Vertex<N>], _: Vec3) -> Self {
+        Unpolarized
+    }
+
+    #[inline(always)]
+    fn value(
+        &self,
+        _: &Bdpt<N>,
+        _: &[Vertex<N>],
+        _: &[Vertex<N>],
+        _: (usize, usize),
+        _: Option<&Vertex<N>>,
+        c: SampledSpectrum<N>,
+    ) -> SampledSpectrum<N> {
+        c
+    }
+}
+
+/// Polarised BDPT: the camera subpath's [`Chain`] on each of its segments and the light
+/// subpath's [`Beam`] on each of its, from which every strategy's Stokes radiance is the
+/// camera side's chain through the connection's two events applied to the light side's
+/// beam (`integrator::polarized` has the convention).
+struct Polarized<const N: usize> {
+    /// `chains[i]`: on the segment from camera vertex i to i − 1 (i ≥ 1).
+    chains: [Chain<N>; MAX_VERTICES],
+    /// `beams[j]`: on the segment from light vertex j − 1 to j (j ≥ 1).
+    beams: [Beam<N>; MAX_VERTICES],
+}
+
+impl<const N: usize> Bdpt<'_, N> {
+    /// The surface event at `v` toward its own subpath's previous vertex.
+    fn event<'s>(&'s self, v: &'s Vertex<N>) -> Event<'s> {
+        self.event_toward(v, v.wo)
+    }
+
+    /// The surface event at `v` with light leaving toward `to` (world).
+    fn event_toward<'s>(&'s self, v: &'s Vertex<N>, to: Vec3) -> Event<'s> {
+        Event::Surface {
+            material: &self.scene().materials[v.material as usize],
+            frame: &v.frame,
+            wo_local: v.frame.to_local(to),
+        }
+    }
+
+    /// The chain `chain` past the connection vertex `v` (light arriving from `from`,
+    /// leaving toward `to`) by its non-delta lobes.
+    fn chain_past(&self, chain: &Chain<N>, v: &Vertex<N>, to: Vec3, from: Vec3) -> Chain<N> {
+        let e = self.event_toward(v, to);
+        chain.past(&e, from, v.frame.to_local(from), non_delta(&e), self.wl)
+    }
+}
+
+impl<const N: usize> BdptCarrier<N> for Polarized<N> {
+    type Value = StokesSpectrum<N>;
+
+    fn zero() -> StokesSpectrum<N> {
+        StokesSpectrum::zero()
+    }
+
+    fn new(b: &Bdpt<N>, light: &[Vertex<N>], camera: &[Vertex<N>], dir: Vec3) -> Self {
+        let (scene, wl) = (b.scene(), b.wl);
+        let mut chains = [Chain::at_camera(b.ctx, dir); MAX_VERTICES];
+        for i in 1..camera.len().saturating_sub(1) {
+            let v = &camera[i];
+            let wi = direction(v, &camera[i + 1]);
+            let e = b.event(v);
+            chains[i + 1] = chains[i].past(&e, wi, v.frame.to_local(wi), v.lobe, wl);
+        }
+        let mut beams = [Beam::unpolarized(); MAX_VERTICES];
+        if light.len() > 1 {
+            let d = direction(&light[0], &light[1]);
+            beams[1] = Beam::emitted(scene, light[0].light as usize, d, wl);
+        }
+        for j in 1..light.len().saturating_sub(1) {
+            let v = &light[j];
+            let (to, from) = (direction(v, &light[j + 1]), v.wo);
+            let material = &scene.materials[v.material as usize];
+            beams[j + 1] = beams[j].scatter(
+                material,
+                &v.frame,
+                v.frame.to_local(to),
+                v.frame.to_local(from),
+                v.lobe,
+                wl,
+            );
+        }
+        Polarized { chains, beams }
+    }
+
+    fn value(
+        &self,
+        b: &Bdpt<N>,
+        light: &[Vertex<N>],
+        camera: &[Vertex<N>],
+        (s, t): (usize, usize),
+        sampled: Option<&Vertex<N>>,
+        c: SampledSpectrum<N>,
+    ) -> StokesSpectrum<N> {
+        let (scene, wl) = (b.scene(), b.wl);
+        if s == 0 {
+            // The camera subpath reached a light: an emitting surface, or the lights at
+            // infinity together (each weighted by its share of the radiance).
+            let pt = &camera[t - 1];
+            let d = direction(pt, &camera[t - 2]);
+            let chain = &self.chains[t - 1];
+            if !pt.infinite {
+                let beam = Beam::emitted(scene, pt.light as usize, d, wl);
+                return chain.receive(&beam, d, c);
+            }
+            let total = scene.escaped_radiance(-d, wl);
+            let mut out = StokesSpectrum::zero();
+            for &i in &scene.infinite_lights {
+                let le = scene.lights[i as usize].le(-d, wl);
+                let share = SampledSpectrum(std::array::from_fn(|k| {
+                    if total.0[k] > 0.0 {
+                        c.0[k] * le.0[k] / total.0[k]
+                    } else {
+                        0.0
+                    }
+                }));
+                out += chain.receive(&Beam::emitted(scene, i as usize, d, wl), d, share);
+            }
+            return out;
+        }
+        if t == 1 {
+            // A light subpath's vertex seen by the camera.
+            let qs = &light[s - 1];
+            let d = direction(qs, sampled.expect("t = 1 has a camera vertex"));
+            let chain = b.chain_past(&Chain::at_camera(b.ctx, -d), qs, d, qs.wo);
+            return chain.receive(&self.beams[s - 1], -qs.wo, c);
+        }
+        let pt = &camera[t - 1];
+        if s == 1 {
+            // A light sampled from the camera subpath's vertex.
+            let lv = sampled.expect("s = 1 has a light vertex");
+            let wi = direction(pt, lv);
+            let chain = b.chain_past(&self.chains[t - 1], pt, pt.wo, wi);
+            let beam = Beam::emitted(scene, lv.light as usize, -wi, wl);
+            return chain.receive(&beam, -wi, c);
+        }
+        // Two surface vertices joined.
+        let qs = &light[s - 1];
+        let w = direction(pt, qs);
+        let chain = b.chain_past(&self.chains[t - 1], pt, pt.wo, w);
+        let chain = b.chain_past(&chain, qs, -w, qs.wo);
+        chain.receive(&self.beams[s - 1], -qs.wo, c)
+    }
 }

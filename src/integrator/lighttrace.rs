@@ -19,7 +19,10 @@
 //!
 //! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
 //! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
-use super::toolkit::{next_hit, pixel_of, roulette, Connection, Connections, LightPathStart};
+use super::toolkit::{
+    next_hit, pixel_of, roulette, Connection, Connections, LightCarrier, LightPathStart,
+    Unpolarized,
+};
 use super::{Context, TraceCounters};
 use crate::bsdf::{BsdfContext, TransportMode};
 use crate::camera::CameraWiSample;
@@ -38,12 +41,24 @@ pub fn radiance<const N: usize>(
     counters: &mut TraceCounters,
     splats: &mut Splats,
 ) -> SampledSpectrum<N> {
+    radiance_carrying::<N, Unpolarized>(ctx, wl, sampler, counters, splats)
+}
+
+/// [`radiance`] with what the light path carries besides its scalar throughput: nothing
+/// ([`Unpolarized`]), or its Stokes vector (`integrator::polarized`), whose connections
+/// splat Stokes radiance. Both trace the same paths with the same random numbers.
+pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
+    ctx: &Context,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    splats: &mut Splats,
+) -> F::Value {
     let scene = ctx.scene;
     let cam = &scene.camera;
     let settings = ctx.settings;
-    let zero = SampledSpectrum::<N>::zero();
     let Some(start) = LightPathStart::sample(ctx, wl, sampler) else {
-        return zero;
+        return F::zero();
     };
     let (le, pmf) = (&start.le, start.pmf);
     // Rays leave a light's surface as they leave any surface; other lights' origins are
@@ -53,13 +68,13 @@ pub fn radiance<const N: usize>(
 
     // The connections to the camera, their shadow rays traced one by one or, with
     // `--packets paths`, 8 at a time.
-    let mut conns = Connections::new(settings.packets == Packets::Paths);
-    let mut own = zero;
+    let mut conns = Connections::<N, F::Value>::new(settings.packets == Packets::Paths);
+    let mut own = F::zero();
     // The splat of a connection from `from` along `cs`, unless its shadow ray is blocked.
-    let connect = |conns: &Connections<N>,
+    let connect = |conns: &Connections<N, F::Value>,
                    from: &SpawnPoint,
                    cs: &CameraWiSample,
-                   c: SampledSpectrum<N>,
+                   c: F::Value,
                    counters: &mut TraceCounters| {
         let q = ctx.offset.shadow(from, cs.wi, cs.dist, &eye);
         let shadow = match conns.visible(ctx, q, counters) {
@@ -80,7 +95,9 @@ pub fn radiance<const N: usize>(
             let emitted = scene.lights[start.index].l(n, cs.wi, wl);
             if !emitted.is_zero() {
                 let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
-                if let Some(c) = connect(&conns, &light_point, &cs, emitted * k, counters) {
+                let c =
+                    F::emitted(ctx, start.index, cs.wi, wl).seen(ctx, None, cs.wi, emitted * k, wl);
+                if let Some(c) = connect(&conns, &light_point, &cs, c, counters) {
                     conns.push(ctx, c, (&mut own, splats), wl, counters);
                 }
             }
@@ -88,6 +105,7 @@ pub fn radiance<const N: usize>(
     }
 
     let mut beta = start.beta();
+    let mut carried = F::emitted(ctx, start.index, le.dir, wl);
     // The light path's throughput carries the light's flux, whose size depends on the
     // scene's units (an area light's flux scales with its area); the roulette compares
     // the throughput with where it started, so that a scene scaled by 1e-4 is not
@@ -117,6 +135,7 @@ pub fn radiance<const N: usize>(
                 let f = material.eval(wo, wi, wl, &bsdf_ctx).f;
                 if !f.is_zero() {
                     let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
+                    let c = carried.seen(ctx, Some((material, &frame, wi, wo)), cs.wi, c, wl);
                     if let Some(c) = connect(&conns, &it.spawn_point(), &cs, c, counters) {
                         conns.push(ctx, c, (&mut own, splats), wl, counters);
                     }
@@ -130,6 +149,7 @@ pub fn radiance<const N: usize>(
             break;
         };
         beta *= bs.weight();
+        carried.scattered(material, &frame, bs.wi, wo, bs.flags, wl);
         if bs.ended_companions {
             bsdf_ctx.companions_alive = false;
         }
@@ -144,5 +164,5 @@ pub fn radiance<const N: usize>(
         }
     }
     conns.flush(ctx, (&mut own, splats), wl, counters);
-    zero
+    F::zero()
 }

@@ -130,11 +130,24 @@ pub fn stokes_kernel<const N: usize>(
         }
         IntegratorKind::Path => Ok(polarized_path::<N, { ALL & !SPECULAR & !MEDIA }>),
         IntegratorKind::Whitted => Ok(polarized_whitted::<N, { ALL & !MEDIA }>),
-        other => Err(format!(
-            "integrator {}: polarised transport (polarization = true) is implemented for integrator = \"path\" and \"whitted\" so far",
-            other.name()
-        )),
+        IntegratorKind::LightTrace => Ok(polarized_lighttrace::<N>),
+        IntegratorKind::Bdpt => Ok(bdpt::polarized_radiance::<N>),
+        IntegratorKind::Sppm => Err(
+            "integrator sppm: polarised transport (polarization = true) is implemented for integrator = \"path\", \"whitted\", \"lighttrace\" and \"bdpt\"; photon mapping's photons carry no Stokes vectors".into(),
+        ),
     }
+}
+
+fn polarized_lighttrace<const N: usize>(
+    ctx: &Context,
+    _: CameraRay,
+    _: Option<Option<Hit>>,
+    wl: &SampledWavelengths<N>,
+    sampler: &mut Sampler,
+    counters: &mut TraceCounters,
+    splats: &mut Splats,
+) -> StokesSpectrum<N> {
+    lighttrace::radiance_carrying::<N, polarized::Beam<N>>(ctx, wl, sampler, counters, splats)
 }
 
 fn whitted_k<const N: usize, const K: KernelFlags>(

@@ -34,14 +34,24 @@
 //! whose materials all depolarise renders the unpolarised image's S0
 //! (`tests/polarization.rs` holds it to that).
 //!
-//! **What is not here yet.** Polarised area lights, light tracing, BDPT, the Whitted
-//! tracer and the packet engine of paths.
-use super::toolkit::{next_hit, Carrier, Immediate, PathState, Vertex};
+//! **Light paths.** Light tracing and BDPT's light subpaths carry the transpose of that
+//! bookkeeping: a [`Beam`], per lane the light's normalised Stokes vector through the
+//! normalised matrices of the events so far (S0 is no longer 1 once a polariser has
+//! acted), in the frame of the segment it travels. A connection is a [`Chain`] (the
+//! camera side: the analyser alone for a splat, a camera subpath's product in BDPT)
+//! through the one or two vertices the connection joins, by their non-delta lobes,
+//! applied to the beam: the same Mueller matrices, evaluated for light travelling the
+//! physical way, so the three integrators estimate one Stokes image.
+//!
+//! **What is not here yet.** Polarised area lights, photon mapping and the packet
+//! engine of paths.
+use super::toolkit::{next_hit, Carrier, Immediate, LightCarrier, PathState, Vertex};
 use super::{path, whitted};
 use super::{Context, TraceCounters};
 use crate::accel::embree::Hit;
-use crate::bsdf::{LobeFlags, Polarizing};
+use crate::bsdf::{LobeFlags, Material, Polarizing};
 use crate::camera::CameraRay;
+use crate::math::Frame;
 use crate::optics::mueller::Mueller;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -50,44 +60,128 @@ use crate::spectrum::stokes::{any_perpendicular, mueller_from_rows, rotate_basis
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Mat4, Vec3, Vec4};
 
-/// What a polarised path carries: per lane the product T of its events' normalised
-/// Mueller matrices (module docs), the frame of its current segment, and the Stokes
-/// radiance found so far.
-struct Polarized<'a, const N: usize> {
-    scene: &'a Scene,
-    t: [Mat4; N],
-    x: Vec3,
-    out: StokesSpectrum<N>,
+/// The normalised Stokes vector per lane (S0 = 1) of light `light` arriving from
+/// direction `dir` (toward the light), and its frame; None when it is unpolarised.
+#[inline]
+fn light_state<const N: usize>(
+    scene: &Scene,
+    light: usize,
+    dir: Vec3,
+    wl: &SampledWavelengths<N>,
+) -> Option<([Vec4; N], Vec3)> {
+    if let Some(p) = scene.light_polarization(light) {
+        let (s, x) = p.stokes(-dir);
+        return Some(([s; N], x));
+    }
+    let l = &scene.lights[light];
+    let (s1, x) = l.le_linear(dir, wl)?;
+    let le = l.le(dir, wl);
+    Some((
+        std::array::from_fn(|i| {
+            let p = if le.0[i] > 0.0 {
+                s1.0[i] / le.0[i]
+            } else {
+                0.0
+            };
+            Vec4::new(1.0, p, 0.0, 0.0)
+        }),
+        x,
+    ))
 }
 
-impl<const N: usize> Polarized<'_, N> {
-    /// The normalised Stokes vector per lane (S0 = 1) of light `light` arriving from
-    /// direction `dir` (toward the light), and its frame; None when it is unpolarised.
+/// Light on a segment of a light path, travelling away from the light: per lane its
+/// Stokes vector relative to the scalar throughput (the light's normalised Stokes
+/// vector through the normalised Mueller matrices of the events so far, so S0 need not
+/// stay 1), and its frame x̂ (None: unpolarised, (S0, 0, 0, 0) in any frame).
+#[derive(Clone, Copy)]
+pub(crate) struct Beam<const N: usize> {
+    s: [Vec4; N],
+    x: Option<Vec3>,
+}
+
+impl<const N: usize> Beam<N> {
+    /// Unpolarised light of unit intensity.
     #[inline]
-    fn light_state(
-        &self,
-        light: usize,
-        dir: Vec3,
-        wl: &SampledWavelengths<N>,
-    ) -> Option<([Vec4; N], Vec3)> {
-        if let Some(p) = self.scene.light_polarization(light) {
-            let (s, x) = p.stokes(-dir);
-            return Some(([s; N], x));
+    pub(crate) fn unpolarized() -> Self {
+        Beam {
+            s: [Vec4::X; N],
+            x: None,
         }
-        let l = &self.scene.lights[light];
-        let (s1, x) = l.le_linear(dir, wl)?;
-        let le = l.le(dir, wl);
-        Some((
-            std::array::from_fn(|i| {
-                let p = if le.0[i] > 0.0 {
-                    s1.0[i] / le.0[i]
-                } else {
-                    0.0
+    }
+
+    /// The light `light` emitting along `d`.
+    #[inline]
+    pub(crate) fn emitted(
+        scene: &Scene,
+        light: usize,
+        d: Vec3,
+        wl: &SampledWavelengths<N>,
+    ) -> Self {
+        match light_state(scene, light, -d, wl) {
+            None => Beam::unpolarized(),
+            Some((s, x)) => Beam { s, x: Some(x) },
+        }
+    }
+
+    /// The beam after scattering at a surface (`LightCarrier::scattered`).
+    #[inline]
+    pub(crate) fn scatter(
+        &self,
+        material: &Material,
+        frame: &Frame,
+        to_local: Vec3,
+        from_local: Vec3,
+        flags: LobeFlags,
+        wl: &SampledWavelengths<N>,
+    ) -> Self {
+        match material.mueller(to_local, from_local, flags, wl, frame) {
+            Polarizing::Depolarizing => Beam {
+                s: self.s.map(|v| Vec4::new(v.x, 0.0, 0.0, 0.0)),
+                x: None,
+            },
+            Polarizing::Mueller { m, x_in, x_out } => {
+                let s = match self.x {
+                    None => self.s,
+                    Some(x) => {
+                        let d = -frame.to_world(from_local);
+                        let r = rotate_basis(d, x, frame.to_world(x_in));
+                        self.s.map(|v| r * v)
+                    }
                 };
-                Vec4::new(1.0, p, 0.0, 0.0)
-            }),
-            x,
-        ))
+                Beam {
+                    s: std::array::from_fn(|i| m[i] * s[i]),
+                    x: Some(frame.to_world(x_out)),
+                }
+            }
+        }
+    }
+}
+
+/// The camera's side of a path: per lane the product T of its events' normalised
+/// Mueller matrices from the camera (module docs), and the frame x̂ of its current
+/// segment.
+#[derive(Clone, Copy)]
+pub(crate) struct Chain<const N: usize> {
+    t: [Mat4; N],
+    x: Vec3,
+}
+
+impl<const N: usize> Chain<N> {
+    /// At the camera, for its ray along `dir`: T is the camera's analyser (`[camera]
+    /// polarizer`, `--polarizer`) or the identity, in the camera's frame.
+    pub(crate) fn at_camera(ctx: &Context, dir: Vec3) -> Self {
+        let scene = ctx.scene;
+        let analyser = match ctx.settings.polarizer.or(scene.camera.polarizer) {
+            Some(a) => {
+                let m = Mueller::linear_polarizer(a as f64);
+                mueller_from_rows(m.0.map(|r| r.map(|v| v as f32)))
+            }
+            None => Mat4::IDENTITY,
+        };
+        Chain {
+            t: [analyser; N],
+            x: scene.camera.stokes_x(dir),
+        }
     }
 
     /// The shape of the event at `v` taking light arriving along −`wi` to the path's
@@ -132,6 +226,53 @@ impl<const N: usize> Polarized<'_, N> {
             },
         }
     }
+
+    /// The chain past the event at `v` (see [`Chain::through`]).
+    #[inline]
+    pub(crate) fn past(
+        &self,
+        v: &Vertex,
+        wi: Vec3,
+        wi_local: Vec3,
+        flags: LobeFlags,
+        wl: &SampledWavelengths<N>,
+    ) -> Self {
+        let (t, x_in) = self.through(v, wi, wi_local, flags, wl);
+        Chain {
+            t,
+            x: x_in.unwrap_or_else(|| any_perpendicular(wi)),
+        }
+    }
+
+    /// The Stokes radiance the camera receives of `beam` on the chain's current
+    /// segment, travelling along `d`, with the scalar contribution `c`.
+    #[inline]
+    pub(crate) fn receive(
+        &self,
+        beam: &Beam<N>,
+        d: Vec3,
+        c: SampledSpectrum<N>,
+    ) -> StokesSpectrum<N> {
+        match beam.x {
+            None => StokesSpectrum(std::array::from_fn(|i| {
+                self.t[i].col(0) * (beam.s[i].x * c.0[i])
+            })),
+            Some(x) => {
+                let r = rotate_basis(d, x, self.x);
+                StokesSpectrum(std::array::from_fn(|i| {
+                    self.t[i] * (r * beam.s[i]) * c.0[i]
+                }))
+            }
+        }
+    }
+}
+
+/// What a polarised camera path carries: its [`Chain`] and the Stokes radiance found
+/// so far.
+struct Polarized<'a, const N: usize> {
+    scene: &'a Scene,
+    chain: Chain<N>,
+    out: StokesSpectrum<N>,
 }
 
 impl<const N: usize> Carrier<N> for Polarized<'_, N> {
@@ -146,11 +287,12 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
         dir: Vec3,
         wl: &SampledWavelengths<N>,
     ) {
-        let add: StokesSpectrum<N> = match self.light_state(light, dir, wl) {
-            None => StokesSpectrum(std::array::from_fn(|i| self.t[i].col(0) * c.0[i])),
+        let t = &self.chain.t;
+        let add: StokesSpectrum<N> = match light_state(self.scene, light, dir, wl) {
+            None => StokesSpectrum(std::array::from_fn(|i| t[i].col(0) * c.0[i])),
             Some((s, x)) => {
-                let r = rotate_basis(-dir, x, self.x);
-                StokesSpectrum(std::array::from_fn(|i| self.t[i] * (r * s[i]) * c.0[i]))
+                let r = rotate_basis(-dir, x, self.chain.x);
+                StokesSpectrum(std::array::from_fn(|i| t[i] * (r * s[i]) * c.0[i]))
             }
         };
         self.out += add;
@@ -167,15 +309,8 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
         light: usize,
         wl: &SampledWavelengths<N>,
     ) {
-        // Light samples reach the non-delta lobes only.
-        let flags = match v {
-            Vertex::Surface { material, .. } => {
-                LobeFlags::from_bits(material.flags().bits() & !LobeFlags::SPECULAR.bits())
-            }
-            Vertex::Medium { .. } => LobeFlags::NONE,
-        };
-        let (t, x_in) = self.through(v, wi, wi_local, flags, wl);
-        let add = match (self.light_state(light, wi, wl), x_in) {
+        let (t, x_in) = self.chain.through(v, wi, wi_local, non_delta(v), wl);
+        let add = match (light_state(self.scene, light, wi, wl), x_in) {
             // Polarised light onto a polarising event: into the event's frame.
             (Some((s, x)), Some(x_in)) => {
                 let r = rotate_basis(-wi, x, x_in);
@@ -196,30 +331,86 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
         flags: LobeFlags,
         wl: &SampledWavelengths<N>,
     ) {
-        let (t, x_in) = self.through(v, wi, wi_local, flags, wl);
-        self.t = t;
-        self.x = x_in.unwrap_or_else(|| any_perpendicular(wi));
+        self.chain = self.chain.past(v, wi, wi_local, flags, wl);
+    }
+}
+
+/// The lobes light samples and connections reach at `v`: a surface's non-delta ones.
+#[inline]
+pub(crate) fn non_delta(v: &Vertex) -> LobeFlags {
+    match v {
+        Vertex::Surface { material, .. } => {
+            LobeFlags::from_bits(material.flags().bits() & !LobeFlags::SPECULAR.bits())
+        }
+        Vertex::Medium { .. } => LobeFlags::NONE,
     }
 }
 
 impl<'a, const N: usize> Polarized<'a, N> {
-    /// The carrier of a camera ray: T is the camera's analyser (`[camera] polarizer`,
-    /// `--polarizer`) or the identity, in the camera's frame.
+    /// The carrier of a camera ray.
     fn at_camera(ctx: &Context<'a>, cam: &CameraRay) -> Self {
-        let scene = ctx.scene;
-        let analyser = match ctx.settings.polarizer.or(scene.camera.polarizer) {
-            Some(a) => {
-                let m = Mueller::linear_polarizer(a as f64);
-                mueller_from_rows(m.0.map(|r| r.map(|v| v as f32)))
-            }
-            None => Mat4::IDENTITY,
-        };
         Polarized {
-            scene,
-            t: [analyser; N],
-            x: scene.camera.stokes_x(cam.ray.dir),
+            scene: ctx.scene,
+            chain: Chain::at_camera(ctx, cam.ray.dir),
             out: StokesSpectrum::zero(),
         }
+    }
+}
+
+/// A polarised light path (light tracing): its [`Beam`].
+impl<const N: usize> LightCarrier<N> for Beam<N> {
+    type Value = StokesSpectrum<N>;
+
+    #[inline]
+    fn zero() -> StokesSpectrum<N> {
+        StokesSpectrum::zero()
+    }
+
+    #[inline]
+    fn emitted(ctx: &Context, light: usize, d: Vec3, wl: &SampledWavelengths<N>) -> Self {
+        Beam::emitted(ctx.scene, light, d, wl)
+    }
+
+    #[inline]
+    fn scattered(
+        &mut self,
+        material: &Material,
+        frame: &Frame,
+        to_local: Vec3,
+        from_local: Vec3,
+        flags: LobeFlags,
+        wl: &SampledWavelengths<N>,
+    ) {
+        *self = self.scatter(material, frame, to_local, from_local, flags, wl);
+    }
+
+    #[inline]
+    fn seen(
+        &self,
+        ctx: &Context,
+        at: Option<(&Material, &Frame, Vec3, Vec3)>,
+        d: Vec3,
+        c: SampledSpectrum<N>,
+        wl: &SampledWavelengths<N>,
+    ) -> StokesSpectrum<N> {
+        let chain = Chain::at_camera(ctx, -d);
+        let chain = match at {
+            None => chain,
+            Some((material, frame, to_local, from_local)) => {
+                let v = Vertex::Surface {
+                    material,
+                    frame,
+                    wo_local: to_local,
+                };
+                let from = frame.to_world(from_local);
+                chain.past(&v, from, from_local, non_delta(&v), wl)
+            }
+        };
+        let travel = match at {
+            None => d,
+            Some((_, frame, _, from_local)) => -frame.to_world(from_local),
+        };
+        chain.receive(self, travel, c)
     }
 }
 

@@ -19,6 +19,7 @@ use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
 use crate::math::Frame;
 use crate::medium::{Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
+use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -479,6 +480,7 @@ pub(crate) trait Carrier<const N: usize> {
 }
 
 /// Unpolarised transport: contributions are summed, events change nothing else.
+#[derive(Clone, Copy)]
 pub(crate) struct Unpolarized;
 
 impl<const N: usize> Carrier<N> for Unpolarized {
@@ -512,6 +514,83 @@ impl<const N: usize> Carrier<N> for Unpolarized {
 
     #[inline(always)]
     fn scattered(&mut self, _: &Vertex, _: Vec3, _: Vec3, _: LobeFlags, _: &SampledWavelengths<N>) {
+    }
+}
+
+/// What a light path carries besides its scalar throughput (light tracing; `bdpt.rs`
+/// keeps its own per vertex): nothing for unpolarised transport ([`Unpolarized`]); in a
+/// polarised render, the normalised Stokes vector of the light on the current segment
+/// (`integrator::polarized::Beam`). Its connections to the camera carry
+/// [`LightCarrier::Value`].
+pub(crate) trait LightCarrier<const N: usize>: Copy {
+    type Value: ConnectionValue<N>;
+
+    fn zero() -> Self::Value;
+
+    /// The light `light` emits along the unit `d`.
+    fn emitted(ctx: &Context, light: usize, d: Vec3, wl: &SampledWavelengths<N>) -> Self;
+
+    /// The light scatters at a surface, arriving from `from_local` (toward where it
+    /// came from) and leaving along `to_local`, by a lobe of `flags` (local frame).
+    fn scattered(
+        &mut self,
+        material: &Material,
+        frame: &Frame,
+        to_local: Vec3,
+        from_local: Vec3,
+        flags: LobeFlags,
+        wl: &SampledWavelengths<N>,
+    );
+
+    /// What the camera receives of a connection whose scalar value is `c`, the light
+    /// travelling along the unit `d` to the camera: from the light itself (`at`
+    /// None), or scattered toward it at a surface `at` = (material, frame, `d` and
+    /// the direction the light came from, local) by the material's non-delta lobes.
+    fn seen(
+        &self,
+        ctx: &Context,
+        at: Option<(&Material, &Frame, Vec3, Vec3)>,
+        d: Vec3,
+        c: SampledSpectrum<N>,
+        wl: &SampledWavelengths<N>,
+    ) -> Self::Value;
+}
+
+impl<const N: usize> LightCarrier<N> for Unpolarized {
+    type Value = SampledSpectrum<N>;
+
+    #[inline(always)]
+    fn zero() -> SampledSpectrum<N> {
+        SampledSpectrum::zero()
+    }
+
+    #[inline(always)]
+    fn emitted(_: &Context, _: usize, _: Vec3, _: &SampledWavelengths<N>) -> Self {
+        Unpolarized
+    }
+
+    #[inline(always)]
+    fn scattered(
+        &mut self,
+        _: &Material,
+        _: &Frame,
+        _: Vec3,
+        _: Vec3,
+        _: LobeFlags,
+        _: &SampledWavelengths<N>,
+    ) {
+    }
+
+    #[inline(always)]
+    fn seen(
+        &self,
+        _: &Context,
+        _: Option<(&Material, &Frame, Vec3, Vec3)>,
+        _: Vec3,
+        c: SampledSpectrum<N>,
+        _: &SampledWavelengths<N>,
+    ) -> SampledSpectrum<N> {
+        c
     }
 }
 
@@ -754,8 +833,8 @@ impl<const N: usize> ShadowSink<N> for Deferred<N> {
 /// pixel sample's own radiance (BDPT's s ≥ 0, t ≥ 2 strategies), or splatted into a
 /// pixel (a light path's vertex seen by the camera).
 #[derive(Clone, Copy)]
-pub(crate) struct Connection<const N: usize> {
-    pub c: SampledSpectrum<N>,
+pub(crate) struct Connection<const N: usize, V = SampledSpectrum<N>> {
+    pub c: V,
     pub splat: Option<u32>,
     /// The shadow ray still to trace (`None`: none, or already traced and clear).
     pub shadow: Option<RayQuery>,
@@ -766,9 +845,9 @@ pub(crate) struct Connection<const N: usize> {
 /// rays are deferred and go to Embree 8 at a time (`rtcOccluded8`) before the
 /// connections are added; otherwise each is traced when made (`rtcOccluded1`), and a
 /// connection found blocked costs nothing more.
-pub(crate) struct Connections<const N: usize> {
+pub(crate) struct Connections<const N: usize, V = SampledSpectrum<N>> {
     batched: bool,
-    pending: [Option<Connection<N>>; CONNECTIONS_CAP],
+    pending: [Option<Connection<N, V>>; CONNECTIONS_CAP],
     len: usize,
     queries: usize,
 }
@@ -776,7 +855,42 @@ pub(crate) struct Connections<const N: usize> {
 /// Connections kept before they are added (up to 8 of them with shadow rays: a packet).
 const CONNECTIONS_CAP: usize = 16;
 
-impl<const N: usize> Connections<N> {
+/// What a connection carries: radiance, or in a polarised render Stokes radiance
+/// (`integrator::polarized`).
+pub(crate) trait ConnectionValue<const N: usize>: Copy {
+    /// Adds the connection to the pixel sample's own value (when it is finite).
+    fn add_to(&self, own: &mut Self);
+    /// Splats it into `pixel`.
+    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>);
+}
+
+impl<const N: usize> ConnectionValue<N> for SampledSpectrum<N> {
+    #[inline]
+    fn add_to(&self, own: &mut Self) {
+        if self.is_finite() {
+            *own += *self;
+        }
+    }
+    #[inline]
+    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>) {
+        splats.add(pixel, self, wl);
+    }
+}
+
+impl<const N: usize> ConnectionValue<N> for StokesSpectrum<N> {
+    #[inline]
+    fn add_to(&self, own: &mut Self) {
+        if self.is_finite() {
+            *own += *self;
+        }
+    }
+    #[inline]
+    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>) {
+        splats.add_stokes(pixel, self, wl);
+    }
+}
+
+impl<const N: usize, V: ConnectionValue<N>> Connections<N, V> {
     pub fn new(batched: bool) -> Self {
         Connections {
             batched,
@@ -809,8 +923,8 @@ impl<const N: usize> Connections<N> {
     pub fn push(
         &mut self,
         ctx: &Context,
-        c: Connection<N>,
-        out: (&mut SampledSpectrum<N>, &mut Splats),
+        c: Connection<N, V>,
+        out: (&mut V, &mut Splats),
         wl: &SampledWavelengths<N>,
         counters: &mut TraceCounters,
     ) {
@@ -831,7 +945,7 @@ impl<const N: usize> Connections<N> {
     pub fn flush(
         &mut self,
         ctx: &Context,
-        (l, splats): (&mut SampledSpectrum<N>, &mut Splats),
+        (l, splats): (&mut V, &mut Splats),
         wl: &SampledWavelengths<N>,
         counters: &mut TraceCounters,
     ) {
@@ -872,18 +986,10 @@ impl<const N: usize> Connections<N> {
     }
 
     #[inline]
-    fn add(
-        c: &Connection<N>,
-        (l, splats): (&mut SampledSpectrum<N>, &mut Splats),
-        wl: &SampledWavelengths<N>,
-    ) {
+    fn add(c: &Connection<N, V>, (l, splats): (&mut V, &mut Splats), wl: &SampledWavelengths<N>) {
         match c.splat {
-            Some(p) => splats.add(p, &c.c, wl),
-            None => {
-                if c.c.is_finite() {
-                    *l += c.c;
-                }
-            }
+            Some(p) => c.c.splat(splats, p, wl),
+            None => c.c.add_to(l),
         }
     }
 }

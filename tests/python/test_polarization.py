@@ -77,6 +77,29 @@ def test_stokes_equals_the_cli_exr_and_the_previews_are_written(tmp_path):
     assert plain.stokes is None
 
 
+@pytest.mark.parametrize("integrator", ["bdpt", "lighttrace"])
+def test_polarised_splatting_integrators_from_python_match_the_cli(integrator, tmp_path):
+    # Light tracing and BDPT splat Stokes radiance; Python's .stokes is the CLI's EXR.
+    out = tmp_path / "b.exr"
+    subprocess.run(
+        [str(require_heron_bin()), "render", str(BREWSTER), "-o", str(out), "--spp", "2",
+         "--integrator", integrator, "--quiet", "--no-png"],
+        check=True,
+    )
+    ch = read_exr(out)
+    r = heron.load_scene(str(BREWSTER)).render(spp=2, integrator=integrator)
+    st = r.stokes
+    assert st.shape == (240, 320, 4, 3)
+    for c, name in enumerate("RGB"):
+        assert np.array_equal(st[..., 0, c], ch[name])
+        for k in (1, 2, 3):
+            assert np.array_equal(st[..., k, c], ch[f"S{k}.{name}"]), (k, name)
+    if integrator == "bdpt":
+        # Its camera subpaths see the window's reflection, horizontally polarised.
+        window = st[100:112, 140:152, :, :] @ Y_OF_RGB
+        assert (window[..., 1].mean() / window[..., 0].mean()) > 0.9
+
+
 def test_the_analyser_removes_the_glare_and_halves_unpolarised_light():
     scene = heron.load_scene(str(BREWSTER))
     y = lambda r, rows, cols: float((r.rgb[rows, cols] @ Y_OF_RGB).mean())  # noqa: E731
