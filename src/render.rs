@@ -828,6 +828,8 @@ fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, widt
         }
     }
     let stokes_splats = !t.splats.stokes.is_empty();
+    // A render splats through `Splats::add` or through `add_stokes`, never both.
+    debug_assert!(!stokes_splats || t.splats.stokes.len() == t.splats.list.len());
     if stokes_splats && state.splat_stokes.is_empty() {
         // Polarised splats from an integrator not known to splat.
         state.splat_stokes = vec![[0; 9]; npix];

@@ -268,6 +268,33 @@ fn an_all_diffuse_scene_renders_the_unpolarised_image_in_s0() {
         .all(|&v| v == 0.0));
 }
 
+/// Light tracing and BDPT on the all-diffuse box: a light path's Stokes vector stays
+/// (1, 0, 0, 0) times its scalar weight, so polarised light tracing's splats are the
+/// unpolarised ones bit for bit, bins included, and BDPT's S1–S3 are exactly 0.
+#[test]
+fn polarised_splats_of_an_all_diffuse_scene_are_the_unpolarised_ones() {
+    let s = small_cornell_box();
+    for kind in [IntegratorKind::LightTrace, IntegratorKind::Bdpt] {
+        let run = |polarization: bool| {
+            render_with(&s, |o| {
+                o.settings.integrator = kind;
+                o.settings.spp = 2;
+                o.settings.spectral_bins = 4;
+                o.settings.polarization = polarization;
+            })
+        };
+        let (plain, pol) = (run(false), run(true));
+        if kind == IntegratorKind::LightTrace {
+            assert_eq!(plain.xyz, pol.xyz);
+            assert_eq!(plain.spectral, pol.spectral);
+        }
+        let zero = |v: &[f32]| v.iter().all(|&x| x == 0.0);
+        assert!(pol.stokes.unwrap().iter().all(|p| zero(p.as_flattened())));
+        assert!(zero(pol.stokes_spectral.as_ref().unwrap()));
+        assert!(plain.xyz.iter().any(|c| c[1] > 0.0));
+    }
+}
+
 #[test]
 fn polarised_renders_are_the_same_bytes_on_one_and_two_threads() {
     let s = scene(

@@ -245,10 +245,11 @@ impl Splats {
             for i in 0..N {
                 if wl.pdf[i] > 0.0 && s0.0[i] != 0.0 {
                     let k = b.index(wl.lambda[i]) as u16;
-                    let q = w / wl.pdf[i];
-                    self.spectral.push((pixel, k, s0.0[i] * q));
+                    // As `add` computes it, so that S0's bins round as radiance's do.
+                    let p = wl.pdf[i];
+                    self.spectral.push((pixel, k, s0.0[i] * w / p));
                     self.stokes_spectral
-                        .push([s1.0[i] * q, s2.0[i] * q, s3.0[i] * q]);
+                        .push([s1.0[i] * w / p, s2.0[i] * w / p, s3.0[i] * w / p]);
                 }
             }
         }
