@@ -287,15 +287,9 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
         dir: Vec3,
         wl: &SampledWavelengths<N>,
     ) {
-        let t = &self.chain.t;
-        let add: StokesSpectrum<N> = match light_state(self.scene, light, dir, wl) {
-            None => StokesSpectrum(std::array::from_fn(|i| t[i].col(0) * c.0[i])),
-            Some((s, x)) => {
-                let r = rotate_basis(-dir, x, self.chain.x);
-                StokesSpectrum(std::array::from_fn(|i| t[i] * (r * s[i]) * c.0[i]))
-            }
-        };
-        self.out += add;
+        // `dir` points toward the light: its light travels along −dir.
+        let beam = Beam::emitted(self.scene, light, -dir, wl);
+        self.out += self.chain.receive(&beam, -dir, c);
     }
 
     #[inline]
@@ -309,17 +303,10 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
         light: usize,
         wl: &SampledWavelengths<N>,
     ) {
-        let (t, x_in) = self.chain.through(v, wi, wi_local, non_delta(v), wl);
-        let add = match (light_state(self.scene, light, wi, wl), x_in) {
-            // Polarised light onto a polarising event: into the event's frame.
-            (Some((s, x)), Some(x_in)) => {
-                let r = rotate_basis(-wi, x, x_in);
-                StokesSpectrum(std::array::from_fn(|i| t[i] * (r * s[i]) * c.0[i]))
-            }
-            // Unpolarised light, or a depolarising event: only S0 counts.
-            _ => StokesSpectrum(std::array::from_fn(|i| t[i].col(0) * c.0[i])),
-        };
-        self.out += add;
+        // Light samples reach the non-delta lobes only; the light travels along −wi.
+        let chain = self.chain.past(v, wi, wi_local, non_delta(v), wl);
+        let beam = Beam::emitted(self.scene, light, -wi, wl);
+        self.out += chain.receive(&beam, -wi, c);
     }
 
     #[inline]
