@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Does a change leave every image as it was? Renders every scene in scenes/ under every
-# integrator with the binary built from BASE (a commit; default HEAD~1) and with the
-# working tree's, and compares the EXR bytes (and, for a render that fails, the message).
+# integrator (whitted, path, lighttrace, bdpt, sppm) and in the variants that run other
+# code (--variance, spectral bins, polarised transport, shards merged by heron merge)
+# with the binary built from BASE (a commit; default HEAD~1) and with the working
+# tree's, and compares the EXR bytes (and, for a render that fails, the message).
+# QUICK=1 renders the integrators only.
 #
 #   scripts/same_images.sh [BASE] [SPP]     (SPP default 4; 2 spp with --lanes 8 reaches
 #                                            every kernel branch the scene uses)
@@ -30,28 +33,80 @@ build() { # $1: source dir, $2: target dir
     cargo build --release --locked --quiet --bin heron)
 }
 
+render_one() { # $1: heron binary, $2: output path without .exr, $3...: scene and flags
+  local bin=$1 out=$2
+  shift 2
+  if "$bin" render "$@" -o "$out.exr" --spp "$spp" --no-png --quiet --threads 2 >"$out.log" 2>&1; then
+    :
+  else
+    echo "exit $?" >>"$out.log"
+  fi
+}
+
+# A sharded render: shards 0/2 and 1/2 as film files, then heron merge (the film files
+# themselves may change format; the merged image must not).
+render_sharded() { # $1: heron binary, $2: output path without .exr, $3...: scene and flags
+  local bin=$1 out=$2
+  shift 2
+  {
+    for k in 0 1; do
+      "$bin" render "$@" --shard "$k/2" -o "$out.part$k.heronfilm" --spp "$spp" --no-png \
+        --quiet --threads 2 || echo "exit $?"
+    done
+    "$bin" merge "$out.part0.heronfilm" "$out.part1.heronfilm" -o "$out.exr" --no-png ||
+      echo "exit $?"
+    rm -f "$out".part*.heronfilm
+  } >"$out.log" 2>&1
+}
+
+# Every integrator, then the variants that run other code: the film's squares
+# (--variance), spectral bins, polarised transport and sharded renders.
+VARIANTS=(
+  "var-bins path: --integrator path --variance --spectral-bins 4"
+  "var-bins bdpt: --integrator bdpt --variance --spectral-bins 4"
+  "var-bins lighttrace: --integrator lighttrace --variance --spectral-bins 4"
+  "pol-bins path: --integrator path --polarization --spectral-bins 4"
+  "pol-bins whitted: --integrator whitted --polarization --spectral-bins 4"
+  "pol-bins lighttrace: --integrator lighttrace --polarization --spectral-bins 4"
+  "pol-bins bdpt: --integrator bdpt --polarization --spectral-bins 4"
+  "sppm-bins sppm: --integrator sppm --spectral-bins 4"
+  "shard path: --integrator path --variance --spectral-bins 4 --shard"
+  "shard bdpt: --integrator bdpt --variance --spectral-bins 4 --shard"
+  "shard sppm: --integrator sppm --shard"
+  "shard pol-lighttrace: --integrator lighttrace --polarization --spectral-bins 4 --shard"
+)
+
 render_all() { # $1: heron binary, $2: output dir, $3...: extra flags
   mkdir -p "$2"
   for scene in scenes/*.toml; do
     name=$(basename "$scene" .toml)
-    for integ in whitted path lighttrace bdpt; do
-      out="$2/$name.$integ"
+    jobs=()
+    for integ in whitted path lighttrace bdpt sppm; do
+      jobs+=("$integ: --integrator $integ")
+    done
+    if [ -z "${QUICK:-}" ]; then
+      jobs+=("${VARIANTS[@]}")
+    fi
+    for job in "${jobs[@]}"; do
+      label=${job%%:*}
+      flags=${job#*: }
+      out="$2/$name.${label// /.}"
       [ -e "$out.done" ] && continue
       # shellcheck disable=SC2086
-      if "$1" render "$scene" -o "$out.exr" --spp "$spp" --integrator "$integ" \
-        --no-png --quiet --threads 2 ${3:-} >"$out.log" 2>&1; then
-        :
-      else
-        echo "exit $?" >>"$out.log"
-      fi
-      # Timing lines differ between runs; keep only what the render said of its input.
-      grep -v -i -E 'seconds|[0-9.]+ ?s\b|/s\b|time' "$out.log" >"$out.msg" || true
+      case "$flags" in
+        *--shard) render_sharded "$1" "$out" "$scene" ${flags% --shard} ${3:-} ;;
+        *) render_one "$1" "$out" "$scene" $flags ${3:-} ;;
+      esac
+      # Timing lines differ between runs, and paths between the two sides' folders; keep
+      # only what the render said of its input.
+      { grep -v -i -E 'seconds|[0-9.]+ ?s\b|/s\b|time' "$out.log" || true; } |
+        sed "s#$2/##g" >"$out.msg"
       touch "$out.done"
     done
   done
 }
 
-base_dir="$root/renders-$base-spp$spp"
+base_dir="$root/renders-$base-spp$spp${QUICK:+-quick}"
 if [ ! -e "$base_dir/complete" ]; then
   wt="$root/worktree"
   git worktree remove --force "$wt" 2>/dev/null || rm -rf "$wt"

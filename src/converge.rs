@@ -311,15 +311,15 @@ fn render_reference(renderer: &Renderer, o: &RenderOptions) -> Result<(Film, f64
         wall += stats.wall.as_secs_f64();
         parts.push((PathBuf::from(format!("reference half {shard}")), state));
     }
-    let whole = merge(&parts)?.film();
+    let whole = merge(&parts)?.film.image();
     let (n1, n2) = (
         Shard { index: 0, count: 2 }.samples(spp).len() as f64,
         Shard { index: 1, count: 2 }.samples(spp).len() as f64,
     );
     let k = (n1 * n2).sqrt() / (n1 + n2);
     let halves = (
-        parts[0].1.film().linear_srgb(),
-        parts[1].1.film().linear_srgb(),
+        parts[0].1.film.image().linear_srgb(),
+        parts[1].1.film.image().linear_srgb(),
         k,
     );
     Ok((whole, wall, Some(halves)))

@@ -1240,7 +1240,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
             every,
             Arc::new(move |state: &heron::checkpoint::Checkpoint| {
                 // A preview that cannot be written is not worth the render: say so and go on.
-                if let Err(e) = stage_png(&state.film(), &png, &shown).and_then(|s| s.commit()) {
+                if let Err(e) =
+                    stage_png(&state.film.image(), &png, &shown).and_then(|s| s.commit())
+                {
                     eprintln!("warning: --preview-every: {e}");
                 }
             }),
@@ -1259,7 +1261,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         bar.finish_and_clear();
     }
     state.xyz_channels = args.xyz;
-    let film = state.film();
+    let film = state.film.image();
     if to_film {
         // The sums as they are: heron merge (or --resume, if the render stopped early)
         // carries on from them.
@@ -1267,7 +1269,7 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     } else {
         // From the settings key, as heron merge does: the same header either way (the
         // key records what ran, e.g. no packets for light tracing).
-        let provenance = heron::provenance::Provenance::from_key(&state.key, stats.spp)
+        let provenance = heron::provenance::Provenance::from_key(&state.key.provenance, stats.spp)
             .expect("the settings key holds the provenance");
         let png = (!args.no_png).then_some(&shown);
         write_image(&film, &exr_path, &state, &provenance, png)?;
@@ -1390,14 +1392,15 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
         })
         .collect::<Result<Vec<_>>>()?;
     let total = heron::checkpoint::merge(&parts)?;
-    let provenance = heron::provenance::Provenance::from_key(&total.key, total.spp_done)
-        .ok_or_else(|| {
-            anyhow::anyhow!(
-                "{}: not a heron film file: its settings lack the provenance",
-                display(&parts[0].0)
-            )
-        })?;
-    let film = total.film();
+    let provenance =
+        heron::provenance::Provenance::from_key(&total.key.provenance, total.film.spp_done)
+            .ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}: not a heron film file: its settings lack the provenance",
+                    display(&parts[0].0)
+                )
+            })?;
+    let film = total.film.image();
     let png = (!args.no_png).then_some(&shown);
     write_image(&film, &args.output, &total, &provenance, png)?;
     eprintln!(
@@ -1407,11 +1410,11 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
         if parts.len() == 1 { "" } else { "s" },
         film.width,
         film.height,
-        total.spp_done,
-        total.rays + total.shadow_rays,
-        total.rays,
-        total.shadow_rays,
-        total.nonfinite
+        total.film.spp_done,
+        total.film.rays + total.film.shadow_rays,
+        total.film.rays,
+        total.film.shadow_rays,
+        total.film.nonfinite
     );
     Ok(())
 }

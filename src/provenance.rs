@@ -98,11 +98,11 @@ pub const SPPM_KEYS: [&str; 3] = ["sppmPhotons", "sppmAlpha", "sppmRadius"];
 pub const POLARIZATION_KEYS: [&str; 2] = ["polarization", "polarizer"];
 
 impl Provenance {
-    /// The provenance a film's settings key holds (the key of `render.rs` contains every
-    /// provenance entry), with `spp` samples per pixel: what `heron merge` writes, the
-    /// same as the one render with all the samples would.
+    /// The provenance a film's settings key holds (`FilmKey::provenance`: every entry
+    /// but spp), with `spp` samples per pixel: what `heron merge` writes, the same as the
+    /// one render with all the samples would.
     pub fn from_key(
-        key: &serde_json::Map<String, serde_json::Value>,
+        key: &std::collections::BTreeMap<String, String>,
         spp: u32,
     ) -> Option<Provenance> {
         KEYS.iter()
@@ -110,13 +110,12 @@ impl Provenance {
             .chain(SPPM_KEYS.iter().filter(|k| key.contains_key(**k)))
             .chain(POLARIZATION_KEYS.iter().filter(|k| key.contains_key(**k)))
             .map(|&k| {
-                let v = key.get(k)?.as_str()?;
                 Some((
                     k,
                     if k == "spp" {
                         spp.to_string()
                     } else {
-                        v.to_string()
+                        key.get(k)?.clone()
                     },
                 ))
             })
@@ -201,11 +200,13 @@ mod tests {
         let p = Provenance::of_render(&scene, settings, 7);
         let names: Vec<&str> = p.0.iter().map(|(k, _)| *k).collect();
         assert_eq!(names, KEYS);
-        let key: serde_json::Map<String, serde_json::Value> =
+        // As a film's key holds it: every entry but spp.
+        let key: std::collections::BTreeMap<String, String> =
             Provenance::of_render(&scene, settings, settings.spp)
                 .0
                 .into_iter()
-                .map(|(k, v)| (k.to_string(), v.into()))
+                .filter(|(k, _)| *k != "spp")
+                .map(|(k, v)| (k.to_string(), v))
                 .collect();
         assert_eq!(Provenance::from_key(&key, 7), Some(p));
         let mut partial = key.clone();

@@ -10,18 +10,17 @@
 //! tile order, pass by pass. So the image is bit-identical whatever the thread count.
 use crate::accel::embree::{self, RayCoherence, RayQuery};
 use crate::camera::CameraRay;
-use crate::checkpoint::{Checkpoint, Shard};
-use crate::film::fixed::{to_fixed, to_fixed3, SquareSum};
-use crate::film::{
-    add_splat_squares, add_stokes_to_bins, add_to_bins, rgb_squares, xyz_of_sample, Film,
-    SpectralBins, Splats,
-};
+use crate::checkpoint::{Checkpoint, FilmKey, Shard};
+use crate::film::planes::Layout;
+use crate::film::state::FilmState;
+use crate::film::tile::{SampleValue, TileResult, TileSums};
+use crate::film::{add_splat_squares, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
+use crate::integrator::sppm::SppmPixels;
 use crate::integrator::{self, Context, Deferred, PathState, TraceCounters, WALKS};
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene};
 use crate::settings::{IntegratorKind, KernelFlags, Packets, RenderSettings};
-use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::{HeronError, Result};
 use rayon::prelude::*;
@@ -193,7 +192,7 @@ impl<'s> Renderer<'s> {
     /// Renders the image; returns the film and statistics.
     pub fn render(&self, opts: &RenderOptions) -> Result<(Film, RenderStats)> {
         let (state, stats) = self.render_state(opts)?;
-        Ok((state.film(), stats))
+        Ok((state.film.image(), stats))
     }
 
     /// Renders and returns the film's unnormalised state (sums and counts), which a
@@ -370,25 +369,27 @@ fn render_with(
 /// The settings that determine a render's image, which a checkpoint must match to be
 /// resumed: the provenance (scene and input hashes, integrator, sampler, spp, seed,
 /// lanes, wavelengths, depth, packets, bins), the image size and the pass size.
-fn settings_key(
-    scene: &Scene,
-    opts: &RenderOptions,
-    pass_spp: u32,
-) -> serde_json::Map<String, serde_json::Value> {
-    let mut m = serde_json::Map::new();
-    for (k, v) in
-        crate::provenance::Provenance::of_render(scene, &opts.settings, opts.settings.spp).0
-    {
-        m.insert(k.to_string(), v.into());
+fn settings_key(scene: &Scene, opts: &RenderOptions, pass_spp: u32) -> FilmKey {
+    let spp = opts.settings.spp;
+    FilmKey::new(
+        &crate::provenance::Provenance::of_render(scene, &opts.settings, spp),
+        spp,
+        (scene.camera.width, scene.camera.height),
+        pass_spp,
+        opts.variance,
+    )
+}
+
+/// The planes of a render's film.
+fn layout(scene: &Scene, opts: &RenderOptions) -> Layout {
+    Layout {
+        width: scene.camera.width,
+        height: scene.camera.height,
+        bins: opts.settings.spectral_bins,
+        splats: kind_splats(opts),
+        variance: opts.variance,
+        stokes: opts.settings.polarization,
     }
-    m.insert("width".into(), scene.camera.width.into());
-    m.insert("height".into(), scene.camera.height.into());
-    m.insert("passSpp".into(), pass_spp.into());
-    // Only when asked, so that the films of renders without it keep their bytes.
-    if opts.variance {
-        m.insert("variance".into(), true.into());
-    }
-    m
 }
 
 /// Whether the render's integrator splats (so that splat buffers are needed).
@@ -420,70 +421,6 @@ pub(crate) enum SampleFn {
     StokesOne(integrator::StokesFn<1>),
     StokesFour(integrator::StokesFn<4>),
     StokesEight(integrator::StokesFn<8>),
-}
-
-/// What one pixel sample gives the film: radiance, or Stokes radiance in a polarised
-/// render (whose S0 is the radiance and whose S1–S3 go to sums of their own). The tile
-/// loop is one generic function, so an unpolarised render runs the loop it ran before
-/// polarisation existed (`STOKES` false: no Stokes code is compiled into it).
-pub(crate) trait SampleValue<const N: usize>: Copy {
-    const STOKES: bool;
-    fn zero() -> Self;
-    /// The radiance (S0).
-    fn s0(&self) -> SampledSpectrum<N>;
-    /// S1, S2, S3 as XYZ, in fixed point; None when any is out of the film's range.
-    fn stokes_fixed(&self, wl: &SampledWavelengths<N>) -> Option<[i128; 9]>;
-    /// S1, S2, S3 (zero for radiance).
-    fn stokes_components(&self) -> [SampledSpectrum<N>; 3];
-}
-
-impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
-    const STOKES: bool = false;
-    #[inline(always)]
-    fn zero() -> Self {
-        SampledSpectrum::zero()
-    }
-    #[inline(always)]
-    fn s0(&self) -> SampledSpectrum<N> {
-        *self
-    }
-    #[inline(always)]
-    fn stokes_fixed(&self, _: &SampledWavelengths<N>) -> Option<[i128; 9]> {
-        Some([0; 9])
-    }
-    #[inline(always)]
-    fn stokes_components(&self) -> [SampledSpectrum<N>; 3] {
-        [SampledSpectrum::zero(); 3]
-    }
-}
-
-impl<const N: usize> SampleValue<N> for StokesSpectrum<N> {
-    const STOKES: bool = true;
-    #[inline]
-    fn zero() -> Self {
-        StokesSpectrum::zero()
-    }
-    #[inline]
-    fn s0(&self) -> SampledSpectrum<N> {
-        self.component(0)
-    }
-    #[inline]
-    fn stokes_fixed(&self, wl: &SampledWavelengths<N>) -> Option<[i128; 9]> {
-        let mut out = [0i128; 9];
-        for k in 1..4 {
-            let c = self.component(k);
-            if !c.is_finite() {
-                return None;
-            }
-            let f = to_fixed3(xyz_of_sample(&c, wl))?;
-            out[3 * (k - 1)..3 * k].copy_from_slice(&f);
-        }
-        Some(out)
-    }
-    #[inline]
-    fn stokes_components(&self) -> [SampledSpectrum<N>; 3] {
-        std::array::from_fn(|k| self.component(k + 1))
-    }
 }
 
 /// Renders `spp` samples per pixel (or the shard's share of them) in passes of
@@ -528,17 +465,16 @@ pub(crate) fn render_passes(
         .collect();
     let n_work = tiles.len() as u64 * passes.len() as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
-    let nb = opts.settings.spectral_bins;
     // Unnormalised sums over the whole render: XYZ and bins per pixel, finite samples per
     // pixel, and splatted XYZ.
     let key = settings_key(ctx.scene, opts, pass_spp);
     let mut state = initial_state(ctx.scene, opts, key, passes.len())?;
     let mut stats = RenderStats {
-        resumed_from: opts.resume.as_ref().map(|c| c.spp_done),
+        resumed_from: opts.resume.as_ref().map(|c| c.film.spp_done),
         ..Default::default()
     };
-    let first_pass = state.passes_done as usize;
-    let (rays0, shadow0) = (state.rays, state.shadow_rays);
+    let first_pass = state.film.passes_done as usize;
+    let (rays0, shadow0) = (state.film.rays, state.film.shadow_rays);
     done.store(
         first_pass as u64 * tiles.len() as u64,
         std::sync::atomic::Ordering::Relaxed,
@@ -624,26 +560,27 @@ pub(crate) fn render_passes(
             return Err(HeronError::Cancelled);
         }
         for t in results {
-            add_tile(&mut state, &mut stats, t, cam.width, nb);
+            let first = state.film.add_tile(t);
+            stats.first_nonfinite = stats.first_nonfinite.or(first);
         }
-        state.passes_done += 1;
-        state.spp_done = s1 - range.start;
+        state.film.passes_done += 1;
+        state.film.spp_done = s1 - range.start;
         if clock.end_pass(opts, &state, s1 == range.end)? {
             stats.stopped = true;
             break;
         }
     }
-    stats.finish(&state, start, (rays0, shadow0));
+    stats.finish(&state.film, start, (rays0, shadow0));
     Ok((state, stats))
 }
 
 impl RenderStats {
     /// The statistics of a render that ended with `state`, started at `start` from a
     /// state that had traced `before` (camera and shadow rays).
-    fn finish(&mut self, state: &Checkpoint, start: Instant, before: (u64, u64)) {
+    fn finish(&mut self, state: &FilmState, start: Instant, before: (u64, u64)) {
         self.wall = start.elapsed();
         self.spp = state.spp_done;
-        self.samples = state.width as u64 * state.height as u64 * state.spp_done as u64;
+        self.samples = state.layout.pixels() as u64 * state.spp_done as u64;
         // This process's rays (a resumed render's earlier ones are in the checkpoint).
         self.counters.rays = state.rays - before.0;
         self.counters.shadow_rays = state.shadow_rays - before.1;
@@ -678,68 +615,105 @@ fn render_sppm<const N: usize>(
     }
     let scene = ctx.scene;
     let cam = &scene.camera;
-    let nb = opts.settings.spectral_bins;
+    let npix = (cam.width * cam.height) as usize;
     let range = opts
         .shard
         .map_or(0..opts.settings.spp, |s| s.samples(opts.settings.spp));
     let key = settings_key(scene, opts, 1);
     let mut state = initial_state(scene, opts, key, range.len())?;
     let mut stats = RenderStats {
-        resumed_from: opts.resume.as_ref().map(|c| c.spp_done),
+        resumed_from: opts.resume.as_ref().map(|c| c.film.spp_done),
         ..Default::default()
     };
-    let before = (state.rays, state.shadow_rays);
+    let before = (state.film.rays, state.film.shadow_rays);
     let mut clock = PassClock::new();
     let start = clock.start;
-    let first = range.start + state.passes_done;
+    let first = range.start + state.film.passes_done;
     let cancel = || cancelled(opts);
     for k in first..range.end {
-        let mut pixels = state.sppm.take().unwrap_or_default();
+        let mut pixels = state
+            .film
+            .integrator
+            .take()
+            .map_or_else(|| SppmPixels::new(npix), SppmPixels::from_plane);
         let it = pool.install(|| integrator::sppm::iteration::<N>(ctx, &mut pixels, k, &cancel));
         if cancelled(opts) {
             return Err(HeronError::Cancelled);
         }
-        state.sppm = Some(pixels);
+        state.film.integrator = Some(pixels.into_plane());
         // The camera paths' light, as one tile of the whole image.
-        let mut sums = TileSums::new(cam.width, cam.height, nb, false, false);
+        let layout = state.film.layout;
+        let mut sums = TileSums::new(&layout, (0, 0, cam.width, cam.height), PACKET as u32);
         for y in 0..cam.height {
             for x in 0..cam.width {
                 let l = &it.l[(y * cam.width + x) as usize];
-                sums.add::<N, false, SampledSpectrum<N>>((0, 0), (x, y, k), l, &it.wl);
+                sums.add::<N, false, SampledSpectrum<N>>((x, y, k), l, &it.wl);
             }
         }
         let tile = sums.result(
-            (0, 0, cam.width, cam.height),
             Splats::new(0),
             Vec::new(),
-            it.counters,
+            (it.counters.rays, it.counters.shadow_rays),
         );
-        add_tile(&mut state, &mut stats, tile, cam.width, nb);
+        let first = state.film.add_tile(tile);
+        stats.first_nonfinite = stats.first_nonfinite.or(first);
         // The photons' sums, already exact integers.
-        for (a, b) in state.splat.iter_mut().zip(&it.photons.xyz) {
-            for (x, y) in a.iter_mut().zip(b) {
-                *x = x.wrapping_add(y.load());
-            }
-        }
-        for (a, b) in state.splat_bins.iter_mut().zip(&it.photons.bins) {
+        let planes = &mut state.film.planes;
+        for (a, b) in planes.splat.iter_mut().zip(it.photons.xyz.iter().flatten()) {
             *a = a.wrapping_add(b.load());
         }
-        state.nonfinite += it
+        for (a, b) in planes.splat_bins.iter_mut().zip(&it.photons.bins) {
+            *a = a.wrapping_add(b.load());
+        }
+        state.film.nonfinite += it
             .photons
             .nonfinite
             .load(std::sync::atomic::Ordering::Relaxed);
-        state.passes_done += 1;
-        state.spp_done = k + 1 - range.start;
+        state.film.passes_done += 1;
+        state.film.spp_done = k + 1 - range.start;
         if let Some(p) = &opts.progress {
-            p(state.spp_done as u64, range.len() as u64);
+            p(state.film.spp_done as u64, range.len() as u64);
         }
         if clock.end_pass(opts, &state, k + 1 == range.end)? {
             stats.stopped = true;
             break;
         }
     }
-    stats.finish(&state, start, before);
+    stats.finish(&state.film, start, before);
     Ok((state, stats))
+}
+
+/// The film's state a render starts from: the checkpoint `opts` resumes, checked against
+/// this render (its settings `key`, its film's planes and at most `passes` passes), or
+/// an empty film.
+fn initial_state(
+    scene: &Scene,
+    opts: &RenderOptions,
+    key: FilmKey,
+    passes: usize,
+) -> Result<Checkpoint> {
+    let layout = layout(scene, opts);
+    let sppm = opts.settings.integrator == IntegratorKind::Sppm;
+    match &opts.resume {
+        // Photon mapping keeps N and R² per pixel.
+        Some(c) => c.resume(
+            &key,
+            opts.shard,
+            &layout,
+            passes,
+            sppm.then_some((SppmPixels::PLANE, 2)),
+        ),
+        None => {
+            let mut film = FilmState::new(layout);
+            film.integrator = sppm.then(|| SppmPixels::new(layout.pixels()).into_plane());
+            Ok(Checkpoint {
+                key,
+                shard: opts.shard,
+                xyz_channels: false,
+                film,
+            })
+        }
+    }
 }
 
 /// When a render last wrote a checkpoint and a preview, for the decisions at the end
@@ -788,387 +762,6 @@ impl PassClock {
     }
 }
 
-/// Adds one tile's sums of a pass (and its splats) to the film's state.
-fn add_tile(state: &mut Checkpoint, stats: &mut RenderStats, t: TileResult, width: u32, nb: usize) {
-    let npix = state.sum_xyz.len();
-    for y in 0..t.h {
-        for x in 0..t.w {
-            let (dst, src) = (
-                ((t.y0 + y) * width + t.x0 + x) as usize,
-                (y * t.w + x) as usize,
-            );
-            for j in 0..3 {
-                state.sum_xyz[dst][j] = state.sum_xyz[dst][j].wrapping_add(t.xyz[src][j]);
-            }
-            state.good[dst] += t.good[src];
-            if let Some(st) = t.stokes.get(src) {
-                for (a, b) in state.sum_stokes[dst].iter_mut().zip(st) {
-                    *a = a.wrapping_add(*b);
-                }
-            }
-            if let Some(sq) = t.sq.get(src) {
-                for (a, b) in state.sum_sq[dst].iter_mut().zip(sq) {
-                    a.add(*b);
-                }
-            }
-            for (a, b) in state.sum_bins[dst * nb..(dst + 1) * nb]
-                .iter_mut()
-                .zip(&t.spectral[src * nb..(src + 1) * nb])
-            {
-                *a = a.wrapping_add(*b);
-            }
-            if !t.stokes_bins.is_empty() {
-                for (a, b) in state.sum_stokes_bins[3 * dst * nb..3 * (dst + 1) * nb]
-                    .iter_mut()
-                    .zip(&t.stokes_bins[3 * src * nb..3 * (src + 1) * nb])
-                {
-                    *a = a.wrapping_add(*b);
-                }
-            }
-        }
-    }
-    let stokes_splats = !t.splats.stokes.is_empty();
-    // A render splats through `Splats::add` or through `add_stokes`, never both.
-    debug_assert!(!stokes_splats || t.splats.stokes.len() == t.splats.list.len());
-    if stokes_splats && state.splat_stokes.is_empty() {
-        // Polarised splats from an integrator not known to splat.
-        state.splat_stokes = vec![[0; 9]; npix];
-        state.splat_stokes_bins = vec![0; 3 * state.splat_bins.len()];
-    }
-    for (j, &(p, c)) in t.splats.list.iter().enumerate() {
-        state.any_splat = true;
-        // A polarised splat's four components count together.
-        let st = if stokes_splats {
-            let s = &t.splats.stokes[j];
-            match (to_fixed3(s[0]), to_fixed3(s[1]), to_fixed3(s[2])) {
-                (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-                _ => None,
-            }
-        } else {
-            Some([[0; 3]; 3])
-        };
-        match (to_fixed3(c), st) {
-            (Some(f), Some(st)) => {
-                for (a, b) in state.splat[p as usize].iter_mut().zip(f) {
-                    *a = a.wrapping_add(b);
-                }
-                if stokes_splats {
-                    for (a, b) in state.splat_stokes[p as usize]
-                        .iter_mut()
-                        .zip(st.iter().flatten())
-                    {
-                        *a = a.wrapping_add(*b);
-                    }
-                }
-            }
-            _ => state.nonfinite += 1,
-        }
-    }
-    if state.splat_sq.is_empty() && !t.splat_sq.is_empty() {
-        // Splats from an integrator not known to splat (as `any_splat`).
-        state.splat_sq = vec![[SquareSum::default(); 3]; npix];
-    }
-    for (p, sq) in &t.splat_sq {
-        for (a, b) in state.splat_sq[*p as usize].iter_mut().zip(sq) {
-            a.add(*b);
-        }
-    }
-    for (j, &(p, k, v)) in t.splats.spectral.iter().enumerate() {
-        // A splat too large for the film was counted with its XYZ above.
-        let Some(f) = to_fixed(v) else { continue };
-        if stokes_splats {
-            let s = t.splats.stokes_spectral[j].map(to_fixed);
-            let [Some(s1), Some(s2), Some(s3)] = s else {
-                continue;
-            };
-            for (c, v) in [s1, s2, s3].into_iter().enumerate() {
-                let a = &mut state.splat_stokes_bins[(3 * p as usize + c) * nb + k as usize];
-                *a = a.wrapping_add(v);
-            }
-        }
-        let a = &mut state.splat_bins[p as usize * nb + k as usize];
-        *a = a.wrapping_add(f);
-    }
-    state.rays += t.counters.rays;
-    state.shadow_rays += t.counters.shadow_rays;
-    state.nonfinite += t.nonfinite + t.splats.nonfinite;
-    stats.first_nonfinite = stats.first_nonfinite.or(t.first_nonfinite);
-}
-
-/// The film's state a render starts from: the checkpoint `opts` resumes, checked against
-/// this render (its settings `key`, image, arrays and at most `passes` passes), or empty
-/// sums.
-fn initial_state(
-    scene: &Scene,
-    opts: &RenderOptions,
-    key: serde_json::Map<String, serde_json::Value>,
-    passes: usize,
-) -> Result<Checkpoint> {
-    let cam = &scene.camera;
-    let npix = (cam.width * cam.height) as usize;
-    let nb = opts.settings.spectral_bins;
-    let sppm = opts.settings.integrator == IntegratorKind::Sppm;
-    let stokes_splats = opts.settings.polarization && kind_splats(opts);
-    Ok(match &opts.resume {
-        Some(c) => {
-            if c.variance != opts.variance {
-                let with = |v: bool| if v { "with" } else { "without" };
-                return Err(HeronError::Invalid(format!(
-                    "--resume: the checkpoint was made {} --variance, this render is {} it",
-                    with(c.variance),
-                    with(opts.variance)
-                )));
-            }
-            if let Some(m) = c.mismatch(&key) {
-                return Err(HeronError::Invalid(format!(
-                    "--resume: the checkpoint was made with other settings ({m})"
-                )));
-            }
-            if c.shard != opts.shard {
-                let show = |s: Option<Shard>| s.map_or("no shard".into(), |s| format!("shard {s}"));
-                return Err(HeronError::Invalid(format!(
-                    "--resume: the checkpoint holds {}, this render {}",
-                    show(c.shard),
-                    show(opts.shard)
-                )));
-            }
-            let splat_len = if kind_splats(opts) { npix * nb } else { 0 };
-            let (sq_len, splat_sq_len) = variance_lens(opts, npix);
-            if (c.width, c.height) != (cam.width, cam.height)
-                || c.sum_bins.len() != npix * nb
-                || c.splat_bins.len() != splat_len
-                || c.sum_sq.len() != sq_len
-                || c.splat_sq.len() != splat_sq_len
-                || c.passes_done as usize > passes
-                || c.sum_stokes.len() != if opts.settings.polarization { npix } else { 0 }
-                || c.sum_stokes_bins.len()
-                    != if opts.settings.polarization {
-                        3 * npix * nb
-                    } else {
-                        0
-                    }
-                || c.splat_stokes.len() != if stokes_splats { npix } else { 0 }
-                || c.splat_stokes_bins.len() != if stokes_splats { 3 * npix * nb } else { 0 }
-                || c.sppm.as_ref().map(|s| s.n.len()) != sppm.then_some(npix)
-            {
-                return Err(HeronError::Invalid(
-                    "--resume: the checkpoint's film does not fit this render".into(),
-                ));
-            }
-            (**c).clone()
-        }
-        None => Checkpoint {
-            key,
-            shard: opts.shard,
-            width: cam.width,
-            height: cam.height,
-            // Splats count when the integrator splats (a resumed render or a shard may
-            // add none itself), or when any sample splatted.
-            any_splat: kind_splats(opts),
-            sum_xyz: vec![[0; 3]; npix],
-            sum_bins: vec![0; npix * nb],
-            good: vec![0u32; npix],
-            splat: vec![[0; 3]; npix],
-            splat_bins: vec![0; if kind_splats(opts) { npix * nb } else { 0 }],
-            variance: opts.variance,
-            sum_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).0],
-            splat_sq: vec![[SquareSum::default(); 3]; variance_lens(opts, npix).1],
-            sppm: sppm.then(|| integrator::sppm::SppmPixels::new(npix)),
-            sum_stokes: vec![[0; 9]; if opts.settings.polarization { npix } else { 0 }],
-            sum_stokes_bins: vec![
-                0;
-                if opts.settings.polarization {
-                    3 * npix * nb
-                } else {
-                    0
-                }
-            ],
-            splat_stokes: vec![[0; 9]; if stokes_splats { npix } else { 0 }],
-            splat_stokes_bins: vec![0; if stokes_splats { 3 * npix * nb } else { 0 }],
-            ..Default::default()
-        },
-    })
-}
-
-/// The lengths of the film's arrays of squares: (per pixel, per pixel for splats), zero
-/// without `--variance`.
-fn variance_lens(opts: &RenderOptions, npix: usize) -> (usize, usize) {
-    match (opts.variance, kind_splats(opts)) {
-        (false, _) => (0, 0),
-        (true, false) => (npix, 0),
-        (true, true) => (npix, npix),
-    }
-}
-
-struct TileResult {
-    x0: u32,
-    y0: u32,
-    w: u32,
-    h: u32,
-    /// Per pixel: sums of XYZ and of the spectral bins over the finite samples of this
-    /// pass (fixed point), and their count.
-    xyz: Vec<[i128; 3]>,
-    spectral: Vec<i128>,
-    good: Vec<u32>,
-    /// Polarised renders: per pixel, the sums of S1, S2, S3 as XYZ (empty otherwise),
-    /// and with spectral bins those of S1, S2 and S3 (3 × bins per pixel).
-    stokes: Vec<[i128; 9]>,
-    stokes_bins: Vec<i128>,
-    /// With `--variance`: per pixel, the sums of the squares of the samples' linear sRGB
-    /// (empty otherwise); and per sample that splatted, the squares of its splats summed
-    /// per pixel.
-    sq: Vec<[SquareSum; 3]>,
-    splat_sq: Vec<(u32, [SquareSum; 3])>,
-    splats: Splats,
-    counters: TraceCounters,
-    nonfinite: u64,
-    first_nonfinite: Option<(u32, u32, u32)>,
-}
-
-/// One tile's sums of one pass, as its samples arrive.
-struct TileSums {
-    w: u32,
-    nb: usize,
-    bins: SpectralBins,
-    xyz: Vec<[i128; 3]>,
-    spectral: Vec<i128>,
-    good: Vec<u32>,
-    stokes: Vec<[i128; 9]>,
-    stokes_bins: Vec<i128>,
-    sq: Vec<[SquareSum; 3]>,
-    nonfinite: u64,
-    /// The first sample left out, in the one-path-at-a-time engine's order (its key:
-    /// row, packet, sample, lane), whichever order the samples finished in.
-    first_nonfinite: Option<([u32; 4], (u32, u32, u32))>,
-}
-
-impl TileSums {
-    fn new(w: u32, h: u32, nb: usize, variance: bool, stokes: bool) -> Self {
-        let n = (w * h) as usize;
-        TileSums {
-            w,
-            nb,
-            bins: SpectralBins { count: nb },
-            xyz: vec![[0i128; 3]; n],
-            spectral: vec![0i128; n * nb],
-            good: vec![0u32; n],
-            stokes: if stokes { vec![[0; 9]; n] } else { Vec::new() },
-            stokes_bins: if stokes {
-                vec![0; 3 * n * nb]
-            } else {
-                Vec::new()
-            },
-            sq: if variance {
-                vec![[SquareSum::default(); 3]; n]
-            } else {
-                Vec::new()
-            },
-            nonfinite: 0,
-            first_nonfinite: None,
-        }
-    }
-
-    /// Adds the radiance `l` at wavelengths `wl` of sample `s` of the tile's pixel
-    /// (`x`, `y`) (tile coordinates; the tile starts at `origin`). The sums are exact
-    /// integers, so the order in which samples arrive does not change them.
-    #[inline]
-    fn add<const N: usize, const VARIANCE: bool, O: SampleValue<N>>(
-        &mut self,
-        origin: (u32, u32),
-        (x, y, s): (u32, u32, u32),
-        value: &O,
-        wl: &SampledWavelengths<N>,
-    ) {
-        let l = &value.s0();
-        let (nb, i) = (self.nb, (y * self.w + x) as usize);
-        // A sample whose radiance is not finite, or too large for the film's fixed-point
-        // sums (film/fixed.rs), is left out and counted.
-        let v = if l.is_finite() {
-            Some(xyz_of_sample(l, wl))
-        } else {
-            None
-        };
-        let c = v.and_then(to_fixed3);
-        // S1–S3 (polarised renders) count only with S0, and S0 only with them.
-        let st = if O::STOKES {
-            value.stokes_fixed(wl)
-        } else {
-            Some([0; 9])
-        };
-        // The bins are added only when the XYZ is in range, and the XYZ only when the
-        // bins were.
-        // A polarised sample's four components go into their bins together.
-        let ok = c.is_some()
-            && st.is_some()
-            && (nb == 0
-                || if O::STOKES {
-                    let [s1, s2, s3] = value.stokes_components();
-                    add_stokes_to_bins(
-                        &self.bins,
-                        &mut self.spectral[i * nb..(i + 1) * nb],
-                        &mut self.stokes_bins[3 * i * nb..3 * (i + 1) * nb],
-                        [*l, s1, s2, s3],
-                        wl,
-                    )
-                } else {
-                    add_to_bins(&self.bins, &mut self.spectral[i * nb..(i + 1) * nb], l, wl)
-                });
-        let (Some(c), true) = (c, ok) else {
-            self.nonfinite += 1;
-            let key = [y, x / PACKET as u32, s, x % PACKET as u32];
-            if self.first_nonfinite.map_or(true, |(k, _)| key < k) {
-                self.first_nonfinite = Some((key, (origin.0 + x, origin.1 + y, s)));
-            }
-            return;
-        };
-        for (a, b) in self.xyz[i].iter_mut().zip(c) {
-            *a = a.wrapping_add(b);
-        }
-        if O::STOKES {
-            if let Some(st) = st {
-                for (a, b) in self.stokes[i].iter_mut().zip(st) {
-                    *a = a.wrapping_add(b);
-                }
-            }
-        }
-        self.good[i] += 1;
-        if VARIANCE {
-            // In range: v passed to_fixed3.
-            if let Some(q) = v.and_then(rgb_squares) {
-                for (a, b) in self.sq[i].iter_mut().zip(q) {
-                    a.add(b);
-                }
-            }
-        }
-    }
-
-    fn result(
-        self,
-        (x0, y0, w, h): (u32, u32, u32, u32),
-        splats: Splats,
-        splat_sq: Vec<(u32, [SquareSum; 3])>,
-        counters: TraceCounters,
-    ) -> TileResult {
-        TileResult {
-            x0,
-            y0,
-            w,
-            h,
-            xyz: self.xyz,
-            spectral: self.spectral,
-            good: self.good,
-            stokes: self.stokes,
-            stokes_bins: self.stokes_bins,
-            sq: self.sq,
-            splat_sq,
-            splats,
-            counters,
-            nonfinite: self.nonfinite,
-            first_nonfinite: self.first_nonfinite.map(|(_, p)| p),
-        }
-    }
-}
-
 /// Whether the render was abandoned (`RenderOptions::cancel`).
 #[inline]
 fn cancelled(opts: &RenderOptions) -> bool {
@@ -1190,7 +783,7 @@ fn render_tile<const N: usize, const VARIANCE: bool, O: SampleValue<N>>(
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
-    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE, O::STOKES);
+    let mut sums = TileSums::new(&layout(ctx.scene, opts), (x0, y0, w, h), PACKET as u32);
     let mut splat_sq = Vec::new();
     let mut scratch = Vec::new();
     let mut counters = TraceCounters::default();
@@ -1288,12 +881,12 @@ fn render_tile<const N: usize, const VARIANCE: bool, O: SampleValue<N>>(
                             &mut splat_sq,
                         );
                     }
-                    sums.add::<N, VARIANCE, O>((x0, y0), (xs + k as u32, y, s), &l, &wls[k]);
+                    sums.add::<N, VARIANCE, O>((xs + k as u32, y, s), &l, &wls[k]);
                 }
             }
         }
     }
-    sums.result((x0, y0, w, h), splats, splat_sq, counters)
+    sums.result(splats, splat_sq, (counters.rays, counters.shadow_rays))
 }
 
 /// A path of the packet engine: its pixel sample (tile coordinates and sample index),
@@ -1327,7 +920,7 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
     let cam = &ctx.scene.camera;
     let w = TILE.min(cam.width - x0);
     let h = TILE.min(cam.height - y0);
-    let mut sums = TileSums::new(w, h, opts.settings.spectral_bins, VARIANCE, false);
+    let mut sums = TileSums::new(&layout(ctx.scene, opts), (x0, y0, w, h), PACKET as u32);
     let mut counters = TraceCounters::default();
     let base = Sampler::new(
         opts.settings.sampler,
@@ -1393,7 +986,6 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
                     // Stopped by the lens: the sample adds 0, and the lane takes the
                     // next one.
                     None => sums.add::<N, VARIANCE, SampledSpectrum<N>>(
-                        (x0, y0),
                         (x, y, s),
                         &SampledSpectrum::zero(),
                         &wl,
@@ -1509,13 +1101,17 @@ fn render_tile_paths<const N: usize, const VARIANCE: bool>(
             shadows[k].resolve(&mut lane.state.l);
             if going & (1 << k) == 0 {
                 let l = lane.state.radiance();
-                sums.add::<N, VARIANCE, SampledSpectrum<N>>((x0, y0), lane.pixel, &l, &lane.wl);
+                sums.add::<N, VARIANCE, SampledSpectrum<N>>(lane.pixel, &l, &lane.wl);
                 lanes[k] = None;
                 shadows[k].clear();
             }
         }
     }
-    sums.result((x0, y0, w, h), Splats::default(), Vec::new(), counters)
+    sums.result(
+        Splats::default(),
+        Vec::new(),
+        (counters.rays, counters.shadow_rays),
+    )
 }
 
 #[cfg(test)]
@@ -1572,7 +1168,8 @@ mod tests {
             render_passes(&ctx, &pool, &o, pass, &integrate)
                 .unwrap()
                 .0
-                .film()
+                .film
+                .image()
         };
         let a = run(1, 16);
         assert!(
@@ -1643,7 +1240,8 @@ mod tests {
             let film = render_passes(&ctx, &pool, &o, 16, &integrate)
                 .unwrap()
                 .0
-                .film();
+                .film
+                .image();
             let rgb = film.linear_srgb();
             let var = film.variance.as_ref().unwrap();
             let n = rgb.len() as f64;

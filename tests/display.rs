@@ -522,12 +522,16 @@ fn the_preview_hook_sees_every_pass_and_leaves_the_film_unchanged() {
             std::time::Duration::ZERO,
             Arc::new(move |state: &heron::checkpoint::Checkpoint| {
                 calls.fetch_add(1, Ordering::SeqCst);
-                seen.lock().unwrap().push(state.spp_done);
+                seen.lock().unwrap().push(state.film.spp_done);
                 // The writer --preview-every uses.
-                heron::film::png::stage_png(&state.film(), &png, &DisplayTransform::default())
-                    .unwrap()
-                    .commit()
-                    .unwrap();
+                heron::film::png::stage_png(
+                    &state.film.image(),
+                    &png,
+                    &DisplayTransform::default(),
+                )
+                .unwrap()
+                .commit()
+                .unwrap();
             }),
         ));
     }
@@ -537,7 +541,10 @@ fn the_preview_hook_sees_every_pass_and_leaves_the_film_unchanged() {
     assert_eq!(*seen.lock().unwrap(), [1024]);
     let (w, h, _) = decode_png(&png);
     assert_eq!((w, h), (64, 64));
-    assert!(plain.film() == with.film(), "the preview changed the image");
+    assert!(
+        plain.film.image() == with.film.image(),
+        "the preview changed the image"
+    );
 }
 
 fn default_scene_args<'a>(sc: &'a str, out: &'a str, spp: &'a str) -> Vec<&'a str> {

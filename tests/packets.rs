@@ -141,18 +141,20 @@ fn shards_of_packets_of_paths_add_up_to_the_one_render() {
     o.settings.spp = 7;
     o.threads = 2;
     let (one, _) = render_state(&s, &o).unwrap();
-    let mut sum = vec![[0i128; 3]; one.sum_xyz.len()];
+    let mut sum = vec![0i128; one.film.planes.xyz.len()];
     for k in 0..3 {
         o.shard = Some(Shard::parse(&format!("{k}/3")).unwrap());
         let (part, _) = render_state(&s, &o).unwrap();
-        for (a, b) in sum.iter_mut().zip(&part.sum_xyz) {
-            for (x, y) in a.iter_mut().zip(b) {
-                *x = x.wrapping_add(*y);
-            }
+        for (a, b) in sum.iter_mut().zip(&part.film.planes.xyz) {
+            *a = a.wrapping_add(*b);
         }
     }
-    let differ = sum.iter().zip(&one.sum_xyz).filter(|(a, b)| a != b).count();
-    assert_eq!(differ, 0, "{differ} of {} pixels differ", sum.len());
+    let differ = sum
+        .iter()
+        .zip(&one.film.planes.xyz)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differ, 0, "{differ} of {} sums differ", sum.len());
 }
 
 /// `auto` runs packets of paths under `whitted` and one path at a time otherwise, and
@@ -171,7 +173,7 @@ fn auto_resolves_and_the_provenance_says_what_ran() {
         o.settings.spp = 1;
         assert_eq!(o.settings.packets, Packets::Auto);
         let (state, _) = render_state(&s, &o).unwrap();
-        assert_eq!(state.key["packets"], ran, "{}", kind.name());
+        assert_eq!(state.key.provenance["packets"], ran, "{}", kind.name());
     }
     // Asked for, packets of paths are what runs under the others too (light tracing and
     // BDPT send their connections' shadow rays 8 at a time).
@@ -185,6 +187,6 @@ fn auto_resolves_and_the_provenance_says_what_ran() {
         o.settings.spp = 1;
         o.settings.packets = Packets::Paths;
         let (state, _) = render_state(&s, &o).unwrap();
-        assert_eq!(state.key["packets"], ran, "{}", kind.name());
+        assert_eq!(state.key.provenance["packets"], ran, "{}", kind.name());
     }
 }

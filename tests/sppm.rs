@@ -62,15 +62,17 @@ fn sppm(
 /// The mean over the pixels of Y of the camera pass's light (the direct light) and of
 /// the photons' estimate.
 fn parts_y(c: &Checkpoint) -> (f64, f64) {
-    let n = c.sum_xyz.len() as f64;
-    let direct = c
-        .sum_xyz
-        .iter()
-        .zip(&c.good)
+    let p = &c.film.planes;
+    let n = p.good.len() as f64;
+    let direct = p
+        .xyz
+        .chunks_exact(3)
+        .zip(&p.good)
         .map(|(s, &g)| to_f64(s[1]) / g.max(1) as f64)
         .sum::<f64>()
         / n;
-    let photons = c.splat.iter().map(|s| to_f64(s[1])).sum::<f64>() / n / c.spp_done as f64;
+    let photons =
+        p.splat.chunks_exact(3).map(|s| to_f64(s[1])).sum::<f64>() / n / c.film.spp_done as f64;
     (direct, photons)
 }
 
@@ -159,7 +161,7 @@ fn bdpt_reference(scene: &Scene, spp: u32) -> Film {
 fn errors(scene: &Scene, reference: &Film, iterations: &[u32]) -> Vec<f64> {
     iterations
         .iter()
-        .map(|&i| region_error(&sppm(scene, i, 7, |_| {}).film(), reference, 4))
+        .map(|&i| region_error(&sppm(scene, i, 7, |_| {}).film.image(), reference, 4))
         .collect()
 }
 
@@ -221,7 +223,13 @@ fn four_lanes_and_one_estimate_the_same_dispersive_image() {
     };
     let stats = |lanes: usize, seeds: std::ops::Range<u64>| {
         let films: Vec<Vec<f64>> = seeds
-            .map(|s| regions(&sppm(&scene, 32, s, |o| o.settings.lanes = lanes).film()))
+            .map(|s| {
+                regions(
+                    &sppm(&scene, 32, s, |o| o.settings.lanes = lanes)
+                        .film
+                        .image(),
+                )
+            })
             .collect();
         (0..films[0].len())
             .map(|k| mean_se(&films.iter().map(|f| f[k]).collect::<Vec<_>>()))
@@ -264,9 +272,12 @@ fn the_image_does_not_depend_on_the_thread_count_and_resumes_to_the_same_bytes()
             }
         }));
     });
-    assert_eq!(part.spp_done, 2);
+    assert_eq!(part.film.spp_done, 2);
     let saved = Checkpoint::read(&path).unwrap();
-    assert!(saved.sppm.is_some(), "the checkpoint keeps the radii");
+    assert!(
+        saved.film.integrator.is_some(),
+        "the checkpoint keeps the radii"
+    );
     let resumed = sppm(&scene, 6, 3, |o| {
         o.resume = Some(std::sync::Arc::new(saved))
     });
@@ -285,11 +296,18 @@ fn shards_are_independent_chains_that_merge_into_their_weighted_mean() {
         })
         .collect();
     let merged = merge(&parts).unwrap();
-    assert_eq!(merged.spp_done, 6);
-    assert!(merged.sppm.is_none(), "a merged film is not resumable");
+    assert_eq!(merged.film.spp_done, 6);
+    assert!(
+        merged.film.integrator.is_none(),
+        "a merged film is not resumable"
+    );
     // Each shard is an SPPM render of 3 iterations from the initial radii: the merged
     // image is the mean of the two parts' images, pixel by pixel.
-    let (a, b, m) = (parts[0].1.film(), parts[1].1.film(), merged.film());
+    let (a, b, m) = (
+        parts[0].1.film.image(),
+        parts[1].1.film.image(),
+        merged.film.image(),
+    );
     for i in 0..m.xyz.len() {
         for c in 0..3 {
             let want = 0.5 * (a.xyz[i][c] as f64 + b.xyz[i][c] as f64);
@@ -427,7 +445,7 @@ fn the_spectrum_seen_through_the_magnifier_lies_where_heron_trace_sends_each_ban
         o.settings.spectral_bins = 47;
         o.settings.wavelengths = heron::settings::WavelengthSampler::Uniform;
     });
-    let film = state.film();
+    let film = state.film.image();
     let renderer = heron::render::Renderer::new(&scene).unwrap();
     let accel = renderer.accel();
     let (bins, data) = film.spectral.as_ref().unwrap();

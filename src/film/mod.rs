@@ -6,7 +6,10 @@
 //! Lanes with pdf 0 (terminated wavelengths) add nothing.
 pub mod exr;
 pub mod fixed;
+pub mod planes;
 pub mod png;
+pub mod state;
+pub mod tile;
 
 use crate::spectrum::cie::cie1931;
 use crate::spectrum::color::{xyz_to_linear_srgb, XYZ_TO_SRGB};
@@ -318,7 +321,7 @@ pub struct Film {
     pub xyz: Vec<[f32; 3]>,
     pub spectral: Option<(SpectralBins, Vec<f32>)>,
     /// Per pixel, the estimated variance of the pixel's value in linear sRGB (R, G, B):
-    /// of the mean, not of one sample (`Checkpoint::film` says how it is estimated).
+    /// of the mean, not of one sample (`state.rs` says how it is estimated).
     /// Infinite where a pixel has fewer than two finite samples.
     pub variance: Option<Vec<[f32; 3]>>,
     /// Polarised renders: per pixel, the Stokes components S1, S2, S3 as CIE XYZ (signed;

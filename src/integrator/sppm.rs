@@ -61,6 +61,7 @@ use super::{Context, TraceCounters};
 use crate::bsdf::{BsdfContext, LobeFlags, Material, TransportMode};
 use crate::camera::CameraRay;
 use crate::film::fixed::{to_fixed, to_fixed3, AtomicFixed, LIMIT};
+use crate::film::state::IntegratorPlane;
 use crate::film::{xyz_lane_weights, SpectralBins};
 use crate::geometry::SpawnPoint;
 use crate::light::SurfacePoint;
@@ -636,6 +637,26 @@ impl SppmPixels {
             n: vec![0.0; pixels],
             r2: vec![0.0; pixels],
         }
+    }
+
+    /// The name of the film's plane that keeps this state for a resume.
+    pub const PLANE: &'static str = "sppm";
+
+    /// The state as the film's integrator plane: every pixel's N, then every R².
+    pub fn into_plane(self) -> IntegratorPlane {
+        let mut values = self.n;
+        values.extend(self.r2);
+        IntegratorPlane {
+            name: Self::PLANE.into(),
+            values,
+        }
+    }
+
+    /// The state [`SppmPixels::into_plane`] kept (2 values per pixel: the resume checked).
+    pub fn from_plane(plane: IntegratorPlane) -> SppmPixels {
+        let mut n = plane.values;
+        let r2 = n.split_off(n.len() / 2);
+        SppmPixels { n, r2 }
     }
 }
 
