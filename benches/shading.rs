@@ -41,7 +41,7 @@ fn shading(c: &mut Criterion) {
             let mut o = RenderOptions::from_scene(&scene);
             o.settings.spp = 1;
             o.threads = 1;
-            o.settings.lanes = lanes;
+            o.settings.lanes = heron::settings::Lanes::from_count(lanes as i64).unwrap();
             let id = match o.settings.integrator {
                 heron::settings::IntegratorKind::Whitted => format!("{name}/lanes{lanes}"),
                 k => format!("{name}/{}/lanes{lanes}", k.name()),

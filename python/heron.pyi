@@ -161,7 +161,7 @@ class RenderResult:
     """Image height in pixels."""
 
 def load_scene(path: _Path) -> Scene:
-    """Reads and validates a heron scene file (TOML), as ``heron render SCENE`` does."""
+    """Reads and validates a scene file (heron's TOML, or a Mitsuba 3 .xml or pbrt-v4 .pbrt scene converted as ``heron convert`` does), as ``heron render SCENE`` does."""
 
 class TraceEvent(TypedDict):
     kind: Literal["reflect", "refract", "total-internal-reflection", "absorb", "escape"]

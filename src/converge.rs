@@ -29,7 +29,7 @@ use crate::files::Staged;
 use crate::film::Film;
 use crate::render::{RenderOptions, Renderer};
 use crate::scene::Scene;
-use crate::settings::IntegratorKind;
+use crate::settings::{IntegratorKind, Lanes};
 use crate::{HeronError, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -174,7 +174,7 @@ pub struct Plan {
     pub reference_spp: u32,
     /// The reference's integrator; None: the runs'.
     pub reference_integrator: Option<IntegratorKind>,
-    pub lanes: Vec<usize>,
+    pub lanes: Vec<Lanes>,
     pub spps: Vec<u32>,
     pub roi: Option<Roi>,
     /// A folder to write one heat map per setting into ([`heat_map_path`]).
@@ -213,7 +213,7 @@ pub fn converge(scene: &Scene, base: &RenderOptions, plan: &Plan) -> Result<Conv
     let mut o = base.clone();
     o.progress = None;
     o.settings.spp = plan.reference_spp;
-    o.settings.lanes = 8;
+    o.settings.lanes = Lanes::Eight;
     o.settings.seed = base.settings.seed.wrapping_add(1);
     o.settings.sampler = crate::settings::SamplerKind::Independent;
     if let Some(k) = plan.reference_integrator {
@@ -254,7 +254,7 @@ pub fn converge(scene: &Scene, base: &RenderOptions, plan: &Plan) -> Result<Conv
             let e = errors(&x, &r, all.clone());
             let e_roi = plan.roi.map(|q| errors(&x, &r, q.pixels(w)));
             rows.push(ConvergeRow {
-                lanes: l,
+                lanes: l.count(),
                 spp,
                 wall_s: wall,
                 ns_per_sample: wall * 1e9 / stats.samples as f64,
@@ -265,7 +265,7 @@ pub fn converge(scene: &Scene, base: &RenderOptions, plan: &Plan) -> Result<Conv
                 roi_rel_mse: e_roi.map(|e| e.rel_mse),
             });
             if let Some(dir) = &plan.heat_maps {
-                let path = heat_map_path(dir, base.settings.integrator, l, spp);
+                let path = heat_map_path(dir, base.settings.integrator, l.count(), spp);
                 maps.push((path, heat_map(&x, &r, w, h, plan.roi)));
             }
         }

@@ -31,6 +31,7 @@ pub mod provenance;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod session;
 pub mod settings;
 pub mod sky;
 pub mod spectrum;

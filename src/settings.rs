@@ -452,8 +452,8 @@ pub struct RenderSettings {
     pub light_sampler: LightSamplerKind,
     /// How rays leave surfaces ([`OffsetMode`]).
     pub offset: OffsetMode,
-    /// Wavelength lanes per path: 1, 4 or 8.
-    pub lanes: usize,
+    /// Wavelength lanes per path.
+    pub lanes: Lanes,
     /// How rays go to Embree.
     pub packets: Packets,
     /// How hero wavelengths are drawn.
@@ -498,7 +498,7 @@ impl Default for RenderSettings {
             offset: OffsetMode::Auto,
             // The defaults with the lowest RMSE·√t over the course scenes, the Cornell
             // box and a rainbow (scripts/bench_defaults.py, BENCHMARKS.md "Defaults").
-            lanes: 8,
+            lanes: Lanes::Eight,
             packets: Packets::Auto,
             wavelengths: WavelengthSampler::Visible,
             spectral_bins: 0,
@@ -510,6 +510,54 @@ impl Default for RenderSettings {
             polarization: false,
             polarizer: None,
         }
+    }
+}
+
+/// Wavelengths carried per path, each count its own monomorphised kernel. The one
+/// place a lane count is checked: the CLI's `--lanes`, `heron converge --lanes`, the
+/// Python module's `lanes=` and [`RenderSettings::apply`] all parse through
+/// [`Lanes::from_count`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Lanes {
+    One,
+    Four,
+    Eight,
+}
+
+impl Lanes {
+    pub const ALL: [Lanes; 3] = [Lanes::One, Lanes::Four, Lanes::Eight];
+
+    /// The number of wavelengths.
+    pub fn count(self) -> usize {
+        match self {
+            Lanes::One => 1,
+            Lanes::Four => 4,
+            Lanes::Eight => 8,
+        }
+    }
+
+    /// The lane count `n`, or what was expected.
+    pub fn from_count(n: i64) -> Result<Lanes, String> {
+        match n {
+            1 => Ok(Lanes::One),
+            4 => Ok(Lanes::Four),
+            8 => Ok(Lanes::Eight),
+            n => Err(format!("expected 1, 4 or 8, got {n}")),
+        }
+    }
+
+    /// A lane count written as text (a flag's value).
+    pub fn parse(s: &str) -> Result<Lanes, String> {
+        match s.trim().parse::<i64>() {
+            Ok(n) => Lanes::from_count(n),
+            Err(_) => Err(format!("expected 1, 4 or 8, got {s}")),
+        }
+    }
+}
+
+impl std::fmt::Display for Lanes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.count())
     }
 }
 
@@ -564,10 +612,7 @@ impl RenderSettings {
                 .map_err(|_| format!("--spp: expected at most {}, got {v}", u32::MAX))?;
         }
         if let Some(v) = a.lanes {
-            s.lanes = match v {
-                1 | 4 | 8 => v as usize,
-                n => return Err(format!("--lanes: expected 1, 4 or 8, got {n}")),
-            };
+            s.lanes = Lanes::from_count(v).map_err(|e| format!("--lanes: {e}"))?;
         }
         if let Some(w) = a.wavelengths {
             s.wavelengths = match w {
@@ -666,7 +711,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             (s.spp, s.lanes, s.integrator, s.max_depth, s.packets),
-            (3, 4, IntegratorKind::Bdpt, 2, Packets::Off)
+            (3, Lanes::Four, IntegratorKind::Bdpt, 2, Packets::Off)
         );
         assert_eq!(s.wavelengths, WavelengthSampler::Uniform);
         assert!(!s.offset.is_epsilon(s.integrator));

@@ -23,8 +23,9 @@
 //! fifth decimal of a degree; refined, a trace is the same on every x86 CPU, so the
 //! figures of papers/ regenerate byte for byte wherever they are made.
 use crate::accel::embree::{self, RayQuery};
-use crate::bsdf::{BsdfContext, LobeFlags};
-use crate::geometry::Ray;
+use crate::bsdf::{BsdfContext, LobeFlags, Material};
+use crate::geometry::{Interaction, Ray};
+use crate::math::Frame;
 use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
 use crate::{HeronError, Result};
@@ -162,31 +163,19 @@ pub fn trace(
     reflect_at: &[bool],
     stokes: Option<[f64; 4]>,
 ) -> Result<TraceReport> {
-    if !origin.is_finite() || !dir.is_finite() || dir.length_squared() == 0.0 {
-        return Err(HeronError::Invalid(
-            "--origin and --dir: expected finite vectors, --dir not zero".into(),
-        ));
-    }
-    if !(crate::spectrum::LAMBDA_MIN..=crate::spectrum::LAMBDA_MAX).contains(&lambda_nm) {
-        return Err(HeronError::Invalid(format!(
-            "--lambda: expected a wavelength in 360–830 nm, got {lambda_nm}"
-        )));
-    }
+    check_request(origin, dir, lambda_nm, stokes)?;
     // Offsets as a render of the scene's own integrator would make them.
     let offset = scene.settings.ray_offset(scene.settings.integrator);
-    if let Some(st) = stokes {
-        let pol = (st[1] * st[1] + st[2] * st[2] + st[3] * st[3]).sqrt();
-        if !st.iter().all(|v| v.is_finite()) || !(st[0] > 0.0) || pol > st[0] * (1.0 + 1e-9) {
-            return Err(HeronError::Invalid(format!(
-                "--stokes: expected S0,S1,S2,S3 with S0 > 0 and S1² + S2² + S3² ≤ S0² (a physical state), got {st:?}"
-            )));
-        }
-    }
     let mut ray = Ray::new(origin, dir.normalize(), 0.0, f32::INFINITY);
     // The light's state and its frame's x̂ (⊥ the ray), when asked.
     let mut pol = stokes.map(|st| (st, crate::spectrum::stokes::any_perpendicular(ray.dir)));
     let mut events = Vec::new();
     let mut dielectric_events = 0usize;
+    let report = |events, truncated| TraceReport {
+        lambda_nm,
+        events,
+        truncated,
+    };
     for _ in 0..=scene.settings.max_depth {
         let q = RayQuery {
             origin: ray.origin,
@@ -197,134 +186,208 @@ pub fn trace(
         let Some(hit) = accel.intersect1(&q) else {
             events.push(TraceEvent {
                 kind: EventKind::Escape,
-                position: arr(ray.origin),
-                normal: None,
-                material: None,
-                n_i: None,
-                n_t: None,
-                incoming: arr(ray.dir),
                 outgoing: Some(arr(ray.dir)),
-                fresnel_r: None,
-                distance: None,
                 stokes: pol.map(|p| p.0),
                 stokes_x: pol.map(|p| arr(p.1)),
+                ..TraceEvent::at(ray.origin, ray.dir)
             });
-            return Ok(TraceReport {
-                lambda_nm,
-                events,
-                truncated: false,
-            });
+            return Ok(report(events, false));
         };
         let hit = refine(scene, &ray, &hit);
         let (it, material) = scene.interaction(&ray, &hit, offset.is_robust());
-        let wo = -ray.dir;
         let mut ev = TraceEvent {
             kind: EventKind::Absorb,
-            position: arr(it.position),
             normal: Some(arr(it.normal)),
             material: Some(scene.material_names[it.material as usize].clone()),
             n_i: Some(1.0),
             n_t: Some(1.0),
-            incoming: arr(ray.dir),
-            outgoing: None,
-            fresnel_r: None,
             distance: Some(hit.t),
-            stokes: None,
-            stokes_x: None,
+            ..TraceEvent::at(it.position, ray.dir)
         };
-        let flags = material.flags();
-        let frame = it.frame();
-        let wo_local = frame.to_local(wo);
-        let wl = SampledWavelengths::<1>::new([lambda_nm], [1.0]);
-        let spec = |side: LobeFlags| {
-            let ctx = BsdfContext::radiance::<1>().with_lobes(LobeFlags::SPECULAR | side);
-            material
-                .sample(wo_local, 0.5, Vec2::ZERO, &wl, &ctx)
-                .map(|b| frame.to_world(b.wi))
-        };
-        let two_sided_delta =
-            flags.contains(LobeFlags::SPECULAR | LobeFlags::REFLECTION | LobeFlags::TRANSMISSION);
-        let out = if two_sided_delta {
-            if let Some(d) = material.interface() {
-                let (ni, nt) = d.indices(lambda_nm, it.front_face);
-                ev.n_i = Some(ni);
-                ev.n_t = Some(nt);
-                ev.fresnel_r = Some(d.fresnel_r(wo_local, lambda_nm));
-            }
-            let want_reflect = reflect_at.get(dielectric_events).copied().unwrap_or(false);
-            dielectric_events += 1;
-            match spec(LobeFlags::TRANSMISSION) {
-                None => {
-                    ev.kind = EventKind::TotalInternalReflection;
-                    spec(LobeFlags::REFLECTION)
-                }
-                Some(_) if want_reflect => {
-                    ev.kind = EventKind::Reflect;
-                    // The lecture's pure refraction gives reflection no weight outside
-                    // total internal reflection; the law of reflection still says where
-                    // an R event goes.
-                    spec(LobeFlags::REFLECTION).or(Some(crate::bsdf::reflect(wo, it.normal)))
-                }
-                Some(t) => {
-                    ev.kind = EventKind::Refract;
-                    Some(t)
-                }
-            }
-        } else if flags.contains(LobeFlags::SPECULAR | LobeFlags::REFLECTION) {
-            ev.kind = EventKind::Reflect;
-            spec(LobeFlags::REFLECTION)
-        } else {
-            None
-        };
+        let surface = Surface::new(material, &it, -ray.dir, lambda_nm);
+        let reflect = reflect_at.get(dielectric_events).copied().unwrap_or(false);
+        let (out, dielectric) = surface.scatter(&mut ev, reflect);
+        dielectric_events += usize::from(dielectric);
         ev.outgoing = out.map(arr);
-        if let (Some((st, x)), Some(d)) = (pol, out) {
-            // The material's ωi is where the light comes from (−ray), ωo where it goes.
-            let fraction = match ev.kind {
-                EventKind::Refract => 1.0 - ev.fresnel_r.unwrap_or(0.0) as f64,
-                EventKind::TotalInternalReflection => 1.0,
-                _ => ev.fresnel_r.map_or_else(
-                    || {
-                        let ctx = BsdfContext::radiance::<1>()
-                            .with_lobes(LobeFlags::SPECULAR | LobeFlags::REFLECTION);
-                        material
-                            .sample(wo_local, 0.5, Vec2::ZERO, &wl, &ctx)
-                            .map_or(0.0, |b| b.weight().0[0] as f64)
-                    },
-                    |r| r as f64,
-                ),
-            };
-            let (m, x_in, x_out) =
-                match material.mueller(frame.to_local(d), wo_local, flags, &wl, &frame) {
-                    crate::bsdf::Polarizing::Mueller { m, x_in, x_out } => {
-                        (m[0], frame.to_world(x_in), frame.to_world(x_out))
-                    }
-                    crate::bsdf::Polarizing::Depolarizing => (
-                        glam::Mat4::from_diagonal(glam::Vec4::new(1.0, 0.0, 0.0, 0.0)),
-                        x,
-                        crate::spectrum::stokes::any_perpendicular(d),
-                    ),
-                };
-            let r = crate::spectrum::stokes::rotate_basis(ray.dir, x, x_in);
-            let v = glam::Vec4::new(st[0] as f32, st[1] as f32, st[2] as f32, st[3] as f32);
-            let out_st = (m * (r * v)) * fraction as f32;
-            let after = out_st.to_array().map(f64::from);
-            ev.stokes = Some(after);
-            ev.stokes_x = Some(arr(x_out));
-            pol = Some((after, x_out));
+        if let (Some(light), Some(d)) = (pol, out) {
+            let after = surface.polarize(&ev, ray.dir, light, d);
+            ev.stokes = Some(after.0);
+            ev.stokes_x = Some(arr(after.1));
+            pol = Some(after);
         }
         events.push(ev);
         let Some(d) = out else {
-            return Ok(TraceReport {
-                lambda_nm,
-                events,
-                truncated: false,
-            });
+            return Ok(report(events, false));
         };
         ray = offset.spawn(&it.spawn_point(), d);
     }
-    Ok(TraceReport {
-        lambda_nm,
-        events,
-        truncated: true,
-    })
+    Ok(report(events, true))
+}
+
+/// The ray, the wavelength and the Stokes vector as asked, or what was expected.
+fn check_request(origin: Vec3, dir: Vec3, lambda_nm: f32, stokes: Option<[f64; 4]>) -> Result<()> {
+    if !origin.is_finite() || !dir.is_finite() || dir.length_squared() == 0.0 {
+        return Err(HeronError::Invalid(
+            "--origin and --dir: expected finite vectors, --dir not zero".into(),
+        ));
+    }
+    if !(crate::spectrum::LAMBDA_MIN..=crate::spectrum::LAMBDA_MAX).contains(&lambda_nm) {
+        return Err(HeronError::Invalid(format!(
+            "--lambda: expected a wavelength in 360–830 nm, got {lambda_nm}"
+        )));
+    }
+    if let Some(st) = stokes {
+        let pol = (st[1] * st[1] + st[2] * st[2] + st[3] * st[3]).sqrt();
+        if !st.iter().all(|v| v.is_finite()) || !(st[0] > 0.0) || pol > st[0] * (1.0 + 1e-9) {
+            return Err(HeronError::Invalid(format!(
+                "--stokes: expected S0,S1,S2,S3 with S0 > 0 and S1² + S2² + S3² ≤ S0² (a physical state), got {st:?}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+impl TraceEvent {
+    /// An event at `position` of a ray along `incoming`, its other fields empty.
+    fn at(position: Vec3, incoming: Vec3) -> TraceEvent {
+        TraceEvent {
+            kind: EventKind::Absorb,
+            position: arr(position),
+            normal: None,
+            material: None,
+            n_i: None,
+            n_t: None,
+            incoming: arr(incoming),
+            outgoing: None,
+            fresnel_r: None,
+            distance: None,
+            stokes: None,
+            stokes_x: None,
+        }
+    }
+}
+
+/// A hit's material in its local frame, at the traced wavelength.
+struct Surface<'a> {
+    material: &'a Material,
+    frame: Frame,
+    /// Toward where the ray came from: world and local.
+    wo: Vec3,
+    wo_local: Vec3,
+    normal: Vec3,
+    front_face: bool,
+    lambda_nm: f32,
+    wl: SampledWavelengths<1>,
+}
+
+impl<'a> Surface<'a> {
+    fn new(material: &'a Material, it: &Interaction, wo: Vec3, lambda_nm: f32) -> Self {
+        let frame = it.frame();
+        Surface {
+            material,
+            frame,
+            wo,
+            wo_local: frame.to_local(wo),
+            normal: it.normal,
+            front_face: it.front_face,
+            lambda_nm,
+            wl: SampledWavelengths::<1>::new([lambda_nm], [1.0]),
+        }
+    }
+
+    /// The material's delta lobe on `side` (reflection or transmission), in world space.
+    fn specular(&self, side: LobeFlags) -> Option<Vec3> {
+        let ctx = BsdfContext::radiance::<1>().with_lobes(LobeFlags::SPECULAR | side);
+        self.material
+            .sample(self.wo_local, 0.5, Vec2::ZERO, &self.wl, &ctx)
+            .map(|b| self.frame.to_world(b.wi))
+    }
+
+    /// Where the ray goes on (`None`: absorbed), with the event's kind, indices and
+    /// Fresnel reflectance written into `ev`; `reflect` is the path string's choice at a
+    /// dielectric event. The second value says whether this was a dielectric event (one
+    /// with a reflecting and a transmitting delta lobe), which uses up a choice.
+    fn scatter(&self, ev: &mut TraceEvent, reflect: bool) -> (Option<Vec3>, bool) {
+        let flags = self.material.flags();
+        let two_sided_delta =
+            flags.contains(LobeFlags::SPECULAR | LobeFlags::REFLECTION | LobeFlags::TRANSMISSION);
+        if !two_sided_delta {
+            if flags.contains(LobeFlags::SPECULAR | LobeFlags::REFLECTION) {
+                ev.kind = EventKind::Reflect;
+                return (self.specular(LobeFlags::REFLECTION), false);
+            }
+            return (None, false);
+        }
+        if let Some(d) = self.material.interface() {
+            let (ni, nt) = d.indices(self.lambda_nm, self.front_face);
+            ev.n_i = Some(ni);
+            ev.n_t = Some(nt);
+            ev.fresnel_r = Some(d.fresnel_r(self.wo_local, self.lambda_nm));
+        }
+        let out = match self.specular(LobeFlags::TRANSMISSION) {
+            None => {
+                ev.kind = EventKind::TotalInternalReflection;
+                self.specular(LobeFlags::REFLECTION)
+            }
+            Some(_) if reflect => {
+                ev.kind = EventKind::Reflect;
+                // The lecture's pure refraction gives reflection no weight outside total
+                // internal reflection; the law of reflection still says where an R event
+                // goes.
+                self.specular(LobeFlags::REFLECTION)
+                    .or(Some(crate::bsdf::reflect(self.wo, self.normal)))
+            }
+            Some(t) => {
+                ev.kind = EventKind::Refract;
+                Some(t)
+            }
+        };
+        (out, true)
+    }
+
+    /// The light's Stokes vector and frame x̂ after the event `ev` that sends the ray
+    /// arriving along `incoming` on along `d`, from `(stokes, x)` before it.
+    fn polarize(
+        &self,
+        ev: &TraceEvent,
+        incoming: Vec3,
+        (st, x): ([f64; 4], Vec3),
+        d: Vec3,
+    ) -> ([f64; 4], Vec3) {
+        let flags = self.material.flags();
+        // The material's ωi is where the light comes from (−ray), ωo where it goes.
+        let fraction = match ev.kind {
+            EventKind::Refract => 1.0 - ev.fresnel_r.unwrap_or(0.0) as f64,
+            EventKind::TotalInternalReflection => 1.0,
+            _ => ev.fresnel_r.map_or_else(
+                || {
+                    let ctx = BsdfContext::radiance::<1>()
+                        .with_lobes(LobeFlags::SPECULAR | LobeFlags::REFLECTION);
+                    self.material
+                        .sample(self.wo_local, 0.5, Vec2::ZERO, &self.wl, &ctx)
+                        .map_or(0.0, |b| b.weight().0[0] as f64)
+                },
+                |r| r as f64,
+            ),
+        };
+        let frame = &self.frame;
+        let (m, x_in, x_out) =
+            match self
+                .material
+                .mueller(frame.to_local(d), self.wo_local, flags, &self.wl, frame)
+            {
+                crate::bsdf::Polarizing::Mueller { m, x_in, x_out } => {
+                    (m[0], frame.to_world(x_in), frame.to_world(x_out))
+                }
+                crate::bsdf::Polarizing::Depolarizing => (
+                    glam::Mat4::from_diagonal(glam::Vec4::new(1.0, 0.0, 0.0, 0.0)),
+                    x,
+                    crate::spectrum::stokes::any_perpendicular(d),
+                ),
+            };
+        let r = crate::spectrum::stokes::rotate_basis(incoming, x, x_in);
+        let v = glam::Vec4::new(st[0] as f32, st[1] as f32, st[2] as f32, st[3] as f32);
+        let out_st = (m * (r * v)) * fraction as f32;
+        (out_st.to_array().map(f64::from), x_out)
+    }
 }

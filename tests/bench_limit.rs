@@ -4,18 +4,14 @@
 //! heron's wrapper find exactly what the render found (hits, primitive IDs, distances,
 //! occlusions), and bad logs get one-line errors naming the file. Nothing here is timed;
 //! the figures are in BENCHMARKS.md.
+mod common;
+
+use common::cli::heron;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use heron::bench::limit::RayLogFile;
 use heron::render::{RenderOptions, Renderer};
-
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
 
 /// Spheres, a plane (two triangles), a triangle and a glass sphere under a point light:
 /// camera packets, shadow rays, and (under `path`) single closest-hit rays.

@@ -3,15 +3,10 @@
 //! count, primitive IDs and distances), the table has a row per ray set and width, and
 //! bad flags get one-line errors. Nothing here is timed; the figures are in
 //! BENCHMARKS.md.
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
+use common::cli::heron;
+use std::path::PathBuf;
 
 fn small_mesh(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("heron-bench-{}-{name}.obj", std::process::id()));

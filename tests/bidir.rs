@@ -359,7 +359,7 @@ fn newton() -> (Scene, Film) {
         // 128 spp at 256²: 8.4M light paths, about 180k per 10 nm bin after the prism
         // ends the companions, so each bin's flux has a standard error near 0.25%.
         o.settings.spp = 128;
-        o.settings.lanes = 4;
+        o.settings.lanes = heron::settings::Lanes::Four;
         o.settings.spectral_bins = 47;
         o.settings.seed = 5;
     });

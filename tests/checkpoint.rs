@@ -4,24 +4,11 @@
 //! valid image of the samples so far and exits with 130; `--time-limit` stops at a pass
 //! boundary with status 0; a checkpoint of other settings, a corrupt one and bad numbers
 //! are one-line errors. Nothing here is timed: the tests wait for files to appear.
+mod common;
+
+use common::cli::{heron, heron_command, scene_path};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-
-fn heron() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-}
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn run(args: &[&str]) -> Output {
-    heron().args(args).output().expect("run heron")
-}
+use std::process::{Child, Command, Stdio};
 
 fn render_args<'a>(scene: &'a str, out: &'a str, spp: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut a = vec![
@@ -34,7 +21,7 @@ fn render_args<'a>(scene: &'a str, out: &'a str, spp: &'a str, extra: &[&'a str]
 /// Starts a render and waits until its first checkpoint exists (the render is then
 /// mid-way: the checkpoint is written only at pass boundaries before the last pass).
 fn start_until_checkpoint(args: &[&str], checkpoint: &Path) -> Child {
-    let mut child = heron()
+    let mut child = heron_command()
         .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -58,7 +45,7 @@ fn start_until_checkpoint(args: &[&str], checkpoint: &Path) -> Child {
 }
 
 fn info_spp(exr: &Path) -> u32 {
-    let o = run(&["info", exr.to_str().unwrap()]);
+    let o = heron(&["info", exr.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8(o.stdout).unwrap();
     text.lines()
@@ -72,8 +59,8 @@ fn killed_and_resumed_equals_uninterrupted(scene_name: &str, spp: &str, extra: &
     let d = tempfile::tempdir().unwrap();
     let p = |n: &str| -> PathBuf { d.path().join(n) };
     let (full, resumed, ck) = (p("full.exr"), p("resumed.exr"), p("render.ckpt"));
-    let sc = scene(scene_name);
-    let o = run(&render_args(&sc, full.to_str().unwrap(), spp, extra));
+    let sc = scene_path(scene_name);
+    let o = heron(&render_args(&sc, full.to_str().unwrap(), spp, extra));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
     let mut args = render_args(&sc, resumed.to_str().unwrap(), spp, extra);
@@ -90,7 +77,7 @@ fn killed_and_resumed_equals_uninterrupted(scene_name: &str, spp: &str, extra: &
 
     let mut args = render_args(&sc, resumed.to_str().unwrap(), spp, extra);
     args.extend_from_slice(&["--resume", ck.to_str().unwrap()]);
-    let o = run(&args);
+    let o = heron(&args);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     let from: u32 = err
@@ -135,7 +122,7 @@ fn sigint_writes_what_it_has_and_exits_130() {
         d.path().join("i.ckpt"),
         d.path().join("f.exr"),
     );
-    let sc = scene("default.toml");
+    let sc = scene_path("default.toml");
     // 64 spp at 512² is 4 passes; the signal arrives after the first.
     let mut args = render_args(&sc, out.to_str().unwrap(), "64", &[]);
     args.extend_from_slice(&[
@@ -162,12 +149,12 @@ fn sigint_writes_what_it_has_and_exits_130() {
         "{err}"
     );
     // The checkpoint written at the stop continues the same render.
-    let o = run(&render_args(&sc, full.to_str().unwrap(), "64", &[]));
+    let o = heron(&render_args(&sc, full.to_str().unwrap(), "64", &[]));
     assert!(o.status.success());
     let resumed = d.path().join("r.exr");
     let mut args = render_args(&sc, resumed.to_str().unwrap(), "64", &[]);
     args.extend_from_slice(&["--resume", ck.to_str().unwrap()]);
-    assert!(run(&args).status.success());
+    assert!(heron(&args).status.success());
     assert!(std::fs::read(&full).unwrap() == std::fs::read(&resumed).unwrap());
 }
 
@@ -175,8 +162,8 @@ fn sigint_writes_what_it_has_and_exits_130() {
 fn a_time_limit_stops_at_a_pass_boundary() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("t.exr");
-    let sc = scene("default.toml");
-    let o = run(&render_args(
+    let sc = scene_path("default.toml");
+    let o = heron(&render_args(
         &sc,
         out.to_str().unwrap(),
         "64",
@@ -196,13 +183,13 @@ fn a_time_limit_stops_at_a_pass_boundary() {
 fn bad_checkpoints_and_numbers_are_one_line_errors() {
     let d = tempfile::tempdir().unwrap();
     let (out, ck) = (d.path().join("o.exr"), d.path().join("c.ckpt"));
-    let sc = scene("default.toml");
+    let sc = scene_path("default.toml");
     // A checkpoint of a 32-spp render cannot continue a 48-spp one.
     let mut args = render_args(&sc, out.to_str().unwrap(), "32", &["--time-limit", "0"]);
     args.extend_from_slice(&["--checkpoint", ck.to_str().unwrap()]);
-    assert!(run(&args).status.success());
+    assert!(heron(&args).status.success());
     assert!(ck.exists());
-    let o = run(&render_args(
+    let o = heron(&render_args(
         &sc,
         out.to_str().unwrap(),
         "48",
@@ -215,7 +202,7 @@ fn bad_checkpoints_and_numbers_are_one_line_errors() {
         "{err}"
     );
     // Nor can a checkpoint without the variance's squares continue a render with it.
-    let o = run(&render_args(
+    let o = heron(&render_args(
         &sc,
         out.to_str().unwrap(),
         "32",
@@ -232,7 +219,7 @@ fn bad_checkpoints_and_numbers_are_one_line_errors() {
     let bad = d.path().join("bad.ckpt");
     for content in [&bytes[..bytes.len() / 2], b"hello".as_slice()] {
         std::fs::write(&bad, content).unwrap();
-        let o = run(&render_args(
+        let o = heron(&render_args(
             &sc,
             out.to_str().unwrap(),
             "16",
@@ -255,7 +242,7 @@ fn bad_checkpoints_and_numbers_are_one_line_errors() {
         if arg.starts_with("--checkpoint-every") {
             extra.extend_from_slice(&["--checkpoint", ck.to_str().unwrap()]);
         }
-        let o = run(&render_args(&sc, out.to_str().unwrap(), "4", &extra));
+        let o = heron(&render_args(&sc, out.to_str().unwrap(), "4", &extra));
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{err}");
         let flag = arg.split('=').next().unwrap();

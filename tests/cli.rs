@@ -1,22 +1,11 @@
 //! The `heron` binary: bad input gets a one-line error naming the file, key and
 //! expectation, a non-zero exit and no output file; good input gives byte-identical
 //! EXR files whatever the thread count.
+mod common;
+
+use common::cli::{heron, repo};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
-
-fn repo(p: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(p)
-        .display()
-        .to_string()
-}
+use std::process::Output;
 
 const SMALL: &str = r#"
 background = [0.1, 0.3, 0.6]

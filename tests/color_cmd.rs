@@ -3,15 +3,10 @@
 //! gets a one-line error naming the file (and line) and what was expected, exit status 1
 //! (2 for a bad command-line value, clap's usage error) and no panic; good input prints
 //! the JSON whose numbers follow from heron's tables (spectra/README.md).
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
+use common::cli::heron;
+use std::path::{Path, PathBuf};
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let p: PathBuf = dir.join(name);

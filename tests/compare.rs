@@ -6,17 +6,12 @@
 //! the file; the heat map is written atomically. And the statistics: over many pure
 //! noise comparisons the family-wise false-positive rate is α, as the correction
 //! promises.
+mod common;
+
+use common::cli::heron;
 use heron::compare::{compare, Correction, Image, Options};
 use heron::math::rng::Rng;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

@@ -4,22 +4,9 @@
 //! own error, estimated from its two halves, is what a second render at its samples
 //! measures against it. (The measures' values on synthetic images are unit tests in
 //! src/compare.rs and src/converge.rs.)
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
-
-fn repo(p: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(p)
-        .display()
-        .to_string()
-}
+use common::cli::{heron, repo};
 
 /// The CSV's header and rows, and its comment lines.
 fn table(stdout: &[u8]) -> (Vec<String>, Vec<Vec<f64>>, Vec<String>) {

@@ -328,9 +328,9 @@ fn ending_secondary_wavelengths_is_unbiased() {
     s.camera = Camera::new(Vec3::new(0.0, 0.5, -3.0), Vec3::ZERO, Vec3::Y, 1.2, 48, 48).unwrap();
     let mut o = RenderOptions::from_scene(&s);
     o.settings.spp = 64;
-    o.settings.lanes = 1;
+    o.settings.lanes = heron::settings::Lanes::One;
     let (one, _) = render(&s, &o).unwrap();
-    o.settings.lanes = 4;
+    o.settings.lanes = heron::settings::Lanes::Four;
     let (four, _) = render(&s, &o).unwrap();
     for c in 0..3 {
         let d: Vec<f64> = one

@@ -3,35 +3,20 @@
 //! `heron display` re-encodes an EXR into the very PNG the render wrote and maps CSV rows
 //! of XYZ; bad flags and files are one-line errors; `--preview-every` rewrites the PNG
 //! during a render without changing the final outputs. Nothing here is timed.
+mod common;
+
+use common::cli::{heron, heron_ok};
 use heron::render::{render, render_state, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::Scene;
 use heron::spectrum::display::{DisplayMode, DisplayTransform};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
-}
-
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
-
-fn ok(args: &[&str]) -> Output {
-    let o = heron(args);
-    assert!(
-        o.status.success(),
-        "heron {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
 }
 
 /// A one-line error (status 1) containing `needle`.
@@ -267,7 +252,7 @@ fn small_render(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
         "--quiet",
     ];
     args.extend_from_slice(extra);
-    ok(&args);
+    heron_ok(&args);
     out
 }
 
@@ -299,7 +284,7 @@ fn heron_display_of_the_exr_is_the_png_the_render_wrote() {
             out.to_str().unwrap(),
         ];
         a.extend_from_slice(&args);
-        ok(&a);
+        heron_ok(&a);
         assert!(
             bytes(&out) == bytes(&p(want)),
             "heron display {args:?} differs from the render's {want}"
@@ -342,7 +327,7 @@ fn in_gamut_images_encode_to_the_same_bytes_under_hue_and_clip() {
     let sc = d.path().join("red.toml");
     std::fs::write(&sc, text).unwrap();
     let exr = d.path().join("a.exr");
-    ok(&[
+    heron_ok(&[
         "render",
         sc.to_str().unwrap(),
         "-o",
@@ -355,7 +340,7 @@ fn in_gamut_images_encode_to_the_same_bytes_under_hue_and_clip() {
     assert!(rgb.iter().flatten().all(|v| (0.0..=1.0).contains(v)));
     assert!(rgb.iter().all(|c| c[0] > 2.0 * c[1]), "not the red quad");
     let clip = d.path().join("clip.png");
-    ok(&[
+    heron_ok(&[
         "display",
         exr.to_str().unwrap(),
         "-o",
@@ -380,7 +365,7 @@ fn heron_display_maps_xyz_rows_of_a_csv() {
         "# comment\ntheta,X,Y,Z\n1,0.95047,1,1.08883\n2,0.2,0.21,0.23\n3,0.0267,0.3,0.0331\n4,9.5,10,10.9\n",
     )
     .unwrap();
-    let out = ok(&["display", csv.to_str().unwrap()]);
+    let out = heron_ok(&["display", csv.to_str().unwrap()]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("sR,sG,sB"));
@@ -424,7 +409,7 @@ fn heron_display_maps_xyz_rows_of_a_csv() {
     assert!((clipped - want).abs() > 5.0, "{clipped} vs {want}");
     // To a file, atomically; the same text.
     let to = d.path().join("out.csv");
-    ok(&["display", csv.to_str().unwrap(), "-o", to.to_str().unwrap()]);
+    heron_ok(&["display", csv.to_str().unwrap(), "-o", to.to_str().unwrap()]);
     assert_eq!(std::fs::read_to_string(&to).unwrap(), text);
 }
 
@@ -510,7 +495,7 @@ fn the_preview_hook_sees_every_pass_and_leaves_the_film_unchanged() {
     let scene = load_scene_from_str(&text, &scenes().join("default.toml")).unwrap();
     let mut o = RenderOptions::from_scene(&scene);
     o.settings.spp = 2048;
-    o.settings.lanes = 1;
+    o.settings.lanes = heron::settings::Lanes::One;
     let (plain, _) = render_state(&scene, &o).unwrap();
     let calls = Arc::new(AtomicU32::new(0));
     let seen = Arc::new(Mutex::new(Vec::new()));
@@ -561,10 +546,10 @@ fn preview_every_leaves_the_final_exr_and_png_unchanged() {
     let sc = scenes().join("default.toml");
     let sc = sc.to_str().unwrap();
     let (a, b) = (d.path().join("a.exr"), d.path().join("b.exr"));
-    ok(&default_scene_args(sc, a.to_str().unwrap(), "32"));
+    heron_ok(&default_scene_args(sc, a.to_str().unwrap(), "32"));
     let mut args = default_scene_args(sc, b.to_str().unwrap(), "32");
     args.extend_from_slice(&["--preview-every", "1e-9"]);
-    ok(&args);
+    heron_ok(&args);
     for ext in ["exr", "png"] {
         assert!(
             std::fs::read(a.with_extension(ext)).unwrap()

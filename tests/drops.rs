@@ -2,6 +2,9 @@
 //! narrow log-normal is the monodisperse sky, a broad one washes out the supernumeraries,
 //! the quadrature has converged at the default node count, and the CLI and scene tables
 //! take distributions with one-line errors.
+mod common;
+
+use common::cli::heron_words;
 use heron::drops::{DropSizeDistribution, DEFAULT_NODES};
 use heron::sky::{AirySky, MieSky};
 
@@ -196,17 +199,10 @@ fn every_distribution_gives_a_primary_bow_near_descartes() {
     }
 }
 
-fn heron(args: &str) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args.split_whitespace())
-        .output()
-        .unwrap()
-}
-
 #[test]
 fn sky_profile_takes_a_distribution_and_debye_terms() {
     let base = "sky profile --lambda 550 --from 40 --to 42 --step 0.5";
-    let out = heron(&format!(
+    let out = heron_words(&format!(
         "{base} --model airy --k 1 --distribution lognormal --median-mm 0.5 --sigma 0.1"
     ));
     assert!(
@@ -222,7 +218,7 @@ fn sky_profile_takes_a_distribution_and_debye_terms() {
         let w = want.profile(t.to_radians(), 550.0) as f64;
         assert!((v - w).abs() <= 1e-6 * w, "θ {t}: {v} vs {w}");
     }
-    let out = heron(&format!(
+    let out = heron_words(&format!(
         "{base} --model mie --droplet-radius 0.05 --debye 2"
     ));
     assert!(
@@ -274,7 +270,7 @@ fn sky_profile_takes_a_distribution_and_debye_terms() {
         ),
         ("--model mie --droplet-radius 0.5 --debye 99", "--debye:"),
     ] {
-        let out = heron(&format!("{base} {args}"));
+        let out = heron_words(&format!("{base} {args}"));
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args}: {err}");
         assert!(out.stdout.is_empty(), "{args}");

@@ -24,7 +24,7 @@ fn image(s: &Scene, kind: IntegratorKind, kernel: KernelChoice) -> (Vec<u32>, Ke
     o.settings.integrator = kind;
     o.settings.kernel = kernel;
     o.settings.spp = 3;
-    o.settings.lanes = 4;
+    o.settings.lanes = heron::settings::Lanes::Four;
     o.threads = 2;
     // The specialised kernels are the unpolarised ones: a polarised scene (brewster,
     // polarized-*) is rendered unpolarised here; polarised renders have their own two

@@ -1,15 +1,10 @@
 //! `heron sky lee` (src/sky/lee.rs): the colour sums, the bow's hue order, the fogbow's
 //! whiteness, determinism across thread counts, and one-line errors.
+mod common;
+
+use common::cli::heron_words_threads;
 use heron::sky::MieSky;
 use heron::spectrum::cie;
-
-fn heron(args: &str, threads: &str) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args.split_whitespace())
-        .env("RAYON_NUM_THREADS", threads)
-        .output()
-        .unwrap()
-}
 
 /// Rows (radius, θ, X, Y, Z) of a `heron sky lee` CSV.
 fn rows(text: &str) -> Vec<[f64; 5]> {
@@ -29,9 +24,9 @@ fn rows(text: &str) -> Vec<[f64; 5]> {
 fn lee_colours_are_the_mie_profiles_under_d65() {
     // Two radii, λ every 50 nm (380…780: 9 wavelengths), a few angles: seconds.
     let args = "sky lee --radius-from 0.01 --radius-to 1 --radii 2 --from 40 --to 42.5 --step 0.5 --lambda-step 50";
-    let a = heron(args, "1");
+    let a = heron_words_threads(args, 1);
     assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
-    let b = heron(args, "2");
+    let b = heron_words_threads(args, 2);
     assert_eq!(a.stdout, b.stdout, "output depends on the thread count");
     let r = rows(&String::from_utf8(a.stdout).unwrap());
     assert_eq!(r.len(), 2 * 6);
@@ -71,10 +66,7 @@ fn xy(c: &[f64; 5]) -> (f64, f64) {
 
 #[test]
 fn large_drops_give_a_red_outer_edge_and_fog_drops_a_white_bow() {
-    let out = heron(
-        "sky lee --radius-from 0.01 --radius-to 1 --radii 2 --from 38 --to 43 --step 0.1 --lambda-step 10",
-        "2",
-    );
+    let out = heron_words_threads("sky lee --radius-from 0.01 --radius-to 1 --radii 2 --from 38 --to 43 --step 0.1 --lambda-step 10", 2);
     assert!(
         out.status.success(),
         "{}",
@@ -124,7 +116,7 @@ fn lee_rejects_bad_values_in_one_line_without_writing() {
         ("--step 0", "--step"),
         ("--sun-radius 9", "--sun-radius"),
     ] {
-        let out = heron(&format!("sky lee {args} -o {}", path.display()), "1");
+        let out = heron_words_threads(&format!("sky lee {args} -o {}", path.display()), 1);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args}: {err}");
         assert!(

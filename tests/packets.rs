@@ -34,7 +34,7 @@ fn image(s: &Scene, kind: IntegratorKind, packets: Packets, threads: usize) -> I
     o.settings.integrator = kind;
     o.settings.packets = packets;
     o.settings.spp = 4;
-    o.settings.lanes = 8;
+    o.settings.lanes = heron::settings::Lanes::Eight;
     o.threads = threads;
     // Packets of paths carry scalar throughputs: polarised scenes are compared
     // unpolarised (a polarised render runs camera packets only, `render.rs`).

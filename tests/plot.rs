@@ -4,25 +4,12 @@
 //! its own colour, where [`heron::plot::Frame`] (computed from the axes, not by
 //! plotters) says they are. A chart with linear instead of log axes, a line in the
 //! wrong colour, a missing series or a guide of the wrong slope fails these checks.
+mod common;
+
+use common::cli::{heron, repo};
 use heron::converge::ConvergeRow;
 use heron::plot::{self, converge, sky, Frame, Picture, GUIDE, PALETTE, SIZE};
 use heron::sky::profile::{profile, ProfileRequest};
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
-
-fn repo(p: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(p)
-        .display()
-        .to_string()
-}
 
 fn pixel(p: &Picture, x: i64, y: i64) -> Option<[u8; 3]> {
     if x < 0 || y < 0 || x >= p.width as i64 || y >= p.height as i64 {

@@ -4,15 +4,11 @@
 //! identical runs, so the files stay byte-identical; bad input to `heron info` is a
 //! one-line error. The hashes are checked against coreutils' `sha256sum`, an
 //! implementation independent of heron's.
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
+use common::cli::heron;
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
 fn sha256sum(p: &Path) -> String {
     let out = Command::new("sha256sum")

@@ -38,7 +38,7 @@ struct Setting {
 fn run(scene: &Scene, s: &Setting, sampler: SamplerKind, seed: u64) -> Film {
     render_with(scene, |o| {
         o.settings.integrator = s.integrator;
-        o.settings.lanes = s.lanes;
+        o.settings.lanes = heron::settings::Lanes::from_count(s.lanes as i64).unwrap();
         o.settings.wavelengths = s.wavelengths;
         o.settings.spp = s.spp;
         o.settings.sampler = sampler;

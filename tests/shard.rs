@@ -6,25 +6,10 @@
 //! exact as the sums). Merging refuses a missing, repeated, foreign, incomplete or
 //! differently split part, or parts with and without `--variance`, with a one-line
 //! message naming it.
+mod common;
+
+use common::cli::{heron, heron_ok, scene_path};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn heron(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .expect("run heron")
-}
-
-fn ok(args: &[&str]) {
-    let o = heron(args);
-    assert!(
-        o.status.success(),
-        "heron {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
 
 /// The one-line error of a failing command.
 fn fails(args: &[&str]) -> String {
@@ -33,14 +18,6 @@ fn fails(args: &[&str]) -> String {
     assert_eq!(o.status.code(), Some(1), "heron {}: {err}", args.join(" "));
     assert_eq!(err.lines().count(), 1, "{err}");
     err
-}
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
 }
 
 fn s(p: &Path) -> &str {
@@ -54,7 +31,7 @@ fn merged_equals_whole(dir: &Path, scene: &str, settings: &[&str], n: u32, order
     let whole = dir.join(format!("whole-{n}.exr"));
     let mut a = vec!["render", scene, "-o", s(&whole), "--quiet"];
     a.extend_from_slice(settings);
-    ok(&a);
+    heron_ok(&a);
     let parts: Vec<PathBuf> = (0..n)
         .map(|k| dir.join(format!("part-{k}-of-{n}.heronfilm")))
         .collect();
@@ -63,12 +40,12 @@ fn merged_equals_whole(dir: &Path, scene: &str, settings: &[&str], n: u32, order
         let mut a = vec!["render", scene, "-o", s(&parts[k as usize]), "--quiet"];
         a.extend_from_slice(&["--shard", &shard, "--threads", &threads]);
         a.extend_from_slice(settings);
-        ok(&a);
+        heron_ok(&a);
     }
     let merged = dir.join(format!("merged-{n}.exr"));
     let mut a = vec!["merge", "-o", s(&merged)];
     a.extend(order.iter().map(|&k| s(&parts[k as usize])));
-    ok(&a);
+    heron_ok(&a);
     for ext in ["exr", "png"] {
         let (x, y) = (whole.with_extension(ext), merged.with_extension(ext));
         assert!(
@@ -81,7 +58,7 @@ fn merged_equals_whole(dir: &Path, scene: &str, settings: &[&str], n: u32, order
 #[test]
 fn whitted_shards_merge_to_the_bytes_of_one_render() {
     let d = tempfile::tempdir().unwrap();
-    let sc = scene("default.toml");
+    let sc = scene_path("default.toml");
     let set = ["--spp", "6", "--xyz", "--spectral-bins", "7"];
     merged_equals_whole(d.path(), &sc, &set, 1, &[0]);
     merged_equals_whole(d.path(), &sc, &set, 2, &[1, 0]);
@@ -98,7 +75,7 @@ fn whitted_shards_merge_to_the_bytes_of_one_render() {
 #[test]
 fn physically_based_shards_merge_to_the_bytes_of_one_render() {
     let d = tempfile::tempdir().unwrap();
-    let sc = scene("cornell-box.toml");
+    let sc = scene_path("cornell-box.toml");
     for (integrator, variance) in [
         ("path", false),
         ("lighttrace", false),
@@ -139,10 +116,10 @@ fn polarised_shards_merge_to_the_bytes_of_one_render() {
         "4",
         "--xyz",
     ];
-    merged_equals_whole(d.path(), &scene("brewster.toml"), &set, 3, &[1, 2, 0]);
+    merged_equals_whole(d.path(), &scene_path("brewster.toml"), &set, 3, &[1, 2, 0]);
     let mut w = set.to_vec();
     w.extend_from_slice(&["--integrator", "whitted", "--polarizer", "30"]);
-    merged_equals_whole(d.path(), &scene("brewster.toml"), &w, 2, &[1, 0]);
+    merged_equals_whole(d.path(), &scene_path("brewster.toml"), &w, 2, &[1, 0]);
     for which in ["dolp", "aolp"] {
         let (x, y) = (
             d.path().join(format!("whole-2.{which}.png")),
@@ -182,14 +159,14 @@ polarization = { axis = [1.0, 0.0, 0.0], linear = 0.8, circular = 0.3 }\n",
 fn a_stopped_shard_resumes_and_then_merges() {
     let d = tempfile::tempdir().unwrap();
     let p = |n: &str| d.path().join(n);
-    let sc = scene("cornell-box.toml");
+    let sc = scene_path("cornell-box.toml");
     // Splatting passes of 2²⁰ pixel samples: 16 spp per pass at 256², so 64 spp
     // split in two gives shards of 32 spp, two passes each.
     let set = ["--spp", "64", "--integrator", "lighttrace", "--quiet"];
     let whole = p("whole.exr");
     let mut a = vec!["render", &sc, "-o", s(&whole), "--no-png"];
     a.extend_from_slice(&set);
-    ok(&a);
+    heron_ok(&a);
     let (p0, p1) = (p("p0.heronfilm"), p("p1.heronfilm"));
     for (k, part) in [("0/2", &p0), ("1/2", &p1)] {
         let mut a = vec!["render", &sc, "-o", s(part), "--shard", k];
@@ -197,7 +174,7 @@ fn a_stopped_shard_resumes_and_then_merges() {
         if k == "1/2" {
             a.extend_from_slice(&["--time-limit", "0"]);
         }
-        ok(&a);
+        heron_ok(&a);
     }
     let merged = p("merged.exr");
     let err = fails(&["merge", s(&p0), s(&p1), "-o", s(&merged), "--no-png"]);
@@ -210,8 +187,8 @@ fn a_stopped_shard_resumes_and_then_merges() {
     let mut a = vec!["render", &sc, "-o", s(&p1), "--shard", "1/2"];
     a.extend_from_slice(&["--resume", s(&p1)]);
     a.extend_from_slice(&set);
-    ok(&a);
-    ok(&["merge", s(&p1), s(&p0), "-o", s(&merged), "--no-png"]);
+    heron_ok(&a);
+    heron_ok(&["merge", s(&p1), s(&p0), "-o", s(&merged), "--no-png"]);
     assert!(std::fs::read(&whole).unwrap() == std::fs::read(&merged).unwrap());
     // Resuming a film as another shard is refused.
     let mut a = vec!["render", &sc, "-o", s(&p1), "--shard", "0/2"];
@@ -228,12 +205,12 @@ fn a_stopped_shard_resumes_and_then_merges() {
 fn merge_names_the_missing_repeated_or_foreign_part() {
     let d = tempfile::tempdir().unwrap();
     let p = |n: &str| d.path().join(n);
-    let sc = scene("default.toml");
+    let sc = scene_path("default.toml");
     let render = |out: &Path, shard: &str, extra: &[&str]| {
         let mut a = vec!["render", &sc, "-o", s(out), "--quiet", "--spp", "3"];
         a.extend_from_slice(&["--shard", shard]);
         a.extend_from_slice(extra);
-        ok(&a);
+        heron_ok(&a);
     };
     let parts: Vec<PathBuf> = (0..3).map(|k| p(&format!("p{k}.heronfilm"))).collect();
     for (k, part) in parts.iter().enumerate() {

@@ -1,6 +1,9 @@
 //! Rainbow sky models (heron::sky): the Aristotelian bow of the seed, Descartes' geometric
 //! optics, Airy theory, Lorenz–Mie, the `heron sky profile` CLI, and a Monte Carlo check
 //! of the bows with heron's own tracer.
+mod common;
+
+use common::cli::heron;
 use glam::Vec3;
 use heron::bsdf::{Dielectric, Material};
 use heron::camera::Camera;
@@ -362,13 +365,6 @@ fn mie_small_sphere_is_rayleigh_like_and_symmetric() {
 }
 
 // ---------------------------------------------------------------- CLI
-
-fn heron(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_heron"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 #[test]
 fn sky_profile_cli_writes_csv() {

@@ -225,9 +225,11 @@ fn four_lanes_and_one_estimate_the_same_dispersive_image() {
         let films: Vec<Vec<f64>> = seeds
             .map(|s| {
                 regions(
-                    &sppm(&scene, 32, s, |o| o.settings.lanes = lanes)
-                        .film
-                        .image(),
+                    &sppm(&scene, 32, s, |o| {
+                        o.settings.lanes = heron::settings::Lanes::from_count(lanes as i64).unwrap()
+                    })
+                    .film
+                    .image(),
                 )
             })
             .collect();
@@ -441,7 +443,7 @@ fn the_spectrum_seen_through_the_magnifier_lies_where_heron_trace_sends_each_ban
     let mut scene = load_scene_from_str(&text, &path).unwrap();
     scene.camera = scene.camera.resized(192, 144).unwrap();
     let state = sppm(&scene, 188, 2, |o| {
-        o.settings.lanes = 1;
+        o.settings.lanes = heron::settings::Lanes::One;
         o.settings.spectral_bins = 47;
         o.settings.wavelengths = heron::settings::WavelengthSampler::Uniform;
     });

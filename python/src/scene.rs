@@ -2,6 +2,7 @@
 use crate::{err, guard, lib_err, panic_message};
 use heron_core::film::Film;
 use heron_core::render::{RenderOptions, RenderStats};
+use heron_core::session::Request;
 use heron_core::settings::SettingsArgs;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyArray4, PyArrayMethods};
 use pyo3::prelude::*;
@@ -12,7 +13,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
 use std::time::Duration;
 
-/// The CLI flags `RenderSettings::apply` names, and the arguments of `Scene.render`.
+/// The CLI flags `Request::session` names, and the arguments of `Scene.render`.
 const RENAMES: &[(&str, &str)] = &[
     ("--spp", "spp"),
     ("--seed", "seed"),
@@ -31,6 +32,7 @@ const RENAMES: &[(&str, &str)] = &[
     ("--sppm-radius", "sppm_radius"),
     ("--polarization", "polarization"),
     ("--polarizer", "polarizer"),
+    ("--variance", "variance"),
 ];
 
 /// How often the thread that called `render` wakes to let Python run its signal
@@ -47,7 +49,8 @@ pub struct Scene {
     pub(crate) inner: Arc<heron_core::scene::Scene>,
 }
 
-/// Reads and validates a heron scene file (TOML), as `heron render SCENE` does.
+/// Reads and validates a scene file, as `heron render SCENE` does: heron's TOML, or a
+/// Mitsuba 3 (.xml) or pbrt-v4 (.pbrt) scene converted as `heron convert` converts it.
 ///
 /// Relative paths in the file (meshes, tables) start at the file's folder. Raises
 /// HeronError with the loader's one-line message (naming the file, the key and what was
@@ -216,9 +219,8 @@ impl Scene {
                     "threads: expected 0 (one per core) or a number of threads, got {threads}"
                 )));
             }
-            let mut opts = RenderOptions::from_scene(&self.inner);
-            opts.settings
-                .apply(&SettingsArgs {
+            let request = Request {
+                settings: SettingsArgs {
                     spp,
                     seed,
                     lanes: Some(lanes),
@@ -238,16 +240,14 @@ impl Scene {
                     sppm_radius,
                     polarization,
                     polarizer,
-                })
-                .map_err(|e| lib_err(e, RENAMES))?;
-            opts.threads = threads as usize;
-            if variance && opts.settings.spp < 2 {
-                return Err(err(format!(
-                    "variance: needs at least 2 samples per pixel to estimate a variance, got {}",
-                    opts.settings.spp
-                )));
-            }
-            opts.variance = variance;
+                },
+                variance,
+                threads: threads as usize,
+            };
+            let opts = request
+                .session(&self.inner)
+                .map_err(|e| lib_err(e, RENAMES))?
+                .opts;
             let scene = self.inner.clone();
             let (film, stats, opts) = render_interruptible(py, scene, opts)?;
             RenderResult::new(py, &film, &stats, &opts)
@@ -458,7 +458,7 @@ impl RenderResult {
             mrays_per_s: stats.mrays_per_s(),
             kernel: heron_core::settings::flag_names(stats.kernel),
             integrator: opts.settings.integrator.name().to_string(),
-            lanes: opts.settings.lanes,
+            lanes: opts.settings.lanes.count(),
             sampler: opts.settings.sampler.name().to_string(),
             seed: opts.settings.seed,
             width: film.width,

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod cli;
 pub mod images;
 pub mod render;
 pub mod scenes;

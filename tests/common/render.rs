@@ -42,7 +42,7 @@ pub fn run_lanes(scene: &Scene, kind: IntegratorKind, spp: u32, seed: u64, lanes
         o.settings.integrator = kind;
         o.settings.spp = spp;
         o.settings.seed = seed;
-        o.settings.lanes = lanes;
+        o.settings.lanes = heron::settings::Lanes::from_count(lanes as i64).unwrap();
     })
 }
 

@@ -24,6 +24,7 @@
 //! calls [`set_flush_denormals`] once.
 #![allow(unsafe_code)]
 
+mod builder;
 mod device;
 pub mod record;
 mod scene;
@@ -34,8 +35,9 @@ pub use device::Device;
 /// The Embree major version heron's bindings were compiled for (build.rs sets
 /// `cfg(heron_embree4)` for 4); the library's own version must agree.
 pub const BINDINGS_MAJOR: u32 = if cfg!(heron_embree4) { 4 } else { 3 };
+pub use builder::SceneBuilder;
 pub use record::{QueryTally, RayLog};
-pub use scene::{Scene, SceneBuilder, StreamScratch};
+pub use scene::{Scene, StreamScratch};
 
 use glam::Vec3;
 

@@ -68,7 +68,27 @@ enum Encoding {
 
 /// The mesh of a PLY file as one group (named by `name`).
 pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, String> {
-    // The header is ASCII up to and including "end_header\n".
+    let (encoding, elements, body) = parse_header(bytes)?;
+    let mut reader = Reader {
+        bytes,
+        pos: body,
+        encoding,
+    };
+    let mut mesh = Mesh::default();
+    let mut seen_vertex = false;
+    for el in &elements {
+        mesh.read_element(&mut reader, el)?;
+        seen_vertex |= el.name == "vertex";
+        if el.name == "face" && !seen_vertex {
+            return Err("the face element comes before the vertex element".into());
+        }
+    }
+    Ok(vec![mesh.into_group(name)])
+}
+
+/// The header's encoding and elements, and where the body starts. The header is ASCII
+/// up to and including "end_header\n".
+fn parse_header(bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
     let end = find(bytes, b"end_header")
         .ok_or("expected a PLY header ending in end_header, found none")?;
     let mut body = end + "end_header".len();
@@ -87,101 +107,121 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, Strin
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
     for (i, line) in lines {
-        let n = i + 1;
-        let w: Vec<&str> = line.split_whitespace().collect();
-        match w.as_slice() {
-            [] | ["comment", ..] | ["obj_info", ..] => {}
-            ["format", f, _version] => {
-                encoding = Some(match *f {
-                    "ascii" => Encoding::Ascii,
-                    "binary_little_endian" => Encoding::Little,
-                    "binary_big_endian" => Encoding::Big,
-                    other => return Err(format!("line {n}: unknown PLY format {other:?}")),
-                })
-            }
-            ["element", name, count] => elements.push(Element {
+        header_line(i + 1, line, &mut encoding, &mut elements)?;
+    }
+    let encoding = encoding.ok_or("expected a format line in the PLY header")?;
+    Ok((encoding, elements, body))
+}
+
+/// One header line (number `n`) into the encoding or the elements.
+fn header_line(
+    n: usize,
+    line: &str,
+    encoding: &mut Option<Encoding>,
+    elements: &mut Vec<Element>,
+) -> Result<(), String> {
+    let w: Vec<&str> = line.split_whitespace().collect();
+    let (list, ty, name) = match w.as_slice() {
+        [] | ["comment", ..] | ["obj_info", ..] => return Ok(()),
+        ["format", f, _version] => {
+            *encoding = Some(match *f {
+                "ascii" => Encoding::Ascii,
+                "binary_little_endian" => Encoding::Little,
+                "binary_big_endian" => Encoding::Big,
+                other => return Err(format!("line {n}: unknown PLY format {other:?}")),
+            });
+            return Ok(());
+        }
+        ["element", name, count] => {
+            elements.push(Element {
                 name: name.to_string(),
                 count: count
                     .parse()
                     .map_err(|_| format!("line {n}: expected an element count, got {count:?}"))?,
                 props: Vec::new(),
-            }),
-            ["property", "list", ct, ty, name] => {
-                let (Some(ct), Some(ty)) = (Scalar::parse(ct), Scalar::parse(ty)) else {
-                    return Err(format!("line {n}: unknown property types in {line:?}"));
-                };
-                let el = elements
-                    .last_mut()
-                    .ok_or(format!("line {n}: a property before any element"))?;
-                el.props.push(Property {
-                    name: name.to_string(),
-                    list: Some(ct),
-                    ty,
-                });
-            }
-            ["property", ty, name] => {
-                let ty =
-                    Scalar::parse(ty).ok_or(format!("line {n}: unknown property type {ty:?}"))?;
-                let el = elements
-                    .last_mut()
-                    .ok_or(format!("line {n}: a property before any element"))?;
-                el.props.push(Property {
-                    name: name.to_string(),
-                    list: None,
-                    ty,
-                });
-            }
-            _ => {
-                return Err(format!(
-                    "line {n}: expected a PLY header line, got {line:?}"
-                ))
-            }
+            });
+            return Ok(());
         }
-    }
-    let encoding = encoding.ok_or("expected a format line in the PLY header")?;
-    let mut reader = Reader {
-        bytes,
-        pos: body,
-        encoding,
+        ["property", "list", ct, ty, name] => {
+            let (Some(ct), Some(ty)) = (Scalar::parse(ct), Scalar::parse(ty)) else {
+                return Err(format!("line {n}: unknown property types in {line:?}"));
+            };
+            (Some(ct), ty, name)
+        }
+        ["property", ty, name] => {
+            let ty = Scalar::parse(ty).ok_or(format!("line {n}: unknown property type {ty:?}"))?;
+            (None, ty, name)
+        }
+        _ => {
+            return Err(format!(
+                "line {n}: expected a PLY header line, got {line:?}"
+            ))
+        }
     };
-    let mut positions: Vec<Vec3> = Vec::new();
-    let mut indices: Vec<[u32; 3]> = Vec::new();
-    // Texture coordinates per vertex, under the names Mitsuba 3's PLY reader accepts.
-    let mut vertex_uvs: Vec<glam::Vec2> = Vec::new();
-    let mut seen_vertex = false;
-    for el in &elements {
+    let el = elements
+        .last_mut()
+        .ok_or(format!("line {n}: a property before any element"))?;
+    el.props.push(Property {
+        name: name.to_string(),
+        list,
+        ty,
+    });
+    Ok(())
+}
+
+/// The mesh as it is read.
+#[derive(Default)]
+struct Mesh {
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    /// Texture coordinates per vertex, under the names Mitsuba 3's PLY reader accepts.
+    vertex_uvs: Vec<glam::Vec2>,
+}
+
+/// Where a vertex element keeps its position and texture coordinates, and a face element
+/// its vertex indices.
+struct Layout {
+    xyz: [Option<usize>; 3],
+    uv: Option<[usize; 2]>,
+    list: Option<usize>,
+}
+
+impl Layout {
+    fn of(el: &Element) -> Result<Layout, String> {
         let xyz = ["x", "y", "z"].map(|c| el.props.iter().position(|p| p.name == c));
-        let uv_props = [
+        let scalar = |name: &str| {
+            el.props
+                .iter()
+                .position(|p| p.name == name && p.list.is_none())
+        };
+        let uv = [
             ("u", "v"),
             ("texture_u", "texture_v"),
             ("s", "t"),
             ("texture_s", "texture_t"),
         ]
         .iter()
-        .find_map(|(a, b)| {
-            let i = el
-                .props
-                .iter()
-                .position(|p| p.name == *a && p.list.is_none())?;
-            let j = el
-                .props
-                .iter()
-                .position(|p| p.name == *b && p.list.is_none())?;
-            Some([i, j])
-        })
+        .find_map(|(a, b)| Some([scalar(a)?, scalar(b)?]))
         .filter(|_| el.name == "vertex");
         let list = el.props.iter().position(|p| {
             p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
         });
-        if el.name == "vertex" {
-            if xyz.iter().any(Option::is_none) {
-                return Err("the vertex element lacks one of the properties x, y, z".into());
-            }
-            seen_vertex = true;
-            positions.reserve(el.count.min(1 << 24));
+        if el.name == "vertex" && xyz.iter().any(Option::is_none) {
+            return Err("the vertex element lacks one of the properties x, y, z".into());
         }
         if el.name == "face" && list.is_none() {
             return Err("the face element lacks the list property vertex_indices".into());
+        }
+        Ok(Layout { xyz, uv, list })
+    }
+}
+
+impl Mesh {
+    /// Reads element `el`'s rows, keeping the vertices and the faces.
+    fn read_element(&mut self, reader: &mut Reader, el: &Element) -> Result<(), String> {
+        let layout = Layout::of(el)?;
+        if el.name == "vertex" {
+            self.positions.reserve(el.count.min(1 << 24));
         }
         let mut face = Vec::new();
         for k in 0..el.count {
@@ -189,97 +229,107 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<ObjGroup>, Strin
             let mut uv = [0.0f64; 2];
             for (j, prop) in el.props.iter().enumerate() {
                 let at = || format!("{} {k}, property {}", el.name, prop.name);
-                match prop.list {
-                    None => {
-                        let v = reader
+                let Some(ct) = prop.list else {
+                    let v = reader
+                        .scalar(prop.ty)
+                        .map_err(|e| format!("{}: {e}", at()))?;
+                    if el.name == "vertex" {
+                        if let Some(c) = layout.xyz.iter().position(|x| *x == Some(j)) {
+                            p[c] = v;
+                        }
+                        if let Some(c) = layout.uv.and_then(|t| t.iter().position(|x| *x == j)) {
+                            uv[c] = v;
+                        }
+                    }
+                    continue;
+                };
+                let count = reader.scalar(ct).map_err(|e| format!("{}: {e}", at()))?;
+                if !(0.0..=1e6).contains(&count) {
+                    return Err(format!("{}: expected a list length, got {count}", at()));
+                }
+                face.clear();
+                for _ in 0..count as usize {
+                    face.push(
+                        reader
                             .scalar(prop.ty)
-                            .map_err(|e| format!("{}: {e}", at()))?;
-                        if el.name == "vertex" {
-                            if let Some(c) = xyz.iter().position(|x| *x == Some(j)) {
-                                p[c] = v;
-                            }
-                            if let Some(c) = uv_props.and_then(|t| t.iter().position(|x| *x == j)) {
-                                uv[c] = v;
-                            }
-                        }
-                    }
-                    Some(ct) => {
-                        let count = reader.scalar(ct).map_err(|e| format!("{}: {e}", at()))?;
-                        if !(0.0..=1e6).contains(&count) {
-                            return Err(format!("{}: expected a list length, got {count}", at()));
-                        }
-                        face.clear();
-                        for _ in 0..count as usize {
-                            face.push(
-                                reader
-                                    .scalar(prop.ty)
-                                    .map_err(|e| format!("{}: {e}", at()))?,
-                            );
-                        }
-                        if el.name == "face" && Some(j) == list {
-                            if face.len() < 3 {
-                                return Err(format!(
-                                    "{}: expected a polygon of at least 3 vertices, got {}",
-                                    at(),
-                                    face.len()
-                                ));
-                            }
-                            let idx = |v: f64| -> Result<u32, String> {
-                                if v >= 0.0 && v.fract() == 0.0 && (v as usize) < positions.len() {
-                                    Ok(v as u32)
-                                } else {
-                                    Err(format!(
-                                        "{}: expected vertex indices below the {} vertices read, got {v}",
-                                        at(),
-                                        positions.len()
-                                    ))
-                                }
-                            };
-                            let a = idx(face[0])?;
-                            for w in face[1..].windows(2) {
-                                indices.push([a, idx(w[0])?, idx(w[1])?]);
-                            }
-                        }
-                    }
+                            .map_err(|e| format!("{}: {e}", at()))?,
+                    );
+                }
+                if el.name == "face" && Some(j) == layout.list {
+                    self.add_polygon(&face, &at())?;
                 }
             }
             if el.name == "vertex" {
-                let v = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
-                if !v.is_finite() {
-                    return Err(format!(
-                        "vertex {k}: expected finite coordinates in f32, got {p:?}"
-                    ));
-                }
-                positions.push(v);
-                if uv_props.is_some() {
-                    let t = glam::Vec2::new(uv[0] as f32, uv[1] as f32);
-                    if !t.is_finite() {
-                        return Err(format!(
-                            "vertex {k}: expected finite texture coordinates in f32, got {uv:?}"
-                        ));
-                    }
-                    vertex_uvs.push(t);
-                }
+                self.add_vertex(k, p, layout.uv.map(|_| uv))?;
             }
         }
-        if el.name == "face" && !seen_vertex {
-            return Err("the face element comes before the vertex element".into());
+        Ok(())
+    }
+
+    /// A polygon of vertex indices (as read), split into a fan of triangles.
+    fn add_polygon(&mut self, face: &[f64], at: &str) -> Result<(), String> {
+        if face.len() < 3 {
+            return Err(format!(
+                "{at}: expected a polygon of at least 3 vertices, got {}",
+                face.len()
+            ));
+        }
+        let read = self.positions.len();
+        let idx = |v: f64| -> Result<u32, String> {
+            if v >= 0.0 && v.fract() == 0.0 && (v as usize) < read {
+                Ok(v as u32)
+            } else {
+                Err(format!(
+                    "{at}: expected vertex indices below the {read} vertices read, got {v}"
+                ))
+            }
+        };
+        let a = idx(face[0])?;
+        for w in face[1..].windows(2) {
+            self.indices.push([a, idx(w[0])?, idx(w[1])?]);
+        }
+        Ok(())
+    }
+
+    /// Vertex `k`'s position and, if the element has them, its texture coordinates.
+    fn add_vertex(&mut self, k: usize, p: [f64; 3], uv: Option<[f64; 2]>) -> Result<(), String> {
+        let v = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+        if !v.is_finite() {
+            return Err(format!(
+                "vertex {k}: expected finite coordinates in f32, got {p:?}"
+            ));
+        }
+        self.positions.push(v);
+        if let Some(uv) = uv {
+            let t = glam::Vec2::new(uv[0] as f32, uv[1] as f32);
+            if !t.is_finite() {
+                return Err(format!(
+                    "vertex {k}: expected finite texture coordinates in f32, got {uv:?}"
+                ));
+            }
+            self.vertex_uvs.push(t);
+        }
+        Ok(())
+    }
+
+    /// The mesh as one group, with per-corner texture coordinates when every vertex
+    /// has them.
+    fn into_group(self, name: &str) -> ObjGroup {
+        let uvs = if self.vertex_uvs.len() == self.positions.len() && !self.vertex_uvs.is_empty() {
+            self.indices
+                .iter()
+                .map(|t| t.map(|i| self.vertex_uvs[i as usize]))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        ObjGroup {
+            name: name.to_string(),
+            positions: self.positions,
+            indices: self.indices,
+            uvs,
         }
     }
-    let uvs = if vertex_uvs.len() == positions.len() && !vertex_uvs.is_empty() {
-        indices
-            .iter()
-            .map(|t| t.map(|i| vertex_uvs[i as usize]))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    Ok(vec![ObjGroup {
-        name: name.to_string(),
-        positions,
-        indices,
-        uvs,
-    }])
 }
 
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {

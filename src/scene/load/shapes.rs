@@ -520,41 +520,12 @@ pub(crate) fn shapes_of_groups(
 ) -> Result<Vec<Shape>> {
     let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
     let transform = mesh_transform(at, &m.transform).map_err(|msg| scene_error(scene_path, msg))?;
-
-    for g in m.groups.keys() {
-        if !groups.iter().any(|x| &x.name == g) {
-            let mut names: Vec<&str> = groups
-                .iter()
-                .filter(|x| !x.indices.is_empty())
-                .map(|x| x.name.as_str())
-                .collect();
-            names.dedup();
-            let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(g.clone())]);
-            return Err(scene_error(
-                mesh_path,
-                format!(
-                    "{at}.{gk}: no object or group named {g:?} in the mesh (it has: {})",
-                    names.join(", ")
-                ),
-            ));
-        }
-    }
-
-    let scale = m.scale.map_or(1.0, |s| s.0);
-    let translate = m.translate.map_or(Vec3::ZERO, |t| t.0);
-
-    // Gather the triangles per material, in the order the materials first appear.
-    struct Part {
-        material: u32,
-        positions: Vec<Vec3>,
-        indices: Vec<[u32; 3]>,
-        /// Vertex index by position: OBJ groups come with their own vertex arrays, so
-        /// vertices are shared within a shape by their (exact) coordinates.
-        remap: HashMap<[u32; 3], u32>,
-        /// Texture coordinates per kept triangle, while every group has them.
-        uvs: Vec<[Vec2; 3]>,
-        textured: bool,
-    }
+    check_group_names(&groups, mesh_path, at, m)?;
+    let placement = Placement {
+        scale: m.scale.map_or(1.0, |s| s.0),
+        translate: m.translate.map_or(Vec3::ZERO, |t| t.0),
+        transform,
+    };
     // Mitsuba 3's readers: an OBJ's v is flipped (its images start at the bottom row,
     // heron's uv at the top), a PLY's is not (`flip_tex_coords`, src/shapes/obj.cpp and
     // ply.cpp).
@@ -562,6 +533,7 @@ pub(crate) fn shapes_of_groups(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
     let flip = m.flip_tex_coords.unwrap_or(!is_ply);
+    // The triangles per material, in the order the materials first appear.
     let mut parts: Vec<Part> = Vec::new();
     let mut any_triangle = false;
     for g in &groups {
@@ -583,64 +555,29 @@ pub(crate) fn shapes_of_groups(
         let part = match parts.iter().position(|p| p.material == material) {
             Some(k) => &mut parts[k],
             None => {
-                parts.push(Part {
-                    material,
-                    positions: Vec::new(),
-                    indices: Vec::new(),
-                    remap: HashMap::new(),
-                    uvs: Vec::new(),
-                    textured: true,
-                });
+                parts.push(Part::new(material));
                 parts.last_mut().expect("just pushed")
             }
         };
         part.textured &= !g.uvs.is_empty();
         for (k, tri) in g.indices.iter().enumerate() {
-            let mut p = tri.map(|i| g.positions[i as usize] * scale + translate);
-            if let Some(t) = &transform {
-                p = p.map(|v| t.transform_point3(v.as_dvec3()).as_vec3());
-            }
-            if p.iter().any(|x| !x.is_finite()) {
-                return Err(merr(format!(
-                    "a vertex of object {:?} is not finite after scale {} and translate {}",
-                    g.name,
-                    fmt_f32(scale),
-                    fmt_points(&[translate])
-                )));
-            }
-            if cross_overflows(p[0], p[1], p[2]) {
-                return Err(merr(format!(
-                    "a triangle of object {:?} is too large for f32 after scale {} and translate {}: expected its edges' cross product to be finite (coordinates within about ±1e19), got {}",
-                    g.name,
-                    fmt_f32(scale),
-                    fmt_points(&[translate]),
-                    fmt_points(&p)
-                )));
-            }
+            let p = placement
+                .place(&g.name, tri.map(|i| g.positions[i as usize]))
+                .map_err(merr)?;
             // Zero-area triangles are never hit; they are dropped.
             if is_degenerate(p[0], p[1], p[2]) {
                 continue;
             }
             any_triangle = true;
-            let mut out = [0u32; 3];
-            for (o, v) in out.iter_mut().zip(p) {
-                let next = part.positions.len() as u32;
-                // + 0.0 turns −0 into +0, so the two zeros share a vertex.
-                let bits = (v + Vec3::ZERO).to_array().map(f32::to_bits);
-                *o = *part.remap.entry(bits).or_insert_with(|| {
-                    part.positions.push(v);
-                    next
-                });
-            }
-            part.indices.push(out);
-            if part.textured {
+            let uv = part.textured.then(|| {
                 let t = g.uvs[k];
-                part.uvs.push(if flip {
+                if flip {
                     t.map(|c| Vec2::new(c.x, 1.0 - c.y))
                 } else {
                     t
-                });
-            }
+                }
+            });
+            part.push(p, uv);
         }
     }
     if !any_triangle {
@@ -651,16 +588,126 @@ pub(crate) fn shapes_of_groups(
     Ok(parts
         .into_iter()
         .filter(|p| !p.indices.is_empty())
-        .map(|p| {
-            let uvs = if p.textured { p.uvs } else { Vec::new() };
-            Shape::new(
-                ShapeKind::Mesh(Mesh {
-                    positions: p.positions,
-                    indices: p.indices,
-                    uvs,
-                }),
-                p.material,
-            )
-        })
+        .map(Part::into_shape)
         .collect())
+}
+
+/// Every group `m.groups` names is in the mesh.
+fn check_group_names(
+    groups: &[obj::ObjGroup],
+    mesh_path: &Path,
+    at: &str,
+    m: &MeshFile,
+) -> Result<()> {
+    for g in m.groups.keys() {
+        if !groups.iter().any(|x| &x.name == g) {
+            let mut names: Vec<&str> = groups
+                .iter()
+                .filter(|x| !x.indices.is_empty())
+                .map(|x| x.name.as_str())
+                .collect();
+            names.dedup();
+            let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(g.clone())]);
+            return Err(scene_error(
+                mesh_path,
+                format!(
+                    "{at}.{gk}: no object or group named {g:?} in the mesh (it has: {})",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Where a mesh entry puts its file's vertices: scaled, translated, then transformed.
+struct Placement {
+    scale: f32,
+    translate: Vec3,
+    transform: Option<DMat4>,
+}
+
+impl Placement {
+    /// A triangle of object `name` placed, or why it cannot be (not finite, or too large
+    /// for its edges' cross product in f32).
+    fn place(&self, name: &str, tri: [Vec3; 3]) -> std::result::Result<[Vec3; 3], String> {
+        let (scale, translate) = (self.scale, self.translate);
+        let mut p = tri.map(|v| v * scale + translate);
+        if let Some(t) = &self.transform {
+            p = p.map(|v| t.transform_point3(v.as_dvec3()).as_vec3());
+        }
+        if p.iter().any(|x| !x.is_finite()) {
+            return Err(format!(
+                "a vertex of object {name:?} is not finite after scale {} and translate {}",
+                fmt_f32(scale),
+                fmt_points(&[translate])
+            ));
+        }
+        if cross_overflows(p[0], p[1], p[2]) {
+            return Err(format!(
+                "a triangle of object {name:?} is too large for f32 after scale {} and translate {}: expected its edges' cross product to be finite (coordinates within about ±1e19), got {}",
+                fmt_f32(scale),
+                fmt_points(&[translate]),
+                fmt_points(&p)
+            ));
+        }
+        Ok(p)
+    }
+}
+
+/// The triangles of one material of a mesh entry.
+struct Part {
+    material: u32,
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    /// Vertex index by position: OBJ groups come with their own vertex arrays, so
+    /// vertices are shared within a shape by their (exact) coordinates.
+    remap: HashMap<[u32; 3], u32>,
+    /// Texture coordinates per kept triangle, while every group has them.
+    uvs: Vec<[Vec2; 3]>,
+    textured: bool,
+}
+
+impl Part {
+    fn new(material: u32) -> Part {
+        Part {
+            material,
+            positions: Vec::new(),
+            indices: Vec::new(),
+            remap: HashMap::new(),
+            uvs: Vec::new(),
+            textured: true,
+        }
+    }
+
+    /// A placed triangle, its vertices shared with the part's by their coordinates.
+    fn push(&mut self, p: [Vec3; 3], uv: Option<[Vec2; 3]>) {
+        let mut out = [0u32; 3];
+        for (o, v) in out.iter_mut().zip(p) {
+            let next = self.positions.len() as u32;
+            // + 0.0 turns −0 into +0, so the two zeros share a vertex.
+            let bits = (v + Vec3::ZERO).to_array().map(f32::to_bits);
+            let positions = &mut self.positions;
+            *o = *self.remap.entry(bits).or_insert_with(|| {
+                positions.push(v);
+                next
+            });
+        }
+        self.indices.push(out);
+        if let Some(uv) = uv {
+            self.uvs.push(uv);
+        }
+    }
+
+    fn into_shape(self) -> Shape {
+        let uvs = if self.textured { self.uvs } else { Vec::new() };
+        Shape::new(
+            ShapeKind::Mesh(Mesh {
+                positions: self.positions,
+                indices: self.indices,
+                uvs,
+            }),
+            self.material,
+        )
+    }
 }

@@ -1,0 +1,345 @@
+//! The schema's leaf types: each is read as a raw TOML value and checked, so that its
+//! error message is ours ("expected …, got …") and sits at the key path of the value.
+use super::show::show;
+use super::*;
+
+/// A refractive index: a positive number (no dispersion), the name of a catalogue entry
+/// (spectra/ior_catalogue.toml), or one of `{ sellmeier = { b = [..], c = [..] } }`
+/// (λ in µm, C in µm²), `{ cauchy = [A, B] }` or `{ cauchy = [A, B, C] }` (λ in µm),
+/// `{ table = "file.csv" }` (rows `wavelength_nm,n`, relative to the scene file), or
+/// `{ n_d = .., v_d = .. }` (a glass known by its index and Abbe number:
+/// [`crate::spectrum::ior::Ior::abbe`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum IorSpec {
+    Constant(f32),
+    Named(String),
+    Sellmeier { b: Vec<f32>, c: Vec<f32> },
+    Cauchy([f32; 3]),
+    Table(String),
+    Abbe { n_d: f32, v_d: f32 },
+}
+
+/// `[x, y]`, two numbers finite in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point2(pub [f32; 2]);
+
+/// `[x, y, z]`, three numbers finite in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point3(pub Vec3);
+
+/// `[x, y, z]`, finite and not the zero vector (not normalised).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Direction3(pub Vec3);
+
+impl Direction3 {
+    /// The unit vector, computed without overflow or underflow for any finite non-zero
+    /// vector (scaled by its largest component first).
+    pub fn unit(&self) -> Vec3 {
+        (self.0 / self.0.abs().max_element()).normalize()
+    }
+}
+
+/// A number > 0, finite in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositiveNumber(pub f32);
+
+/// A number in [0, 1].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnitNumber(pub f32);
+
+/// An integer ≥ 1 that fits in u32.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PositiveCount(pub u32);
+
+/// `[width, height]`, each in 1..=[`MAX_RESOLUTION`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolution {
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A TOML number (integer or float) as f64.
+pub(super) fn number(v: &toml::Value) -> Option<f64> {
+    match *v {
+        toml::Value::Integer(i) => Some(i as f64),
+        toml::Value::Float(f) => Some(f),
+        _ => None,
+    }
+}
+
+/// A number that is finite in f32 (TOML allows nan and inf, and a finite f64 may
+/// overflow f32).
+pub(super) fn finite_f32(v: &toml::Value) -> Option<f32> {
+    number(v).map(|x| x as f32).filter(|x| x.is_finite())
+}
+
+pub(super) fn vec3(v: &toml::Value) -> Option<Vec3> {
+    match v {
+        toml::Value::Array(a) if a.len() == 3 => {
+            let x = finite_f32(&a[0])?;
+            let y = finite_f32(&a[1])?;
+            let z = finite_f32(&a[2])?;
+            Some(Vec3::new(x, y, z))
+        }
+        _ => None,
+    }
+}
+
+pub(super) fn raw<'de, D: Deserializer<'de>>(d: D) -> Result<toml::Value, D::Error> {
+    toml::Value::deserialize(d)
+}
+
+impl<'de> Deserialize<'de> for Point2 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let xy = match &v {
+            toml::Value::Array(a) if a.len() == 2 => {
+                finite_f32(&a[0]).and_then(|x| Some([x, finite_f32(&a[1])?]))
+            }
+            _ => None,
+        };
+        xy.map(Point2).ok_or_else(|| {
+            D::Error::custom(format!(
+                "expected [x, y] with two finite numbers, got {}",
+                show(&v)
+            ))
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for Point3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        vec3(&v).map(Point3).ok_or_else(|| {
+            D::Error::custom(format!(
+                "expected [x, y, z] with three finite numbers, got {}",
+                show(&v)
+            ))
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for Direction3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match vec3(&v) {
+            Some(p) if p.abs().max_element() > 0.0 => Ok(Direction3(p)),
+            _ => Err(D::Error::custom(format!(
+                "expected a non-zero vector [x, y, z] of finite numbers, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PositiveNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match finite_f32(&v) {
+            Some(x) if x > 0.0 => Ok(PositiveNumber(x)),
+            _ => Err(D::Error::custom(format!(
+                "expected a positive finite number, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+pub(super) fn finite_list(v: &toml::Value) -> Option<Vec<f32>> {
+    match v {
+        toml::Value::Array(a) => a.iter().map(finite_f32).collect(),
+        _ => None,
+    }
+}
+
+impl<'de> Deserialize<'de> for IorSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let names = || {
+            crate::spectrum::ior::catalogue()
+                .keys()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let expected = || {
+            format!(
+                "expected a positive number, a catalogue name ({}), {{ sellmeier = {{ b = [..], c = [..] }} }}, {{ cauchy = [A, B, C] }}, {{ n_d = .., v_d = .. }} or {{ table = \"file.csv\" }}, got {}",
+                names(),
+                show(&v)
+            )
+        };
+        match &v {
+            toml::Value::String(name) => {
+                if crate::spectrum::ior::named(name).is_some() {
+                    Ok(IorSpec::Named(name.clone()))
+                } else {
+                    Err(D::Error::custom(format!(
+                        "unknown refractive-index model {name:?}, expected one of {}",
+                        names()
+                    )))
+                }
+            }
+            toml::Value::Table(t) if t.contains_key("n_d") || t.contains_key("v_d") => {
+                let n_d = t.get("n_d").and_then(finite_f32);
+                let v_d = t.get("v_d").and_then(finite_f32);
+                match (n_d, v_d) {
+                    (Some(n_d), Some(v_d)) if t.len() == 2 && n_d >= 1.0 && v_d > 0.0 => {
+                        Ok(IorSpec::Abbe { n_d, v_d })
+                    }
+                    _ => Err(D::Error::custom(format!(
+                        "expected {{ n_d = .., v_d = .. }} with an index n_d ≥ 1 at 587.56 nm and an Abbe number v_d > 0, got {}",
+                        show(&v)
+                    ))),
+                }
+            }
+            toml::Value::Table(t) if t.len() == 1 => {
+                let (k, x) = t.iter().next().expect("one entry");
+                match (k.as_str(), x) {
+                    ("sellmeier", toml::Value::Table(sc)) => {
+                        let b = sc.get("b").and_then(finite_list);
+                        let c = sc.get("c").and_then(finite_list);
+                        match (b, c) {
+                            (Some(b), Some(c))
+                                if sc.len() == 2 && b.len() == c.len() && (1..=4).contains(&b.len()) =>
+                            {
+                                Ok(IorSpec::Sellmeier { b, c })
+                            }
+                            _ => Err(D::Error::custom(format!(
+                                "expected sellmeier = {{ b = [B1, ..], c = [C1, ..] }} with 1 to 4 finite coefficients each (C in µm²), got {}",
+                                show(x)
+                            ))),
+                        }
+                    }
+                    ("cauchy", x) => match finite_list(x) {
+                        Some(c) if (2..=3).contains(&c.len()) => Ok(IorSpec::Cauchy([
+                            c[0],
+                            c[1],
+                            c.get(2).copied().unwrap_or(0.0),
+                        ])),
+                        _ => Err(D::Error::custom(format!(
+                            "expected cauchy = [A, B] or [A, B, C] (λ in µm), got {}",
+                            show(x)
+                        ))),
+                    },
+                    ("table", toml::Value::String(f)) => Ok(IorSpec::Table(f.clone())),
+                    _ => Err(D::Error::custom(expected())),
+                }
+            }
+            _ => match (number(&v), finite_f32(&v)) {
+                (_, Some(x)) if x > 0.0 => Ok(IorSpec::Constant(x)),
+                (Some(_), _) => Err(D::Error::custom(format!(
+                    "expected a positive finite number, got {}",
+                    show(&v)
+                ))),
+                _ => Err(D::Error::custom(expected())),
+            },
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for NonNegativeNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match finite_f32(&v) {
+            Some(x) if x >= 0.0 => Ok(NonNegativeNumber(x)),
+            _ => Err(D::Error::custom(format!(
+                "expected a finite number >= 0, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for MetalSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use crate::spectrum::metals::METAL_NAMES;
+        let v = raw(d)?;
+        let expected = || {
+            format!(
+                "expected a metal of the catalogue ({}), {{ table = \"nk.csv\" }} or {{ n = .., k = .. }}, got {}",
+                METAL_NAMES.join(", "),
+                show(&v)
+            )
+        };
+        match &v {
+            toml::Value::String(name) => {
+                if METAL_NAMES.contains(&name.as_str()) {
+                    Ok(MetalSpec::Named(name.clone()))
+                } else {
+                    Err(D::Error::custom(format!(
+                        "unknown metal {name:?}, expected one of {}",
+                        METAL_NAMES.join(", ")
+                    )))
+                }
+            }
+            toml::Value::Table(t) => {
+                if let (1, Some(toml::Value::String(f))) = (t.len(), t.get("table")) {
+                    return Ok(MetalSpec::Table(f.clone()));
+                }
+                let n = t.get("n").and_then(finite_f32);
+                let k = t.get("k").and_then(finite_f32);
+                match (t.len(), n, k) {
+                    (2, Some(n), Some(k)) if n > 0.0 && k >= 0.0 => {
+                        Ok(MetalSpec::Constant { n, k })
+                    }
+                    (2, Some(_), Some(_)) => Err(D::Error::custom(format!(
+                        "expected n > 0 and k >= 0, got {}",
+                        show(&v)
+                    ))),
+                    _ => Err(D::Error::custom(expected())),
+                }
+            }
+            _ => Err(D::Error::custom(expected())),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for UnitNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match number(&v) {
+            Some(x) if (0.0..=1.0).contains(&x) => Ok(UnitNumber(x as f32)),
+            _ => Err(D::Error::custom(format!(
+                "expected a number in [0, 1], got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PositiveCount {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        match v {
+            toml::Value::Integer(i) if i >= 1 && i <= u32::MAX as i64 => {
+                Ok(PositiveCount(i as u32))
+            }
+            _ => Err(D::Error::custom(format!(
+                "expected a positive integer, got {}",
+                show(&v)
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Resolution {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = raw(d)?;
+        let ok = |x: &toml::Value| match *x {
+            toml::Value::Integer(i) if i >= 1 && i <= MAX_RESOLUTION as i64 => Some(i as u32),
+            _ => None,
+        };
+        if let toml::Value::Array(a) = &v {
+            if let [w, h] = a.as_slice() {
+                if let (Some(width), Some(height)) = (ok(w), ok(h)) {
+                    return Ok(Resolution { width, height });
+                }
+            }
+        }
+        Err(D::Error::custom(format!(
+            "expected [width, height] with positive integers (at most {MAX_RESOLUTION}), got {}",
+            show(&v)
+        )))
+    }
+}

@@ -1,0 +1,372 @@
+//! Mitsuba 3's BSDFs as heron's materials: `diffuse`, the dielectrics, the conductors,
+//! the plastics (mapped to heron's glossy material) and the wrappers (`twosided`,
+//! `mask`, `bumpmap`, `normalmap`), with the indices and roughnesses they name.
+use super::*;
+
+impl<'a> Converter<'a> {
+    /// The name of heron's material for BSDF element `n` (converted once).
+    pub(super) fn bsdf(&mut self, n: &'a Node) -> Result<String, Diagnostic> {
+        let n = self.resolve(n)?;
+        if n.tag != "bsdf" {
+            return Err(n.diag("expected a <bsdf>"));
+        }
+        if let Some(name) = self.material_of.get(&(n as *const Node)) {
+            return Ok(name.clone());
+        }
+        let table = self.bsdf_table(n)?;
+        let name = match table {
+            Some(t) => {
+                let base = n
+                    .attr("id")
+                    .map(str::to_string)
+                    .unwrap_or_else(|| format!("{}-{}", n.attr("type").unwrap_or("bsdf"), n.line));
+                let mut name = base.clone();
+                let mut k = 2;
+                while self.materials.contains_key(&name) {
+                    name = format!("{base}-{k}");
+                    k += 1;
+                }
+                self.materials.insert(name.clone(), Value::Table(t));
+                name
+            }
+            None => self.default_material(),
+        };
+        self.material_of.insert(n as *const Node, name.clone());
+        Ok(name)
+    }
+
+    /// Mitsuba's default BSDF (a diffuse reflectance of 0.5), made once.
+    pub(super) fn default_material(&mut self) -> String {
+        if let Some(m) = &self.default_material {
+            return m.clone();
+        }
+        let name = "mitsuba-default-diffuse".to_string();
+        self.materials.insert(
+            name.clone(),
+            Value::Table(table(vec![
+                ("type", Value::String("lambertian".into())),
+                ("rho_d", float(0.5)),
+            ])),
+        );
+        self.default_material = Some(name.clone());
+        name
+    }
+
+    /// heron's table for a BSDF, or None for Mitsuba's default (after a warning).
+    pub(super) fn bsdf_table(&mut self, n: &'a Node) -> Result<Option<Table>, Diagnostic> {
+        let kind = Self::plugin(n)?;
+        let p = Props::new(n);
+        let t = match kind {
+            "twosided" | "mask" | "bumpmap" | "normalmap" => return self.wrapper_bsdf(n, &p, kind),
+            "diffuse" => self.diffuse_table(&p)?,
+            "thindielectric" => {
+                self.warn(n.diag(
+                    "thindielectric (a sheet with no thickness) is not supported yet; Mitsuba's default BSDF is used",
+                ))?;
+                for k in [
+                    "int_ior",
+                    "ext_ior",
+                    "specular_reflectance",
+                    "specular_transmittance",
+                ] {
+                    p.get(k);
+                }
+                self.finish(&p)?;
+                return Ok(None);
+            }
+            "dielectric" | "roughdielectric" => self.dielectric_table(n, &p, kind)?,
+            "conductor" | "roughconductor" => self.conductor_table(n, &p, kind)?,
+            "plastic" | "roughplastic" => self.plastic_table(n, &p, kind)?,
+            other => {
+                self.warn(n.diag(format!(
+                    "BSDF {other:?} is not supported (diffuse, dielectric, roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided are); Mitsuba's default BSDF (diffuse 0.5) is used"
+                )))?;
+                return Ok(None);
+            }
+        };
+        self.finish(&p)?;
+        Ok(Some(t))
+    }
+
+    /// `twosided` (heron's surfaces are two-sided) and the modulating wrappers heron
+    /// renders without their modulation: the nested BSDF's table.
+    pub(super) fn wrapper_bsdf(
+        &mut self,
+        n: &'a Node,
+        p: &Props<'a>,
+        kind: &str,
+    ) -> Result<Option<Table>, Diagnostic> {
+        // heron's surfaces are two-sided: `twosided` adds nothing. The others
+        // modulate their nested BSDF, which heron renders unmodulated.
+        let inner = p.objects(&["bsdf"]);
+        if kind != "twosided" {
+            self.warn(n.diag(format!(
+                "{kind} is not supported: the nested BSDF is used without it"
+            )))?;
+        }
+        for k in ["opacity", "scale", "flip_invert"] {
+            p.get(k);
+        }
+        // Textures a bump or normal map names are not read.
+        p.objects(&["texture"]);
+        self.finish(p)?;
+        match inner.as_slice() {
+            [] => Ok(None),
+            [b, ..] => {
+                let b = self.resolve(b)?;
+                if inner.len() > 1 {
+                    self.warn(
+                        n.diag("two BSDFs (front and back); heron uses the first on both sides"),
+                    )?;
+                }
+                let name = self.bsdf(b)?;
+                Ok(self
+                    .materials
+                    .get(&name)
+                    .and_then(|v| v.as_table())
+                    .cloned())
+            }
+        }
+    }
+
+    pub(super) fn diffuse_table(&mut self, p: &Props<'a>) -> Result<Table, Diagnostic> {
+        Ok({
+            if let Some(file) = self.bitmap(p, "reflectance")? {
+                table(vec![
+                    ("type", Value::String("lambertian".into())),
+                    ("texture", Value::String(file)),
+                ])
+            } else {
+                let rho = self.colour(p, "reflectance", ColourValue::Grey(0.5))?;
+                table(vec![
+                    ("type", Value::String("lambertian".into())),
+                    ("rho_d", rho.to_toml()),
+                ])
+            }
+        })
+    }
+
+    pub(super) fn dielectric_table(
+        &mut self,
+        n: &Node,
+        p: &Props,
+        kind: &str,
+    ) -> Result<Table, Diagnostic> {
+        Ok({
+            let int = self.ior(p, "int_ior", "bk7")?;
+            let ext = self.ior(p, "ext_ior", "air")?;
+            let mut t = table(vec![
+                ("type", Value::String("dielectric".into())),
+                ("ior", int),
+            ]);
+            // Air's 1.000277 is kept: it is Mitsuba's own default, and heron's
+            // relative index is then Mitsuba's.
+            t.insert("outside_ior".into(), ext);
+            if kind == "roughdielectric" {
+                let alpha = self.roughness(n, p)?;
+                t.insert("roughness".into(), float(alpha));
+            }
+            for k in ["specular_reflectance", "specular_transmittance"] {
+                if let Some(c) = p.get(k) {
+                    self.warn(c.diag(format!(
+                        "{k}: heron's dielectric has no such factor, ignored (1 is used)"
+                    )))?;
+                }
+            }
+            t
+        })
+    }
+
+    pub(super) fn conductor_table(
+        &mut self,
+        n: &Node,
+        p: &Props,
+        kind: &str,
+    ) -> Result<Table, Diagnostic> {
+        Ok({
+            let material = p.string("material")?;
+            let eta = p.float("eta");
+            let k = p.float("k");
+            let (eta, k) = (eta?, k?);
+            let metal = match (material, eta, k) {
+            (_, Some(n_), Some(k_)) => Some(Value::Table(table(vec![
+                ("n", float(n_)),
+                ("k", float(k_)),
+            ]))),
+            (Some(m), None, None) if METALS.contains(&m) => Some(Value::String(m.into())),
+            (None | Some("none"), None, None) => None,
+            (Some(m), None, None) => {
+                return Err(n.diag(format!(
+                    "material: expected one of the metals heron tabulates ({}), \"none\", or eta and k as numbers, got {m:?}",
+                    METALS.join(", ")
+                )))
+            }
+            _ => {
+                return Err(n.diag(
+                    "expected both eta and k as <float> (spectral and RGB eta/k are not supported yet)",
+                ))
+            }
+        };
+            if let Some(c) = p.get("specular_reflectance") {
+                self.warn(c.diag("specular_reflectance: heron's conductor has no such factor, ignored (1 is used)"))?;
+            }
+            match metal {
+            // Mitsuba's `none`: a perfect mirror.
+            None if kind == "conductor" => table(vec![
+                ("type", Value::String("mirror".into())),
+                ("rho_s", float(1.0)),
+            ]),
+            None => {
+                return Err(n.diag(
+                    "material \"none\" on a roughconductor: heron has no rough perfect mirror; give a metal or eta and k",
+                ))
+            }
+            Some(m) => {
+                let mut t = table(vec![("type", Value::String("conductor".into())), ("metal", m)]);
+                if kind == "roughconductor" {
+                    let alpha = self.roughness(n, p)?;
+                    t.insert("roughness".into(), float(alpha));
+                }
+                t
+            }
+        }
+        })
+    }
+
+    pub(super) fn plastic_table(
+        &mut self,
+        n: &Node,
+        p: &Props<'a>,
+        kind: &str,
+    ) -> Result<Table, Diagnostic> {
+        Ok({
+            let rho = self.colour(p, "diffuse_reflectance", ColourValue::Grey(0.5))?;
+            let eta = match self.ior(p, "int_ior", "polypropylene")? {
+                Value::Float(x) => x,
+                Value::String(name) => mitsuba_ior(&name).unwrap_or(1.49),
+                _ => 1.49,
+            };
+            let ext = match self.ior(p, "ext_ior", "air")? {
+                Value::Float(x) => x,
+                _ => 1.000277,
+            };
+            let eta = eta / ext;
+            let alpha = if kind == "roughplastic" {
+                self.roughness(n, p)?
+            } else {
+                0.01
+            };
+            let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+            // Beckmann α ↔ Phong exponent 2/α² − 2 (Walter et al. 2007, §5.2).
+            let shininess = (2.0 / (alpha * alpha) - 2.0).max(1.0);
+            for k in ["specular_reflectance", "nonlinear"] {
+                p.get(k);
+            }
+            self.warn(n.diag(format!(
+            "{kind} is mapped to heron's glossy (modified Phong) material: ρd = diffuse_reflectance, ρs = Fresnel at normal incidence {f0:.4}, shininess {shininess:.0} from α = {alpha}; Mitsuba's coating (Fresnel-weighted, with internal reflections) differs"
+        )))?;
+            let scale = rho.max();
+            // heron requires ρd + ρs ≤ 1 (energy).
+            let rho = if scale + f0 > 1.0 {
+                rho.scaled((1.0 - f0) / scale)
+            } else {
+                rho
+            };
+            table(vec![
+                ("type", Value::String("glossy".into())),
+                ("rho_d", rho.to_toml()),
+                ("rho_s", float(f0)),
+                ("shininess", float(shininess)),
+            ])
+        })
+    }
+
+    /// A microfacet BSDF's α: `alpha`, or `alpha_u`/`alpha_v` when equal; Mitsuba's
+    /// default 0.1. heron's microfacets are GGX.
+    pub(super) fn roughness(&mut self, n: &Node, p: &Props) -> Result<f64, Diagnostic> {
+        let given = p.string("distribution")?;
+        let dist = given.unwrap_or("beckmann");
+        if dist != "ggx" {
+            let default = if given.is_none() {
+                " (Mitsuba's default)"
+            } else {
+                ""
+            };
+            let msg = format!(
+                "distribution {dist:?}{default}: heron's microfacets are GGX, used with the same α"
+            );
+            self.warn(n.diag(msg))?;
+        }
+        p.get("sample_visible");
+        let alpha = p.float("alpha")?;
+        let (u, v) = (p.float("alpha_u")?, p.float("alpha_v")?);
+        let a = match (alpha, u, v) {
+            (Some(a), _, _) => a,
+            (None, Some(u), Some(v)) => {
+                if u != v {
+                    self.warn(n.diag(format!(
+                        "anisotropic roughness (alpha_u {u}, alpha_v {v}) is not supported; their mean is used"
+                    )))?;
+                }
+                0.5 * (u + v)
+            }
+            _ => 0.1,
+        };
+        if !(0.0..=1.0).contains(&a) {
+            return Err(n.diag(format!("alpha: expected a roughness in [0, 1], got {a}")));
+        }
+        Ok(a)
+    }
+
+    /// An index of refraction as heron writes it: a number, or a catalogue name for the
+    /// Mitsuba names heron has with dispersion.
+    pub(super) fn ior(
+        &mut self,
+        p: &Props,
+        name: &str,
+        default: &str,
+    ) -> Result<Value, Diagnostic> {
+        let node = p.get(name);
+        let text = match node {
+            None => default.to_string(),
+            Some(c) => c.attr("value").unwrap_or("").trim().to_string(),
+        };
+        if let Ok(x) = text.parse::<f64>() {
+            if !(x.is_finite() && x > 0.0) {
+                let c = node.expect("a number came from the file");
+                return Err(c.diag(format!("value: expected an index > 0, got {text:?}")));
+            }
+            return Ok(float(x));
+        }
+        if let Some((_, entry)) = CATALOGUE_IORS.iter().find(|(m, _)| *m == text) {
+            if let Some(c) = node {
+                // Said once per element: Mitsuba's constant is not what heron renders.
+                self.warn(c.diag(format!(
+                    "{text:?} is heron's catalogue entry {entry:?}, with its dispersion (Mitsuba uses the constant {})",
+                    mitsuba_ior(&text).unwrap_or(f64::NAN)
+                )))?;
+            }
+            return Ok(Value::String((*entry).into()));
+        }
+        match mitsuba_ior(&text) {
+            Some(x) => Ok(float(x)),
+            None => {
+                let names: Vec<&str> = MITSUBA_IORS.iter().map(|(n, _)| *n).collect();
+                Err(node.unwrap_or(p.node).diag(format!(
+                    "{name}: expected a number or one of Mitsuba's named indices ({}), got {text:?}",
+                    names.join(", ")
+                )))
+            }
+        }
+    }
+
+    // ---- shapes -----------------------------------------------------------------
+}
+
+/// Mitsuba's constant for a named index.
+pub(super) fn mitsuba_ior(name: &str) -> Option<f64> {
+    MITSUBA_IORS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, x)| *x)
+}

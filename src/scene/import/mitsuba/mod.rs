@@ -1,0 +1,592 @@
+//! Mitsuba 3 scene objects to heron's scene tables (the TOML heron renders): sensor,
+//! film and sampler to `[camera]` and `[render]`, integrators, BSDFs to `[materials]`,
+//! shapes (with their area emitters) to `[[shapes]]`, emitters to `[[lights]]` and
+//! `background`. Mitsuba's defaults are those of its plugin documentation
+//! (mitsuba.readthedocs.io, "Plugin reference", 3.x); where heron has no equivalent the
+//! converter says what it did in a [`Diagnostic`] (a warning, an error under `strict`).
+use super::props::{ColourError, ColourValue, Props};
+use super::xml::{Diagnostic, Node};
+use glam::{DMat4, DVec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use toml::{Table, Value};
+
+mod bsdfs;
+mod shapes;
+
+/// A triangle fan of this many triangles stands for a `disk` (area 0.9996 of the disk).
+pub const DISK_SEGMENTS: usize = 128;
+
+/// Mitsuba's `max_depth = -1` (unbounded) becomes this depth; Russian roulette ends the
+/// paths long before it.
+pub const UNBOUNDED_DEPTH: i64 = 1000;
+
+/// Mitsuba 3's table of named indices (`src/core/ior.h`, constants). Four are heron
+/// catalogue glasses with their dispersion instead; [`CATALOGUE_IORS`] names them.
+const MITSUBA_IORS: &[(&str, f64)] = &[
+    ("vacuum", 1.0),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.3330),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.470),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.5750),
+    ("diamond", 2.419),
+];
+
+/// Mitsuba index names that are entries of heron's catalogue (spectra/ior_catalogue.toml).
+const CATALOGUE_IORS: &[(&str, &str)] = &[
+    ("bk7", "N-BK7"),
+    ("water", "water"),
+    ("fused quartz", "fused-silica"),
+    ("diamond", "diamond"),
+];
+
+/// Mitsuba's conductor `material` names heron tabulates (spectrum/metals.rs).
+const METALS: &[&str] = &["Ag", "Al", "Au", "Cu"];
+
+/// What the conversion made: heron's scene table, and what it could not carry over.
+pub struct Converted {
+    pub table: Table,
+    pub warnings: Vec<Diagnostic>,
+}
+
+struct Converter<'a> {
+    /// The folder of the top-level file; mesh paths are written relative to it.
+    base: PathBuf,
+    strict: bool,
+    ids: HashMap<&'a str, &'a Node>,
+    warnings: Vec<Diagnostic>,
+    materials: Table,
+    /// Material name of each converted BSDF element (shared through `ref`).
+    material_of: HashMap<*const Node, String>,
+    default_material: Option<String>,
+    shapes: Vec<Value>,
+    lights: Vec<Value>,
+    background: Option<Value>,
+    /// `[environment]` from an `envmap` emitter.
+    environment: Option<Value>,
+    camera: Option<Table>,
+    render: Table,
+}
+
+/// Converts the document `root` (from [`super::xml::read_document`]) read from `path`.
+pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
+    let mut ids = HashMap::new();
+    collect_ids(root, &mut ids)?;
+    let mut c = Converter {
+        base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+        strict,
+        ids,
+        warnings: Vec::new(),
+        materials: Table::new(),
+        material_of: HashMap::new(),
+        default_material: None,
+        shapes: Vec::new(),
+        lights: Vec::new(),
+        background: None,
+        environment: None,
+        camera: None,
+        render: Table::new(),
+    };
+    for child in &root.children {
+        match child.tag.as_str() {
+            "integrator" => c.integrator(child)?,
+            "sensor" => c.sensor(child)?,
+            "shape" => c.shape(child)?,
+            "emitter" => {
+                c.emitter(child, None)?;
+            }
+            // Named objects at the top level are converted where they are referenced.
+            "bsdf" | "texture" | "spectrum" | "rgb" | "float" if child.attr("id").is_some() => {}
+            "bsdf" => {
+                c.warn(child.diag("a BSDF that no shape uses (it has no id), ignored"))?;
+            }
+            "medium" | "phase" | "volume" | "texture" => {
+                c.unsupported(child, "not supported by heron's import yet, ignored")?
+            }
+            _ => c.unsupported(child, "not supported by heron's import, ignored")?,
+        }
+    }
+    let Some(camera) = c.camera.take() else {
+        return Err(Diagnostic {
+            file: path.to_path_buf(),
+            line: root.line,
+            message: "expected a <sensor type=\"perspective\"> (heron renders through one camera)"
+                .into(),
+        });
+    };
+    let mut table = scene_table(
+        camera,
+        std::mem::take(&mut c.render),
+        c.background.take(),
+        std::mem::take(&mut c.materials),
+        std::mem::take(&mut c.shapes),
+        std::mem::take(&mut c.lights),
+    );
+    if let Some(e) = c.environment.take() {
+        table.insert("environment".into(), e);
+    }
+    Ok(Converted {
+        table,
+        warnings: c.warnings,
+    })
+}
+
+/// heron's scene table from its parts, leaving out the empty optional ones (what both
+/// converters, this one and pbrt.rs, assemble).
+pub(super) fn scene_table(
+    camera: Table,
+    render: Table,
+    background: Option<Value>,
+    materials: Table,
+    shapes: Vec<Value>,
+    lights: Vec<Value>,
+) -> Table {
+    let mut t = Table::new();
+    t.insert("camera".into(), Value::Table(camera));
+    if !render.is_empty() {
+        t.insert("render".into(), Value::Table(render));
+    }
+    if let Some(b) = background {
+        t.insert("background".into(), b);
+    }
+    if !materials.is_empty() {
+        t.insert("materials".into(), Value::Table(materials));
+    }
+    t.insert("shapes".into(), Value::Array(shapes));
+    if !lights.is_empty() {
+        t.insert("lights".into(), Value::Array(lights));
+    }
+    t
+}
+
+fn collect_ids<'a>(n: &'a Node, ids: &mut HashMap<&'a str, &'a Node>) -> Result<(), Diagnostic> {
+    for c in &n.children {
+        if let Some(id) = c.attr("id") {
+            if c.tag != "ref" && ids.insert(id, c).is_some() {
+                return Err(c.diag(format!("the id {id:?} is used twice")));
+            }
+        }
+        collect_ids(c, ids)?;
+    }
+    Ok(())
+}
+
+/// `v` to 12 significant digits (far beyond f32's 7), so that a rotation by 90° writes
+/// 0 and 1 rather than 6e-17 and 0.9999999999999999.
+pub(super) fn tidy(v: f64) -> f64 {
+    if v.abs() < 1e-12 {
+        return 0.0;
+    }
+    format!("{v:.11e}").parse().unwrap_or(v)
+}
+
+pub(super) fn float(v: f64) -> Value {
+    Value::Float(tidy(v))
+}
+
+pub(super) fn vec3(v: DVec3) -> Value {
+    Value::Array(v.to_array().iter().map(|x| float(*x)).collect())
+}
+
+pub(super) fn table(pairs: Vec<(&str, Value)>) -> Table {
+    pairs.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
+}
+
+impl<'a> Converter<'a> {
+    fn warn(&mut self, d: Diagnostic) -> Result<(), Diagnostic> {
+        if self.strict {
+            Err(d)
+        } else {
+            self.warnings.push(d);
+            Ok(())
+        }
+    }
+
+    fn unsupported(&mut self, n: &Node, what: &str) -> Result<(), Diagnostic> {
+        self.warn(n.diag(what))
+    }
+
+    /// Warnings for what `p`'s object held that nothing read.
+    fn finish(&mut self, p: &Props) -> Result<(), Diagnostic> {
+        for d in p.unread() {
+            self.warn(d)?;
+        }
+        Ok(())
+    }
+
+    fn plugin(n: &Node) -> Result<&str, Diagnostic> {
+        n.attr("type")
+            .ok_or_else(|| n.diag("expected the attribute type"))
+    }
+
+    fn resolve(&self, n: &'a Node) -> Result<&'a Node, Diagnostic> {
+        if n.tag != "ref" {
+            return Ok(n);
+        }
+        let Some(id) = n.attr("id") else {
+            return Err(n.diag("expected the attribute id"));
+        };
+        self.ids
+            .get(id)
+            .copied()
+            .ok_or_else(|| n.diag(format!("no element has the id {id:?}")))
+    }
+
+    /// The image file of parameter `name` when it is a `bitmap` texture (nested or by
+    /// `ref`), relative to the top-level file's folder, as heron's `texture` reads it
+    /// (bilinear, repeating, 8-bit images sRGB-decoded: Mitsuba's defaults). Its other
+    /// settings warn where heron differs.
+    fn bitmap(&mut self, p: &Props<'a>, name: &str) -> Result<Option<String>, Diagnostic> {
+        let Some(n) = p
+            .node
+            .children
+            .iter()
+            .find(|c| c.attr("name") == Some(name))
+        else {
+            return Ok(None);
+        };
+        let t = self.resolve(n)?;
+        if t.tag != "texture" || t.attr("type") != Some("bitmap") {
+            return Ok(None);
+        }
+        p.get(name);
+        let tp = Props::new(t);
+        let Some(file) = tp.string("filename")? else {
+            return Err(t.diag("expected <string name=\"filename\" value=\"…\"/>"));
+        };
+        let folder = t.file.parent().unwrap_or(Path::new(""));
+        let rel = relative_to(&folder.join(file), &self.base);
+        for (key, default) in [("filter_type", "bilinear"), ("wrap_mode", "repeat")] {
+            if let Some(v) = tp.string(key)? {
+                if v != default {
+                    self.warn(t.diag(format!(
+                        "{key} {v:?}: heron's textures are {default}, which is used"
+                    )))?;
+                }
+            }
+        }
+        if tp.boolean("raw")? == Some(true) {
+            self.warn(t.diag(
+                "raw: heron decodes an 8-bit image's sRGB curve regardless (Mitsuba's spectral variants refuse a raw reflectance)",
+            ))?;
+        }
+        if let Some(m) = tp.transform("to_uv")? {
+            if m != DMat4::IDENTITY {
+                self.warn(t.diag("to_uv is not supported, ignored: the texture is not moved"))?;
+            }
+        }
+        for w in tp.unread() {
+            self.warn(w)?;
+        }
+        Ok(Some(rel.to_string_lossy().replace('\\', "/")))
+    }
+
+    /// A colour, or `default` when absent; unsupported forms warn and use `default`.
+    fn colour(
+        &mut self,
+        p: &Props<'a>,
+        name: &str,
+        default: ColourValue,
+    ) -> Result<ColourValue, Diagnostic> {
+        match p.colour(name) {
+            Ok(Some(c)) => Ok(c),
+            Ok(None) => Ok(default),
+            Err(ColourError::Bad(d)) => Err(d),
+            Err(ColourError::Unsupported(d)) => {
+                let msg = format!("{}; the default {:?} is used", d.message, default);
+                self.warn(Diagnostic { message: msg, ..d })?;
+                Ok(default)
+            }
+        }
+    }
+
+    // ---- integrator, sensor, film, sampler ---------------------------------------
+
+    fn integrator(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
+        let p = Props::new(n);
+        let kind = Self::plugin(n)?;
+        let (integrator, depth) = match kind {
+            "path" | "volpath" | "volpathmis" => ("path", p.integer("max_depth")?.unwrap_or(-1)),
+            // Mitsuba's `direct` is emitters seen directly plus one bounce of direct
+            // light: heron's path tracer at one scattering event.
+            "direct" => ("path", 2),
+            "ptracer" => ("lighttrace", p.integer("max_depth")?.unwrap_or(-1)),
+            other => {
+                return self.unsupported(
+                    n,
+                    &format!("integrator {other:?} is not supported (path, volpath, volpathmis, direct, ptracer are), heron's default is used"),
+                );
+            }
+        };
+        // Mitsuba counts path vertices up to and including the emitter, heron counts
+        // scattering events: Mitsuba's max_depth = d is heron's d − 1.
+        let heron_depth = if depth < 0 {
+            UNBOUNDED_DEPTH
+        } else {
+            depth - 1
+        };
+        if heron_depth < 1 {
+            return Err(n.diag(format!(
+                "max_depth: expected -1 or at least 2 (heron renders at least one scattering event), got {depth}"
+            )));
+        }
+        self.render
+            .insert("integrator".into(), Value::String(integrator.into()));
+        self.render
+            .insert("max_depth".into(), Value::Integer(heron_depth));
+        if let Some(rr) = p.integer("rr_depth")? {
+            self.render
+                .insert("rr_depth".into(), Value::Integer((rr - 1).max(0)));
+        }
+        if kind == "direct" {
+            for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {
+                if p.get(k).is_some() {
+                    self.warn(n.diag(format!(
+                        "{k}: heron takes one light sample and one BSDF sample per vertex (MIS), ignored"
+                    )))?;
+                }
+            }
+        }
+        if p.boolean("hide_emitters")? == Some(true) {
+            self.warn(n.diag("hide_emitters is not supported, emitters stay visible"))?;
+        }
+        self.finish(&p)
+    }
+
+    fn sensor(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
+        if self.camera.is_some() {
+            return self.unsupported(
+                n,
+                "a second sensor; heron renders through the first, ignored",
+            );
+        }
+        let kind = Self::plugin(n)?;
+        if kind != "perspective" && kind != "thinlens" {
+            return Err(n.diag(format!(
+                "expected a perspective sensor (or thinlens, rendered as a pinhole), got {kind:?}"
+            )));
+        }
+        let p = Props::new(n);
+        let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        if to_world.determinant() < 0.0 {
+            self.warn(n.diag(
+                "to_world mirrors the image (negative determinant); heron's camera cannot mirror, the image is rendered unmirrored",
+            ))?;
+        }
+        if kind == "thinlens" {
+            for k in ["aperture_radius", "focus_distance"] {
+                p.get(k);
+            }
+            self.warn(n.diag("thinlens is rendered as a pinhole: depth of field is lost"))?;
+        }
+        for k in ["near_clip", "far_clip"] {
+            if p.get(k).is_some() {
+                self.warn(n.diag(format!(
+                    "{k}: heron's camera has no clipping planes, ignored"
+                )))?;
+            }
+        }
+        // Film first: the field of view's axis needs the aspect ratio.
+        let (mut width, mut height) = (768_i64, 576_i64);
+        for f in p.objects(&["film", "sampler"]) {
+            let f = self.resolve(f)?;
+            match f.tag.as_str() {
+                "film" => (width, height) = self.film(f)?,
+                "sampler" => self.sampler(f)?,
+                _ => return Err(f.diag("expected a film or a sampler inside the sensor")),
+            }
+        }
+        let aspect = width as f64 / height as f64;
+        let fov_axis = p.string("fov_axis")?.unwrap_or("x");
+        // tan of half the vertical field of view (heron's image plane has height 1 at d).
+        let tan_y = match (p.float("fov")?, p.string("focal_length")?) {
+            (Some(fov), _) => {
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(n.diag(format!("fov: expected degrees in (0, 180), got {fov}")));
+                }
+                let t = (0.5 * fov.to_radians()).tan();
+                let axis = match fov_axis {
+                    "smaller" if aspect < 1.0 => "x",
+                    "smaller" => "y",
+                    "larger" if aspect < 1.0 => "y",
+                    "larger" => "x",
+                    a => a,
+                };
+                match axis {
+                    "x" => t / aspect,
+                    "y" => t,
+                    "diagonal" => t / (1.0 + aspect * aspect).sqrt(),
+                    other => {
+                        return Err(n.diag(format!(
+                            "fov_axis: expected x, y, diagonal, smaller or larger, got {other:?}"
+                        )))
+                    }
+                }
+            }
+            (None, f) => {
+                // Mitsuba: the focal length of 36 × 24 mm film, 36 mm along the longer
+                // image axis (checked against Mitsuba 3.9's x_fov).
+                let text = f.unwrap_or("50mm");
+                let mm = text
+                    .trim()
+                    .trim_end_matches("mm")
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| *v > 0.0 && v.is_finite())
+                    .ok_or_else(|| {
+                        n.diag(format!(
+                            "focal_length: expected e.g. \"50mm\", got {text:?}"
+                        ))
+                    })?;
+                let t_long = 18.0 / mm;
+                if aspect >= 1.0 {
+                    t_long / aspect
+                } else {
+                    t_long
+                }
+            }
+        };
+        let eye = to_world.transform_point3(DVec3::ZERO);
+        let look = to_world.transform_point3(DVec3::Z);
+        let up = to_world.transform_vector3(DVec3::Y);
+        let mut cam = table(vec![
+            ("eye", vec3(eye)),
+            ("look_at", vec3(look)),
+            ("up", vec3(up)),
+            ("d", float(0.5 / tan_y)),
+            (
+                "resolution",
+                Value::Array(vec![Value::Integer(width), Value::Integer(height)]),
+            ),
+        ]);
+        cam.retain(|_, v| !matches!(v, Value::Float(x) if !x.is_finite()));
+        self.camera = Some(cam);
+        self.finish(&p)
+    }
+
+    fn film(&mut self, f: &'a Node) -> Result<(i64, i64), Diagnostic> {
+        let kind = Self::plugin(f)?;
+        if kind != "hdrfilm" && kind != "specfilm" {
+            self.unsupported(f, "heron writes an OpenEXR film like hdrfilm; read as one")?;
+        }
+        let p = Props::new(f);
+        let width = p.integer("width")?.unwrap_or(768);
+        let height = p.integer("height")?.unwrap_or(576);
+        for (k, v) in [("width", width), ("height", height)] {
+            if v < 1 {
+                return Err(f.diag(format!("{k}: expected at least 1 pixel, got {v}")));
+            }
+        }
+        let filters = p.objects(&["rfilter"]);
+        match filters.first() {
+            None => self.warn(f.diag(
+                "no rfilter: Mitsuba's default is a Gaussian, heron's pixels are box-filtered",
+            ))?,
+            Some(r) => {
+                let r = self.resolve(r)?;
+                if Self::plugin(r)? != "box" {
+                    self.warn(
+                        r.diag("heron's pixels are box-filtered; this filter is read as box"),
+                    )?;
+                }
+            }
+        }
+        // What only changes the file's encoding is accepted as is.
+        for k in ["pixel_format", "component_format", "file_format", "banner"] {
+            p.get(k);
+        }
+        for k in [
+            "crop_width",
+            "crop_height",
+            "crop_offset_x",
+            "crop_offset_y",
+        ] {
+            if p.get(k).is_some() {
+                self.warn(f.diag(format!(
+                    "{k}: crops are not supported, the full film is rendered"
+                )))?;
+            }
+        }
+        self.finish(&p)?;
+        Ok((width, height))
+    }
+
+    fn sampler(&mut self, s: &'a Node) -> Result<(), Diagnostic> {
+        let p = Props::new(s);
+        if let Some(spp) = p.integer("sample_count")? {
+            if spp < 1 {
+                return Err(s.diag(format!("sample_count: expected at least 1, got {spp}")));
+            }
+            self.render.insert("spp".into(), Value::Integer(spp));
+        }
+        if let Some(seed) = p.integer("seed")? {
+            self.render
+                .insert("seed".into(), Value::Integer(seed.max(0)));
+        }
+        // heron's sample sequence is its own (Sobol by default); the kind of sampler
+        // changes noise, not the expected image.
+        p.get("jitter");
+        self.finish(&p)
+    }
+
+    // ---- BSDFs ----------------------------------------------------------------------
+}
+
+pub(super) fn vec_row(r: [f64; 4]) -> Value {
+    Value::Array(r.iter().map(|x| float(*x)).collect())
+}
+
+/// `path` relative to the folder `base` when one contains the other's ancestors;
+/// otherwise `path` as given.
+pub fn relative_to(path: &Path, base: &Path) -> PathBuf {
+    let (Ok(p), Ok(b)) = (absolute(path), absolute(base)) else {
+        return path.to_path_buf();
+    };
+    let pc: Vec<_> = p.components().collect();
+    let bc: Vec<_> = b.components().collect();
+    let common = pc.iter().zip(&bc).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return p;
+    }
+    let mut out = PathBuf::new();
+    for _ in common..bc.len() {
+        out.push("..");
+    }
+    for c in &pc[common..] {
+        out.push(c);
+    }
+    out
+}
+
+/// The absolute, `.`-free form of `p` (without touching the file system's links).
+fn absolute(p: &Path) -> std::io::Result<PathBuf> {
+    let abs = std::path::absolute(p)?;
+    let mut out = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    Ok(out)
+}

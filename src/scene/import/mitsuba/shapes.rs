@@ -1,0 +1,317 @@
+//! Mitsuba 3's shapes (with their area emitters) and emitters as heron's shapes and
+//! lights.
+use super::*;
+
+impl<'a> Converter<'a> {
+    pub(super) fn shape(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
+        let kind = Self::plugin(n)?;
+        let p = Props::new(n);
+        let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        let flip = p.boolean("flip_normals")?.unwrap_or(false);
+        // The BSDF and an area emitter.
+        let mut material = None;
+        let mut emission = None;
+        for o in p.objects(&["bsdf", "emitter", "medium"]) {
+            let o = self.resolve(o)?;
+            match o.tag.as_str() {
+                "bsdf" => material = Some(self.bsdf(o)?),
+                "emitter" => emission = self.emitter(o, Some(n))?,
+                "medium" => {
+                    self.unsupported(o, "media are not supported by heron's import yet, ignored")?
+                }
+                _ => return Err(o.diag("expected a bsdf, an emitter or a medium inside a shape")),
+            }
+        }
+        let material = match material {
+            Some(m) => m,
+            None => self.default_material(),
+        };
+        let mut entries: Vec<Table> = Vec::new();
+        match kind {
+            "rectangle" => {
+                let mut q = quad(&to_world, [-1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+                if flip {
+                    q.reverse_edges();
+                }
+                entries.push(q.table());
+            }
+            "cube" => {
+                // The six faces of [-1, 1]³, each (origin, edge1, edge2) with edge1 × edge2
+                // outward.
+                let faces = [
+                    ([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
+                    ([-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]),
+                    ([-1.0, 1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]),
+                    ([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
+                    ([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+                    ([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]),
+                ];
+                for (o, e1, e2) in faces {
+                    let mut q = quad(&to_world, o, e1, e2);
+                    if flip {
+                        q.reverse_edges();
+                    }
+                    entries.push(q.table());
+                }
+            }
+            "disk" => {
+                let c = to_world.transform_point3(DVec3::ZERO);
+                for i in 0..DISK_SEGMENTS {
+                    let a0 = std::f64::consts::TAU * i as f64 / DISK_SEGMENTS as f64;
+                    let a1 = std::f64::consts::TAU * (i + 1) as f64 / DISK_SEGMENTS as f64;
+                    let v0 = to_world.transform_point3(DVec3::new(a0.cos(), a0.sin(), 0.0));
+                    let v1 = to_world.transform_point3(DVec3::new(a1.cos(), a1.sin(), 0.0));
+                    // Counter-clockwise about the transformed +z, as `quad` keeps it.
+                    let swap = flip ^ (to_world.determinant() < 0.0);
+                    let verts = if swap { [c, v1, v0] } else { [c, v0, v1] };
+                    entries.push(table(vec![
+                        ("type", Value::String("triangle".into())),
+                        ("vertices", Value::Array(verts.into_iter().map(vec3).collect())),
+                    ]));
+                }
+            }
+            "sphere" => {
+                let center = p.point("center")?.unwrap_or(DVec3::ZERO);
+                let radius = p.float("radius")?.unwrap_or(1.0);
+                let m3 = glam::DMat3::from_mat4(to_world);
+                let s = [m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length()];
+                if (s[0] - s[1]).abs() > 1e-6 * s[0] || (s[0] - s[2]).abs() > 1e-6 * s[0] {
+                    return Err(n.diag(format!(
+                        "to_world scales the sphere by {:.6}, {:.6}, {:.6}: heron's spheres take a uniform scale only",
+                        s[0], s[1], s[2]
+                    )));
+                }
+                if flip {
+                    self.warn(n.diag("flip_normals on a sphere is not supported, ignored"))?;
+                }
+                entries.push(table(vec![
+                    ("type", Value::String("sphere".into())),
+                    ("center", vec3(to_world.transform_point3(center))),
+                    ("radius", float(radius * s[0])),
+                ]));
+            }
+            "obj" | "ply" => {
+                let Some(file) = p.string("filename")? else {
+                    return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
+                };
+                let folder = n.file.parent().unwrap_or(Path::new(""));
+                let full = folder.join(file);
+                let rel = relative_to(&full, &self.base);
+                if flip {
+                    self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
+                }
+                // heron shades every mesh by its face normals (README, "Mitsuba 3 scenes").
+                p.get("face_normals");
+                let flip_uv = p.boolean("flip_tex_coords")?;
+                let mut t = table(vec![
+                    ("type", Value::String("mesh".into())),
+                    ("file", Value::String(rel.to_string_lossy().replace('\\', "/"))),
+                ]);
+                if to_world != DMat4::IDENTITY {
+                    let rows: Vec<Value> = (0..4)
+                        .map(|r| vec_row(to_world.row(r).to_array()))
+                        .collect();
+                    t.insert("transform".into(), Value::Array(rows));
+                }
+                // heron's defaults are Mitsuba's (true for OBJ, false for PLY).
+                if let Some(f) = flip_uv {
+                    t.insert("flip_tex_coords".into(), Value::Boolean(f));
+                }
+                entries.push(t);
+            }
+            "serialized" => {
+                return Err(n.diag(
+                    "Mitsuba's serialized meshes are not supported; save the mesh as PLY (Mitsuba 3: mesh.write_ply) and use <shape type=\"ply\">",
+                ))
+            }
+            other => {
+                self.warn(n.diag(format!(
+                    "shape {other:?} is not supported (rectangle, cube, disk, sphere, obj, ply are), ignored"
+                )))?;
+                return self.finish(&p);
+            }
+        }
+        for mut e in entries {
+            e.insert("material".into(), Value::String(material.clone()));
+            if let Some(em) = &emission {
+                e.insert("emission".into(), em.clone());
+            }
+            self.shapes.push(Value::Table(e));
+        }
+        self.finish(&p)
+    }
+
+    // ---- emitters ---------------------------------------------------------------
+
+    /// Converts an emitter; inside a shape (`shape` given) it returns the area light's
+    /// radiance for the shape's `emission`.
+    pub(super) fn emitter(
+        &mut self,
+        n: &'a Node,
+        shape: Option<&Node>,
+    ) -> Result<Option<Value>, Diagnostic> {
+        let kind = Self::plugin(n)?;
+        let p = Props::new(n);
+        let out = match (kind, shape) {
+            ("area", Some(_)) => {
+                let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
+                Some(l.to_toml())
+            }
+            ("area", None) => return Err(n.diag("an area emitter must be inside a <shape>")),
+            (_, Some(s)) => {
+                return Err(n.diag(format!(
+                    "expected an area emitter inside {}, got {kind:?}",
+                    s.describe()
+                )))
+            }
+            ("point", None) => {
+                let pos = match (p.point("position")?, p.transform("to_world")?) {
+                    (Some(x), _) => x,
+                    (None, Some(m)) => m.transform_point3(DVec3::ZERO),
+                    (None, None) => DVec3::ZERO,
+                };
+                let i = self.colour(&p, "intensity", ColourValue::Grey(1.0))?;
+                self.lights.push(Value::Table(table(vec![
+                    ("type", Value::String("point".into())),
+                    ("position", vec3(pos)),
+                    ("intensity", i.to_toml()),
+                ])));
+                None
+            }
+            ("spot", None) => {
+                let m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+                let cutoff = p.float("cutoff_angle")?.unwrap_or(20.0);
+                let beam = p.float("beam_width")?.unwrap_or(cutoff * 0.75);
+                if !(cutoff > 0.0 && cutoff <= 90.0 && beam >= 0.0 && beam <= cutoff) {
+                    return Err(n.diag(format!(
+                        "expected 0 < cutoff_angle ≤ 90 and 0 ≤ beam_width ≤ cutoff_angle, got {cutoff} and {beam}"
+                    )));
+                }
+                let i = self.colour(&p, "intensity", ColourValue::Grey(1.0))?;
+                self.warn(n.diag(
+                    "spot: heron's falloff between beam_width and cutoff_angle is pbrt's smoothstep, Mitsuba's is linear in angle",
+                ))?;
+                self.lights.push(Value::Table(table(vec![
+                    ("type", Value::String("spot".into())),
+                    ("position", vec3(m.transform_point3(DVec3::ZERO))),
+                    ("direction", vec3(m.transform_vector3(DVec3::Z))),
+                    ("intensity", i.to_toml()),
+                    ("cone_angle", float(cutoff)),
+                    ("cone_delta", float(cutoff - beam)),
+                ])));
+                None
+            }
+            ("directional", None) => {
+                let dir = match (p.point("direction")?, p.transform("to_world")?) {
+                    (Some(d), _) => d,
+                    (None, Some(m)) => m.transform_vector3(DVec3::Z),
+                    (None, None) => DVec3::Z,
+                };
+                if dir.length() == 0.0 {
+                    return Err(n.diag("direction: expected a non-zero vector"));
+                }
+                let e = self.colour(&p, "irradiance", ColourValue::Grey(1.0))?;
+                self.lights.push(Value::Table(table(vec![
+                    ("type", Value::String("directional".into())),
+                    ("direction", vec3(dir)),
+                    ("radiance", e.to_toml()),
+                ])));
+                None
+            }
+            ("constant", None) => {
+                let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
+                if self.background.is_some() || self.environment.is_some() {
+                    self.warn(n.diag(
+                        "a second environment emitter (constant or envmap); heron's environment is the first, ignored",
+                    ))?;
+                } else {
+                    self.background = Some(l.to_toml());
+                }
+                None
+            }
+            ("envmap", None) => {
+                let Some(file) = p.string("filename")? else {
+                    return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
+                };
+                let folder = n.file.parent().unwrap_or(Path::new(""));
+                let rel = relative_to(&folder.join(file), &self.base);
+                let scale = p.float("scale")?.unwrap_or(1.0);
+                if !(scale >= 0.0) {
+                    return Err(n.diag(format!("scale: expected a number ≥ 0, got {scale}")));
+                }
+                let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+                // Only how the map is sampled, not what it shows: heron's own sampling.
+                p.get("mis_compensation");
+                let mut t = table(vec![
+                    (
+                        "map",
+                        Value::String(rel.to_string_lossy().replace('\\', "/")),
+                    ),
+                    ("scale", float(scale)),
+                ]);
+                if to_world != DMat4::IDENTITY {
+                    // The map is at infinity: its translation does not matter.
+                    let mut m = to_world;
+                    m.w_axis = glam::DVec4::W;
+                    let rows: Vec<Value> = (0..4).map(|r| vec_row(m.row(r).to_array())).collect();
+                    t.insert("transform".into(), Value::Array(rows));
+                }
+                if self.environment.is_some() || self.background.is_some() {
+                    self.warn(n.diag(
+                        "a second environment emitter (envmap or constant); heron's environment is the first, ignored",
+                    ))?;
+                } else {
+                    self.environment = Some(Value::Table(t));
+                }
+                None
+            }
+            (other, None) => {
+                self.warn(n.diag(format!(
+                    "emitter {other:?} is not supported yet (area, point, spot, directional, constant, envmap are), ignored: the image lacks its light"
+                )))?;
+                return Ok(None);
+            }
+        };
+        self.finish(&p)?;
+        Ok(out)
+    }
+}
+
+/// A parallelogram after a transform: origin and edges in world space.
+pub(super) struct Quad {
+    origin: DVec3,
+    edge1: DVec3,
+    edge2: DVec3,
+}
+
+impl Quad {
+    fn reverse_edges(&mut self) {
+        std::mem::swap(&mut self.edge1, &mut self.edge2);
+    }
+
+    fn table(&self) -> Table {
+        table(vec![
+            ("type", Value::String("quad".into())),
+            ("origin", vec3(self.origin)),
+            ("edge1", vec3(self.edge1)),
+            ("edge2", vec3(self.edge2)),
+        ])
+    }
+}
+
+pub(super) fn quad(m: &DMat4, o: [f64; 3], e1: [f64; 3], e2: [f64; 3]) -> Quad {
+    let o = DVec3::from_array(o);
+    let (e1, e2) = (DVec3::from_array(e1), DVec3::from_array(e2));
+    let origin = m.transform_point3(o);
+    let mut q = Quad {
+        origin,
+        edge1: m.transform_point3(o + e1) - origin,
+        edge2: m.transform_point3(o + e2) - origin,
+    };
+    // A mirroring transform turns the normal inward; Mitsuba's normal follows the
+    // transformed geometry's orientation, so the edges are swapped back.
+    if m.determinant() < 0.0 {
+        q.reverse_edges();
+    }
+    q
+}

@@ -1,0 +1,306 @@
+//! pbrt-v4 scene files (pbrt-v4 User's Guide, "Scene Description Format") to heron's
+//! scene table: the tokens and directives with their line, the current transformation
+//! matrix with `AttributeBegin`/`End`, materials (named and current), area lights, and
+//! the shapes heron has. Conventions: pbrt's `Transform`/`ConcatTransform` matrices are
+//! given column by column (pbrt transposes them), its camera looks along local +z with
+//! +x to the image's right, `fov` spans the image's shorter axis, `maxdepth` counts
+//! scattering events as heron's `max_depth` does, and a roughness is remapped to
+//! α = √r unless `remaproughness` is false (pbrt-v4's `TrowbridgeReitzDistribution::
+//! RoughnessToAlpha`).
+//!
+//! Object instancing (`ObjectBegin`/`ObjectEnd`/`ObjectInstance`) is flattened: every
+//! `ObjectInstance` emits a copy of the object's shapes. The composition is pbrt-v4's
+//! (`src/pbrt/scene.cpp`, `BasicSceneBuilder::Shape` and `::ObjectInstance`, and
+//! `BasicScene::CreateAggregate`, which wraps the definition in a `TransformedPrimitive`):
+//! a shape inside a definition keeps the CTM current at its `Shape` (render-from-object),
+//! the instance the CTM current at its `ObjectInstance` (render-from-instance, the world
+//! transform `renderFromWorld` cancelling between the two), so a copy's world-from-shape
+//! matrix is CTM(instance) · CTM(shape). Everything else a copy has (material, reverse
+//! orientation) is the definition's; instances may come before their definition (pbrt-v4
+//! resolves them after parsing), and area lights in a definition do not emit.
+use super::mitsuba::{float, relative_to, scene_table, table, vec3, Converted};
+use super::xml::Diagnostic;
+use glam::{DMat4, DVec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use toml::{Table, Value};
+
+mod directives;
+mod tokens;
+mod translate;
+
+#[derive(Clone)]
+struct Graphics {
+    ctm: DMat4,
+    material: Option<String>,
+    area: Option<(Value, bool)>,
+    reverse: bool,
+}
+
+/// A shape as its `Shape` directive gave it, in its own (object) space: what
+/// [`Conv::emit`] places with a matrix, once for a shape in the world and once per
+/// `ObjectInstance` for a shape in an object definition.
+#[derive(Clone, Debug)]
+enum Geom {
+    Sphere {
+        radius: f64,
+    },
+    /// `trianglemesh` (3 indices a face) or `bilinearmesh` (4, pbrt's p00 p10 p01 p11).
+    Mesh {
+        kind: &'static str,
+        points: Vec<DVec3>,
+        faces: Vec<Vec<usize>>,
+    },
+    /// A PLY file, its path relative to the scene's folder.
+    Ply {
+        file: String,
+    },
+}
+
+/// A `Shape` with the graphics state current at it (pbrt-v4's `ShapeSceneEntity`: the
+/// render-from-object transform, reverse orientation, material and area light).
+#[derive(Clone, Debug)]
+struct ShapeDef {
+    geom: Geom,
+    ctm: DMat4,
+    reverse: bool,
+    material: String,
+    area: Option<(Value, bool)>,
+    file: PathBuf,
+    line: u32,
+}
+
+/// An `ObjectBegin` … `ObjectEnd` definition.
+#[derive(Clone, Debug)]
+struct ObjectDef {
+    name: String,
+    file: PathBuf,
+    line: u32,
+    /// How many `Import`s deep it was opened: pbrt-v4 parses an imported file with a
+    /// builder of its own, so a definition does not span an `Import`'s boundary
+    /// (`BasicSceneBuilder::ObjectEnd`, `::MergeImported`).
+    import_depth: usize,
+    shapes: Vec<ShapeDef>,
+}
+
+/// What the shapes list holds until the end of the files: shapes, and instances to be
+/// resolved then (pbrt-v4 resolves `ObjectInstance` names after parsing, so an instance
+/// may come first), each in file order.
+#[derive(Clone, Debug)]
+enum Slot {
+    Shape(Value),
+    Instance {
+        name: String,
+        ctm: DMat4,
+        file: PathBuf,
+        line: u32,
+    },
+}
+
+/// One open `AttributeBegin`, `TransformBegin` or `ObjectBegin`: the graphics state it
+/// saved, and where it was opened (pbrt-v4's `pushedGraphicsStates` and `pushStack`).
+#[derive(Clone)]
+struct Pushed {
+    g: Graphics,
+    what: &'static str,
+    file: PathBuf,
+    line: u32,
+}
+
+struct Conv {
+    base: PathBuf,
+    strict: bool,
+    warnings: Vec<Diagnostic>,
+    materials: Table,
+    named: HashMap<String, String>,
+    shapes: Vec<Slot>,
+    lights: Vec<Value>,
+    background: Option<Value>,
+    /// `[environment]` from an image `infinite` light.
+    environment: Option<Value>,
+    camera: Option<Table>,
+    camera_from_world: Option<(DMat4, u32, PathBuf, f64)>,
+    resolution: (i64, i64),
+    render: Table,
+    g: Graphics,
+    stack: Vec<Pushed>,
+    n_material: usize,
+    default_material: Option<String>,
+    /// The object being defined (between `ObjectBegin` and `ObjectEnd`).
+    object: Option<ObjectDef>,
+    objects: HashMap<String, ObjectDef>,
+    import_depth: usize,
+}
+
+/// Converts the pbrt-v4 file `path`.
+pub fn convert(path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
+    let mut c = Conv::new(path, strict);
+    c.file(path, 0, None)?;
+    c.finish(path)
+}
+
+/// Converts pbrt-v4 text already in memory, read as if from `path` (its `Include`s and
+/// meshes are read from `path`'s folder).
+pub fn convert_str(text: &str, path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
+    let mut c = Conv::new(path, strict);
+    c.text(text, path, 0)?;
+    c.finish(path)
+}
+
+impl Conv {
+    fn new(path: &Path, strict: bool) -> Conv {
+        Conv {
+            base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+            strict,
+            warnings: Vec::new(),
+            materials: Table::new(),
+            named: HashMap::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+            background: None,
+            environment: None,
+            camera: None,
+            camera_from_world: None,
+            resolution: (1280, 720),
+            render: Table::new(),
+            g: Graphics {
+                ctm: DMat4::IDENTITY,
+                material: None,
+                area: None,
+                reverse: false,
+            },
+            stack: Vec::new(),
+            n_material: 0,
+            default_material: None,
+            object: None,
+            objects: HashMap::new(),
+            import_depth: 0,
+        }
+    }
+
+    /// After the last file: the open definition is an error, the instances become
+    /// shapes, and the camera and tables are put together.
+    fn finish(mut self, path: &Path) -> Result<Converted, Diagnostic> {
+        if let Some(o) = &self.object {
+            return Err(self.diag(
+                &o.file,
+                o.line,
+                format!(
+                    "ObjectBegin {:?} is not closed by an ObjectEnd before the end of the file",
+                    o.name
+                ),
+            ));
+        }
+        let shapes = self.instantiate()?;
+        self.finish_camera(path)?;
+        let mut t = scene_table(
+            self.camera.take().expect("finish_camera sets it"),
+            std::mem::take(&mut self.render),
+            self.background.take(),
+            std::mem::take(&mut self.materials),
+            shapes,
+            std::mem::take(&mut self.lights),
+        );
+        if let Some(e) = self.environment.take() {
+            t.insert("environment".into(), e);
+        }
+        Ok(Converted {
+            table: t,
+            warnings: self.warnings,
+        })
+    }
+
+    /// The shapes list with each `ObjectInstance` replaced by copies of its object's
+    /// shapes, each placed by CTM(instance) · CTM(shape) (pbrt-v4 `src/pbrt/scene.cpp`:
+    /// `renderFromInstance = RenderFromObject(0) * worldFromRender` applied on top of the
+    /// shapes' own `renderFromObject`). An unknown name is an error at the instance, as
+    /// in pbrt-v4's `CreateAggregate` ("object instance not defined"); an empty object
+    /// gives nothing.
+    fn instantiate(&mut self) -> Result<Vec<Value>, Diagnostic> {
+        let slots = std::mem::take(&mut self.shapes);
+        let objects = std::mem::take(&mut self.objects);
+        let mut out = Vec::with_capacity(slots.len());
+        for slot in slots {
+            match slot {
+                Slot::Shape(v) => out.push(v),
+                Slot::Instance {
+                    name,
+                    ctm,
+                    file,
+                    line,
+                } => {
+                    let Some(o) = objects.get(&name) else {
+                        return Err(self.diag(
+                            &file,
+                            line,
+                            format!("ObjectInstance: no object named {name:?} was defined (ObjectBegin {name:?} … ObjectEnd)"),
+                        ));
+                    };
+                    for sd in &o.shapes {
+                        out.extend(self.emit(sd, Some((&name, ctm, &file, line)))?);
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+fn s(v: &str) -> Value {
+    Value::String(v.to_string())
+}
+
+impl Conv {
+    fn diag(&self, file: &Path, line: u32, m: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            file: file.to_path_buf(),
+            line,
+            message: m.into(),
+        }
+    }
+
+    fn warn(&mut self, d: Diagnostic) -> Result<(), Diagnostic> {
+        if self.strict {
+            return Err(d);
+        }
+        self.warnings.push(d);
+        Ok(())
+    }
+}
+
+/// "line N", or "line N of FILE" when `file` is not `here`, for a message about a place
+/// that an error elsewhere refers to.
+fn at(file: &Path, line: u32, here: &Path) -> String {
+    if file == here {
+        format!("line {line}")
+    } else {
+        format!("line {line} of {}", file.display())
+    }
+}
+
+fn v3(n: &[f64]) -> DVec3 {
+    match n {
+        [x, y, z, ..] => DVec3::new(*x, *y, *z),
+        _ => DVec3::ZERO,
+    }
+}
+
+fn scaled(v: Value, k: f64) -> Value {
+    if k == 1.0 {
+        return v;
+    }
+    match v {
+        Value::Table(mut t) => {
+            let s0 = t.get("scale").and_then(Value::as_float).unwrap_or(1.0);
+            t.insert("scale".into(), float(s0 * k));
+            Value::Table(t)
+        }
+        Value::Float(x) => float(x * k),
+        Value::Array(a) => Value::Array(
+            a.into_iter()
+                .map(|x| float(x.as_float().unwrap_or(0.0) * k))
+                .collect(),
+        ),
+        v => v,
+    }
+}

@@ -1,0 +1,682 @@
+//! pbrt-v4's materials, lights, shapes and camera in heron's terms: the translation
+//! of what the directives (`directives.rs`) hand over, and the placement of each shape
+//! with its matrix.
+use super::tokens::Params;
+use super::*;
+
+impl Conv {
+    /// A reflectance parameter ([`Self::colour_as`] for a reflectance).
+    pub(super) fn colour(
+        &mut self,
+        path: &Path,
+        p: &Params,
+        name: &str,
+        default: f64,
+    ) -> Result<Value, Diagnostic> {
+        self.colour_as(path, p, name, default, false)
+    }
+
+    /// A light's spectrum ([`Self::colour_as`] for an emission).
+    pub(super) fn emission(
+        &mut self,
+        path: &Path,
+        p: &Params,
+        name: &str,
+        default: f64,
+    ) -> Result<Value, Diagnostic> {
+        self.colour_as(path, p, name, default, true)
+    }
+
+    /// A colour parameter: "rgb", a "spectrum" (one number, λ value pairs, a file of
+    /// them, or the named illuminants stdillum-D65 and stdillum-A), a "blackbody"
+    /// temperature, or a "float". For a light (`emission`), pbrt-v4 scales every
+    /// spectrum to luminance 1 (`scale /= SpectrumToPhotometric(L)` in each light's
+    /// `Create`; for RGB only the colour space's illuminant counts), which heron's
+    /// blackbody and named illuminants already are and a table is given as a `scale`.
+    /// pbrt-v4's `PiecewiseLinearSpectrum` is zero beyond its ends, as Mitsuba's is.
+    pub(super) fn colour_as(
+        &mut self,
+        path: &Path,
+        p: &Params,
+        name: &str,
+        default: f64,
+        emission: bool,
+    ) -> Result<Value, Diagnostic> {
+        use crate::scene::import::props::{mitsuba_samples, read_spd, ColourValue};
+        let Some(q) = p.get(name) else {
+            return Ok(float(default));
+        };
+        let bad =
+            |this: &Self, m: String| this.diag(path, q.line, format!("\"{} {name}\": {m}", q.ty));
+        let table_colour = |pairs: Vec<(f64, f64)>| {
+            let samples = mitsuba_samples(&pairs);
+            let scale = if emission {
+                let dense = crate::spectrum::DenseSpectrum::from_samples(
+                    &samples
+                        .iter()
+                        .map(|&(l, v)| (l as f32, v as f32))
+                        .collect::<Vec<_>>(),
+                );
+                let y = crate::spectrum::cie::spectrum_to_xyz(&dense)[1] as f64;
+                if y > 0.0 {
+                    1.0 / y
+                } else {
+                    1.0
+                }
+            } else {
+                1.0
+            };
+            ColourValue::Samples { samples, scale }.to_toml()
+        };
+        match (q.ty.as_str(), q.nums.as_slice(), q.strs.as_slice()) {
+            ("rgb", [r, g, b], _) => Ok(Value::Array(vec![float(*r), float(*g), float(*b)])),
+            ("spectrum" | "float", [v], []) => Ok(float(*v)),
+            ("blackbody", [k], _) => {
+                if !emission {
+                    return Err(bad(self, "a blackbody is an emission spectrum".into()));
+                }
+                let (lo, hi) = crate::spectrum::blackbody::KELVIN_RANGE;
+                if !(lo..=hi).contains(k) {
+                    return Err(bad(self, format!("expected kelvin within [{lo}, {hi}], got {k}")));
+                }
+                Ok(ColourValue::Blackbody { kelvin: *k, scale: 1.0 }.to_toml())
+            }
+            ("spectrum", nums, []) if nums.len() >= 4 && nums.len() % 2 == 0 => {
+                let pairs: Vec<(f64, f64)> = nums.chunks(2).map(|c| (c[0], c[1])).collect();
+                if pairs.windows(2).any(|w| !(w[1].0 > w[0].0)) || pairs.iter().any(|(_, v)| !(*v >= 0.0)) {
+                    return Err(bad(self, "expected wavelength value pairs, wavelengths increasing, values ≥ 0".into()));
+                }
+                Ok(table_colour(pairs))
+            }
+            ("spectrum", [], [n]) if n == "stdillum-D65" || n == "stdillum-A" => {
+                let name = if n == "stdillum-A" { "A" } else { "D65" };
+                let mut t = Table::new();
+                t.insert("spectrum".into(), Value::String(name.into()));
+                if !emission {
+                    // A reflectance must stay within [0, 1]: the named illuminants are
+                    // scaled to luminance 1, so only as lights.
+                    return Err(bad(self, "a named illuminant is an emission spectrum".into()));
+                }
+                Ok(Value::Table(t))
+            }
+            ("spectrum", [], [f]) if !f.starts_with("metal-") && !f.starts_with("glass-") && !f.contains("illum") && !f.starts_with("canon") && !f.starts_with("nikon") && !f.starts_with("sony") => {
+                let full = self.base_of(path).join(f);
+                let pairs = read_spd(&full).map_err(|e| bad(self, e))?;
+                Ok(table_colour(pairs))
+            }
+            ("spectrum", _, _) | ("texture", _, _) => {
+                self.warn(self.diag(path, q.line, format!("\"{} {name}\": this named spectrum or texture is not supported yet (rgb, blackbody, λ value pairs, .spd files, stdillum-D65 and stdillum-A are); {default} is used", q.ty)))?;
+                Ok(float(default))
+            }
+            _ => Err(self.diag(
+                path,
+                q.line,
+                format!(
+                    "\"{} {name}\": expected three rgb values, one number, wavelength value pairs, a spectrum file or a blackbody temperature",
+                    q.ty
+                ),
+            )),
+        }
+    }
+
+    pub(super) fn alpha(&mut self, p: &Params) -> Option<f64> {
+        let remap = p.string("remaproughness") != Some("false");
+        let r = p.float("roughness").or_else(|| {
+            let (u, v) = (p.float("uroughness"), p.float("vroughness"));
+            match (u, v) {
+                (Some(u), Some(v)) => Some(0.5 * (u + v)),
+                (Some(u), None) | (None, Some(u)) => Some(u),
+                _ => None,
+            }
+        })?;
+        Some(if remap { r.max(0.0).sqrt() } else { r })
+    }
+
+    pub(super) fn material(
+        &mut self,
+        path: &Path,
+        line: u32,
+        ty: &str,
+        p: &Params,
+        name: Option<&str>,
+    ) -> Result<String, Diagnostic> {
+        let t = match ty {
+            "diffuse" => table(vec![
+                ("type", s("lambertian")),
+                ("rho_d", self.colour(path, p, "reflectance", 0.5)?),
+            ]),
+            "dielectric" | "thindielectric" => {
+                if ty == "thindielectric" {
+                    self.warn(self.diag(
+                        path,
+                        line,
+                        "thindielectric is not supported yet; rendered as a solid dielectric",
+                    ))?;
+                }
+                let ior = match p.get("eta") {
+                    None => float(1.5),
+                    Some(q) => match (q.ty.as_str(), q.nums.first(), q.strs.first()) {
+                        (_, Some(v), _) => float(*v),
+                        ("spectrum", None, Some(n)) => match n.as_str() {
+                            "glass-BK7" => s("N-BK7"),
+                            "glass-F11" | "glass-SF11" => s("N-SF11"),
+                            "fused silica" | "glass-fused-silica" => s("fused-silica"),
+                            other => return Err(self.diag(path, q.line, format!("\"spectrum eta\": expected a number or one of glass-BK7, glass-F11 (heron's N-SF11), got {other:?}"))),
+                        },
+                        _ => return Err(self.diag(path, q.line, "\"eta\": expected a number or a named spectrum")),
+                    },
+                };
+                let mut t = table(vec![("type", s("dielectric")), ("ior", ior)]);
+                if let Some(a) = self.alpha(p) {
+                    if a > 0.0 {
+                        t.insert("roughness".into(), float(a.min(1.0)));
+                    }
+                }
+                p.get("remaproughness");
+                t
+            }
+            "conductor" => {
+                let metal = match (p.get("eta"), p.get("k"), p.get("reflectance")) {
+                    (None, None, None) => s("Cu"),
+                    (Some(e), Some(k), _) => match (e.nums.first(), k.nums.first(), e.strs.first(), k.strs.first()) {
+                        (Some(n), Some(kk), _, _) => Value::Table(table(vec![("n", float(*n)), ("k", float(*kk))])),
+                        (_, _, Some(a), Some(b)) => {
+                            let m = a.strip_prefix("metal-").and_then(|x| x.strip_suffix("-eta"));
+                            let m2 = b.strip_prefix("metal-").and_then(|x| x.strip_suffix("-k"));
+                            match (m, m2) {
+                                (Some(m), Some(m2)) if m == m2 && ["Ag", "Al", "Au", "Cu"].contains(&m) => s(m),
+                                _ => return Err(self.diag(path, e.line, format!("conductor: expected metal-Ag/Al/Au/Cu-eta and -k spectra or numbers, got {a:?} and {b:?}"))),
+                            }
+                        }
+                        _ => return Err(self.diag(path, e.line, "conductor: expected eta and k both as numbers or both as named spectra")),
+                    },
+                    (_, _, Some(q)) => return Err(self.diag(path, q.line, "conductor: \"reflectance\" (an artist's colour) is not supported; give eta and k")),
+                    (Some(q), None, _) | (None, Some(q), _) => return Err(self.diag(path, q.line, "conductor: expected both eta and k")),
+                };
+                let mut t = table(vec![("type", s("conductor")), ("metal", metal)]);
+                if let Some(a) = self.alpha(p) {
+                    if a > 0.0 {
+                        t.insert("roughness".into(), float(a.min(1.0)));
+                    }
+                }
+                p.get("remaproughness");
+                t
+            }
+            "coateddiffuse" => {
+                let rho = self.colour(path, p, "reflectance", 0.5)?;
+                let a = self.alpha(p).unwrap_or(0.0).max(0.01);
+                let shininess = (2.0 / (a * a) - 2.0).max(1.0);
+                let eta = p.float("eta").unwrap_or(1.5);
+                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+                p.get("remaproughness");
+                p.get("thickness");
+                self.warn(self.diag(path, line, format!("coateddiffuse is mapped to heron's glossy (modified Phong): ρd = reflectance, ρs = {f0:.4} (Fresnel at normal incidence), shininess {shininess:.0}")))?;
+                table(vec![
+                    ("type", s("glossy")),
+                    ("rho_d", rho),
+                    ("rho_s", float(f0)),
+                    ("shininess", float(shininess)),
+                ])
+            }
+            other => {
+                for q in &p.0 {
+                    q.used.set(true);
+                }
+                self.warn(self.diag(path, line, format!("material {other:?} is not supported (diffuse, dielectric, conductor, coateddiffuse are); a diffuse 0.5 is used")))?;
+                return Ok(self.default_material());
+            }
+        };
+        p.get("type");
+        p.get("displacement");
+        self.n_material += 1;
+        let key = match name {
+            Some(n) => n.to_string(),
+            None => format!("{ty}-{}", self.n_material),
+        };
+        self.materials.insert(key.clone(), Value::Table(t));
+        Ok(key)
+    }
+
+    pub(super) fn default_material(&mut self) -> String {
+        if let Some(m) = &self.default_material {
+            return m.clone();
+        }
+        let k = "pbrt-default-diffuse".to_string();
+        self.materials.insert(
+            k.clone(),
+            Value::Table(table(vec![
+                ("type", s("lambertian")),
+                ("rho_d", float(0.5)),
+            ])),
+        );
+        self.default_material = Some(k.clone());
+        k
+    }
+
+    pub(super) fn light(
+        &mut self,
+        path: &Path,
+        line: u32,
+        kind: &str,
+        p: &Params,
+    ) -> Result<(), Diagnostic> {
+        let scale = p.float("scale").unwrap_or(1.0);
+        let m = self.g.ctm;
+        match kind {
+            "point" => {
+                let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
+                let i = self.emission(path, p, "I", 1.0)?;
+                self.lights.push(Value::Table(table(vec![
+                    ("type", s("point")),
+                    ("position", vec3(m.transform_point3(from))),
+                    ("intensity", scaled(i, scale)),
+                ])));
+            }
+            "spot" => {
+                let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
+                let to = p.get("to").map_or(DVec3::Z, |q| v3(&q.nums));
+                let i = self.emission(path, p, "I", 1.0)?;
+                let cone = p.float("coneangle").unwrap_or(30.0);
+                let delta = p.float("conedelta").unwrap_or(5.0);
+                self.lights.push(Value::Table(table(vec![
+                    ("type", s("spot")),
+                    ("position", vec3(m.transform_point3(from))),
+                    ("direction", vec3(m.transform_vector3(to - from))),
+                    ("intensity", scaled(i, scale)),
+                    ("cone_angle", float(cone)),
+                    ("cone_delta", float(delta)),
+                ])));
+            }
+            "distant" => {
+                let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
+                let to = p.get("to").map_or(DVec3::Z, |q| v3(&q.nums));
+                let l = self.emission(path, p, "L", 1.0)?;
+                self.lights.push(Value::Table(table(vec![
+                    ("type", s("directional")),
+                    ("direction", vec3(m.transform_vector3(to - from))),
+                    ("radiance", scaled(l, scale)),
+                ])));
+            }
+            "infinite" if p.get("filename").is_none() => {
+                let l = self.emission(path, p, "L", 1.0)?;
+                self.background = Some(scaled(l, scale));
+            }
+            "infinite" => {
+                // pbrt-v4's ImageInfiniteLight: a square image on the equal-area
+                // octahedral map, in the light's frame (the CTM), looked up nearest.
+                let f = p.string("filename").unwrap_or_default().to_string();
+                if p.get("L").is_some() {
+                    return Err(self.diag(path, line, "LightSource \"infinite\": both \"L\" and \"filename\" are given (pbrt-v4 refuses that too)"));
+                }
+                if p.get("illuminance").is_some() {
+                    self.warn(self.diag(path, line, "LightSource \"infinite\": \"illuminance\" (rescaling the map to an illuminance) is not supported, ignored"))?;
+                }
+                if p.get("portal").is_some() {
+                    for q in &p.0 {
+                        q.used.set(true);
+                    }
+                    // PortalImageInfiniteLight lays the image out in the portal's frame,
+                    // not on the equal-area square.
+                    self.warn(self.diag(path, line, "LightSource \"infinite\" with a \"portal\" is not supported yet, ignored: the image lacks its light"))?;
+                    return Ok(());
+                }
+                let full = self.base_of(path).join(&f);
+                let rel = relative_to(&full, &self.base);
+                // The rotation of the CTM (a uniform scale divided out: pbrt normalises
+                // the direction), without its translation.
+                let lin = glam::DMat3::from_mat4(m);
+                let s3 = lin.determinant().abs().cbrt();
+                let lin = if s3 > 0.0 { lin * (1.0 / s3) } else { lin };
+                let mut rows = Vec::new();
+                for r in 0..3 {
+                    let row = lin.row(r);
+                    rows.push(crate::scene::import::mitsuba::vec_row([
+                        row.x, row.y, row.z, 0.0,
+                    ]));
+                }
+                rows.push(crate::scene::import::mitsuba::vec_row([0.0, 0.0, 0.0, 1.0]));
+                let mut t = table(vec![
+                    ("map", s(&rel.to_string_lossy().replace('\\', "/"))),
+                    ("mapping", s("equal-area")),
+                    ("scale", float(scale)),
+                ]);
+                if lin != glam::DMat3::IDENTITY {
+                    t.insert("transform".into(), Value::Array(rows));
+                }
+                if self.environment.is_some() || self.background.is_some() {
+                    self.warn(self.diag(
+                        path,
+                        line,
+                        "a second infinite light; heron's environment is the first, ignored",
+                    ))?;
+                } else {
+                    self.environment = Some(Value::Table(t));
+                }
+            }
+            other => {
+                for q in &p.0 {
+                    q.used.set(true);
+                }
+                self.warn(self.diag(path, line, format!("LightSource {other:?} is not supported yet (point, spot, distant, infinite are), ignored: the image lacks its light")))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A `Shape` directive: its geometry read once, then placed now (a shape in the
+    /// world) or kept with the graphics state for each `ObjectInstance` (a shape in an
+    /// object definition; pbrt-v4 `BasicSceneBuilder::Shape` keeps the CTM, reverse
+    /// orientation and material current here, so a copy has the definition's material).
+    pub(super) fn shape(
+        &mut self,
+        path: &Path,
+        line: u32,
+        kind: &str,
+        p: &Params,
+    ) -> Result<(), Diagnostic> {
+        let Some(geom) = self.geometry(path, line, kind, p)? else {
+            return Ok(());
+        };
+        let material = match self.g.material.clone() {
+            Some(mm) => mm,
+            None => self.default_material(),
+        };
+        let mut area = self.g.area.clone();
+        if let Some(o) = &self.object {
+            if area.is_some() {
+                // pbrt-v4 warns "Area lights not supported with object instancing" and
+                // makes the lights of the world's shapes only (`BasicScene::CreateLights`),
+                // so an instance's copies do not emit.
+                let m = format!("Shape {kind:?} inside ObjectBegin {:?}: area lights are not supported in object instances (as in pbrt-v4), so its copies do not emit", o.name);
+                self.warn(self.diag(path, line, m))?;
+                area = None;
+            }
+        }
+        let sd = ShapeDef {
+            geom,
+            ctm: self.g.ctm,
+            reverse: self.g.reverse,
+            material,
+            area,
+            file: path.to_path_buf(),
+            line,
+        };
+        match &mut self.object {
+            Some(o) => o.shapes.push(sd),
+            None => {
+                for v in self.emit(&sd, None)? {
+                    self.shapes.push(Slot::Shape(v));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A shape's geometry in its own space, its parameters checked; `None` (and a
+    /// warning) for a shape heron does not have.
+    pub(super) fn geometry(
+        &mut self,
+        path: &Path,
+        line: u32,
+        kind: &str,
+        p: &Params,
+    ) -> Result<Option<Geom>, Diagnostic> {
+        Ok(Some(match kind {
+            "sphere" => {
+                let radius = p.float("radius").unwrap_or(1.0);
+                for k in ["zmin", "zmax", "phimax"] {
+                    if p.get(k).is_some() {
+                        self.warn(self.diag(path, line, format!("Shape \"sphere\": {k} (a partial sphere) is not supported, the whole sphere is used")))?;
+                    }
+                }
+                Geom::Sphere { radius }
+            }
+            "trianglemesh" | "bilinearmesh" => {
+                let kind = if kind == "trianglemesh" {
+                    "trianglemesh"
+                } else {
+                    "bilinearmesh"
+                };
+                let pts = p.get("P").map(|q| q.nums.clone()).unwrap_or_default();
+                let idx = p.get("indices").map(|q| q.nums.clone());
+                if pts.len() % 3 != 0 || pts.is_empty() {
+                    return Err(self.diag(path, line, format!("Shape {kind:?}: expected \"point3 P\" with a multiple of 3 numbers, got {}", pts.len())));
+                }
+                let n = pts.len() / 3;
+                let points: Vec<DVec3> = pts
+                    .chunks(3)
+                    .map(|c| DVec3::new(c[0], c[1], c[2]))
+                    .collect();
+                let per = if kind == "trianglemesh" { 3 } else { 4 };
+                let idx = idx.unwrap_or_else(|| {
+                    if n == per {
+                        (0..per).map(|i| i as f64).collect()
+                    } else {
+                        Vec::new()
+                    }
+                });
+                if idx.is_empty() || idx.len() % per != 0 {
+                    return Err(self.diag(
+                        path,
+                        line,
+                        format!("Shape {kind:?}: expected \"integer indices\", {per} per face"),
+                    ));
+                }
+                let mut faces = Vec::with_capacity(idx.len() / per);
+                for f in idx.chunks(per) {
+                    let mut ix = Vec::with_capacity(per);
+                    for &v in f {
+                        if !(v >= 0.0 && (v as usize) < n && v.fract() == 0.0) {
+                            return Err(self.diag(
+                                path,
+                                line,
+                                format!("Shape {kind:?}: index {v} is not one of the {n} vertices"),
+                            ));
+                        }
+                        ix.push(v as usize);
+                    }
+                    faces.push(ix);
+                }
+                for k in ["N", "uv", "S", "faceIndices"] {
+                    p.get(k);
+                }
+                Geom::Mesh {
+                    kind,
+                    points,
+                    faces,
+                }
+            }
+            "plymesh" => {
+                let Some(f) = p.string("filename").map(str::to_string) else {
+                    return Err(self.diag(
+                        path,
+                        line,
+                        "Shape \"plymesh\": expected \"string filename\"",
+                    ));
+                };
+                if f.ends_with(".gz") {
+                    return Err(self.diag(
+                        path,
+                        line,
+                        "Shape \"plymesh\": gzipped PLY files are not supported; unpack the file",
+                    ));
+                }
+                let full = self.base_of(path).join(&f);
+                let rel = relative_to(&full, &self.base);
+                for k in ["displacement", "edgelength"] {
+                    if p.get(k).is_some() {
+                        self.warn(self.diag(
+                            path,
+                            line,
+                            format!("Shape \"plymesh\": {k} is not supported, ignored"),
+                        ))?;
+                    }
+                }
+                Geom::Ply {
+                    file: rel.to_string_lossy().replace('\\', "/"),
+                }
+            }
+            other => {
+                for q in &p.0 {
+                    q.used.set(true);
+                }
+                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
+                return Ok(None);
+            }
+        }))
+    }
+
+    /// The heron shape tables of `sd` placed by its CTM, or for an `ObjectInstance`
+    /// (`inst`: the object's name, the instance's CTM, file and line) by CTM(instance) ·
+    /// CTM(shape). What depends on the whole matrix (a sphere's uniform scale, a mirror
+    /// flipping the winding) is decided here, a copy's message naming the instance.
+    pub(super) fn emit(
+        &mut self,
+        sd: &ShapeDef,
+        inst: Option<(&str, DMat4, &Path, u32)>,
+    ) -> Result<Vec<Value>, Diagnostic> {
+        let m = match inst {
+            Some((_, ctm, _, _)) => ctm * sd.ctm,
+            None => sd.ctm,
+        };
+        // Where a message about the placed shape points: the shape, or the instance
+        // (whose transform is the one to fix), naming the shape's line.
+        let (file, line, ctx) = match inst {
+            Some((name, _, f, l)) => (
+                f.to_path_buf(),
+                l,
+                format!(
+                    "ObjectInstance {name:?}, the shape of {}: ",
+                    at(&sd.file, sd.line, f)
+                ),
+            ),
+            None => (sd.file.clone(), sd.line, String::new()),
+        };
+        let flip = sd.reverse ^ (m.determinant() < 0.0);
+        let mut entries: Vec<Table> = Vec::new();
+        match &sd.geom {
+            Geom::Sphere { radius } => {
+                let m3 = glam::DMat3::from_mat4(m);
+                let sc = [m3.x_axis.length(), m3.y_axis.length(), m3.z_axis.length()];
+                if (sc[0] - sc[1]).abs() > 1e-6 * sc[0] || (sc[0] - sc[2]).abs() > 1e-6 * sc[0] {
+                    return Err(self.diag(
+                        &file,
+                        line,
+                        format!("{ctx}Shape \"sphere\": heron's spheres take a uniform scale only"),
+                    ));
+                }
+                entries.push(table(vec![
+                    ("type", s("sphere")),
+                    ("center", vec3(m.transform_point3(DVec3::ZERO))),
+                    ("radius", float(radius * sc[0])),
+                ]));
+            }
+            Geom::Mesh {
+                kind,
+                points,
+                faces,
+            } => {
+                let verts: Vec<DVec3> = points.iter().map(|&q| m.transform_point3(q)).collect();
+                for ix in faces {
+                    // A flat parallelogram patch (p00, p10, p01, p11) is heron's quad,
+                    // normal (p10 − p00) × (p01 − p00) as pbrt's; others two triangles.
+                    if *kind == "bilinearmesh" {
+                        let (o, a, b, c) = (verts[ix[0]], verts[ix[1]], verts[ix[2]], verts[ix[3]]);
+                        let scale = (a - o).length().max((b - o).length());
+                        if (c - (a + b - o)).length() <= 1e-9 * scale {
+                            let (e1, e2) = if flip { (b - o, a - o) } else { (a - o, b - o) };
+                            entries.push(table(vec![
+                                ("type", s("quad")),
+                                ("origin", vec3(o)),
+                                ("edge1", vec3(e1)),
+                                ("edge2", vec3(e2)),
+                            ]));
+                            continue;
+                        }
+                    }
+                    // pbrt's bilinear patch (p00, p10, p01, p11) as two triangles.
+                    let tris: Vec<[usize; 3]> = if *kind == "trianglemesh" {
+                        vec![[ix[0], ix[1], ix[2]]]
+                    } else {
+                        vec![[ix[0], ix[1], ix[3]], [ix[0], ix[3], ix[2]]]
+                    };
+                    for t in tris {
+                        let t = if flip { [t[0], t[2], t[1]] } else { t };
+                        entries.push(table(vec![
+                            ("type", s("triangle")),
+                            (
+                                "vertices",
+                                Value::Array(t.iter().map(|&k| vec3(verts[k])).collect()),
+                            ),
+                        ]));
+                    }
+                }
+            }
+            Geom::Ply { file: f } => {
+                if flip {
+                    self.warn(self.diag(&file, line, format!("{ctx}Shape \"plymesh\": ReverseOrientation or a mirroring transform on a mesh is not supported, ignored")))?;
+                }
+                let mut t = table(vec![("type", s("mesh")), ("file", s(f))]);
+                if m != DMat4::IDENTITY {
+                    t.insert(
+                        "transform".into(),
+                        Value::Array(
+                            (0..4)
+                                .map(|r| {
+                                    Value::Array(
+                                        m.row(r).to_array().iter().map(|x| float(*x)).collect(),
+                                    )
+                                })
+                                .collect(),
+                        ),
+                    );
+                }
+                entries.push(t);
+            }
+        }
+        Ok(entries
+            .into_iter()
+            .map(|mut e| {
+                e.insert("material".into(), s(&sd.material));
+                if let Some((l, two)) = &sd.area {
+                    e.insert("emission".into(), l.clone());
+                    if *two {
+                        e.insert("two_sided".into(), Value::Boolean(true));
+                    }
+                }
+                Value::Table(e)
+            })
+            .collect())
+    }
+
+    pub(super) fn finish_camera(&mut self, path: &Path) -> Result<(), Diagnostic> {
+        let Some((cfw, line, file, fov)) = self.camera_from_world.clone() else {
+            return Err(self.diag(path, 1, "expected a Camera \"perspective\" directive"));
+        };
+        let wfc = cfw.inverse();
+        let eye = wfc.transform_point3(DVec3::ZERO);
+        let look = wfc.transform_point3(DVec3::Z);
+        let up = wfc.transform_vector3(DVec3::Y);
+        let right = wfc.transform_vector3(DVec3::X);
+        // heron's image right is forward × up; pbrt's is the camera's +x.
+        if right.dot((look - eye).cross(up)) < 0.0 {
+            self.warn(self.diag(&file, line, "Camera: pbrt's camera space is left-handed, so this camera shows the scene mirrored in pbrt; heron renders it unmirrored (a Scale -1 1 1 before LookAt makes the two agree)"))?;
+        }
+        let (w, h) = self.resolution;
+        let aspect = w as f64 / h as f64;
+        // pbrt's fov spans the shorter image axis.
+        let t = (0.5 * fov.to_radians()).tan();
+        let tan_y = if aspect >= 1.0 { t } else { t / aspect };
+        self.camera = Some(table(vec![
+            ("eye", vec3(eye)),
+            ("look_at", vec3(look)),
+            ("up", vec3(up)),
+            ("d", float(0.5 / tan_y)),
+            (
+                "resolution",
+                Value::Array(vec![Value::Integer(w), Value::Integer(h)]),
+            ),
+        ]));
+        Ok(())
+    }
+}
