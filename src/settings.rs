@@ -28,20 +28,6 @@ pub enum IntegratorKind {
 impl IntegratorKind {
     pub const NAMES: &'static [&'static str] = &["whitted", "path", "lighttrace", "bdpt", "sppm"];
 
-    /// Whether the integrator adds to other pixels than the one it samples.
-    pub fn splats(self) -> bool {
-        matches!(
-            self,
-            IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm
-        )
-    }
-
-    /// Whether it starts from the camera ray of the pixel sample (light tracing does
-    /// not, so the renderer traces no camera packets for it).
-    pub fn uses_camera_rays(self) -> bool {
-        !matches!(self, IntegratorKind::LightTrace)
-    }
-
     pub fn parse(name: &str) -> Result<IntegratorKind, String> {
         match name {
             "whitted" => Ok(IntegratorKind::Whitted),

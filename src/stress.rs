@@ -339,26 +339,45 @@ pub fn shape_case(
         scene.material_names[shape.material as usize]
     );
     let label = name.clone();
+    let target = ShapeTarget {
+        scene,
+        accel,
+        offset,
+        index,
+        closed,
+        label: &label,
+    };
     chunked(name, rays, seed, 1 << 32 | index as u64, |rng, n, r| {
         let budget = r.rays + n;
         while r.rays < budget {
-            shape_sample(scene, accel, offset, index, closed, rng, r, &label);
+            shape_sample(&target, rng, r);
         }
     })
 }
 
-/// One ray at the shape and its three continuations.
-#[allow(clippy::too_many_arguments)]
-fn shape_sample(
-    scene: &Scene,
-    accel: &embree::Scene,
+/// The shape a case aims at: shape `index` of `scene`, traced in `accel` with rays
+/// leaving surfaces by `offset`; `closed` is [`closed_shapes`] of the scene and `label`
+/// names the case in failures.
+#[derive(Clone, Copy)]
+struct ShapeTarget<'a> {
+    scene: &'a Scene,
+    accel: &'a embree::Scene,
     offset: RayOffset,
     index: usize,
-    closed: &[bool],
-    rng: &mut Rng,
-    r: &mut CaseReport,
-    label: &str,
-) {
+    closed: &'a [bool],
+    label: &'a str,
+}
+
+/// One ray at the shape and its three continuations.
+fn shape_sample(target: &ShapeTarget, rng: &mut Rng, r: &mut CaseReport) {
+    let ShapeTarget {
+        scene,
+        accel,
+        offset,
+        index,
+        closed,
+        label,
+    } = *target;
     let (p, n, size) = shape_point(&scene.shapes[index], rng);
     // From outside for closed shapes; from either side for open ones.
     let side = if closed[index] || rng.uniform() < 0.5 {

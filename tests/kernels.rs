@@ -5,6 +5,7 @@
 //! course's scenes get the kernels their contents imply.
 mod common;
 
+use heron::integrator::kernel_flags;
 use heron::render::{render, RenderOptions};
 use heron::scene::{Features, Scene};
 use heron::settings::IntegratorKind;
@@ -52,7 +53,7 @@ fn specialised_kernels_give_the_general_kernels_image() {
             let (auto, k) = image(&s, kind, KernelChoice::Auto);
             let (general, g) = image(&s, kind, KernelChoice::General);
             assert_eq!(g, ALL);
-            assert_eq!(k, Features::of(&s).kernel(kind), "{name}");
+            assert_eq!(k, kernel_flags(kind, &Features::of(&s)), "{name}");
             assert!(
                 auto == general,
                 "{name}, {}: kernel {} differs from the general kernel",
@@ -82,7 +83,7 @@ fn a_kernel_without_a_feature_the_scene_uses_changes_the_image() {
     ];
     for (name, kind, flag) in cases {
         let s = scene(name);
-        let need = Features::of(&s).kernel(kind);
+        let need = kernel_flags(kind, &Features::of(&s));
         assert!(need & flag != 0, "{name} should need {}", flag_names(flag));
         let (full, _) = image(&s, kind, KernelChoice::Auto);
         let (without, k) = image(&s, kind, KernelChoice::Forced(need & !flag));
@@ -97,7 +98,7 @@ fn a_kernel_without_a_feature_the_scene_uses_changes_the_image() {
 
 #[test]
 fn course_scenes_get_the_kernels_their_contents_imply() {
-    let w = |name: &str| Features::of(&scene(name)).kernel(IntegratorKind::Whitted);
+    let w = |name: &str| kernel_flags(IntegratorKind::Whitted, &Features::of(&scene(name)));
     // A point light over Lambertian shapes under a blue background.
     assert_eq!(w("default.toml"), SHADOWS | ESCAPE);
     assert_eq!(w("default-mirror.toml"), SHADOWS | SPECULAR | ESCAPE);
@@ -105,9 +106,9 @@ fn course_scenes_get_the_kernels_their_contents_imply() {
     // Mitsuba's Cornell box: an area light, diffuse walls, nothing outside the box.
     let c = scene("cornell-box.toml");
     assert_eq!(
-        Features::of(&c).kernel(IntegratorKind::Path),
+        kernel_flags(IntegratorKind::Path, &Features::of(&c)),
         SHADOWS | EMITTERS
     );
     // Light tracing and BDPT have one kernel.
-    assert_eq!(Features::of(&c).kernel(IntegratorKind::Bdpt), ALL);
+    assert_eq!(kernel_flags(IntegratorKind::Bdpt, &Features::of(&c)), ALL);
 }

@@ -4,6 +4,7 @@
 use glam::Vec3;
 use heron::bsdf::Material;
 use heron::geometry::{Shape, ShapeKind};
+use heron::integrator::{choose_kernel, kernel_flags};
 use heron::light::Light;
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{load_scene, Features, Scene};
@@ -990,17 +991,20 @@ fn features_follow_the_materials_in_use() {
             ..none
         }
     );
-    assert_eq!(f.kernel(IntegratorKind::Whitted), SHADOWS | EMITTERS);
     assert_eq!(
-        flag_names(f.kernel(IntegratorKind::Whitted)),
+        kernel_flags(IntegratorKind::Whitted, &f),
+        SHADOWS | EMITTERS
+    );
+    assert_eq!(
+        flag_names(kernel_flags(IntegratorKind::Whitted, &f)),
         "shadows+emitters"
     );
     assert_eq!(
-        f.choose(IntegratorKind::Whitted, KernelChoice::General),
+        choose_kernel(IntegratorKind::Whitted, &f, KernelChoice::General),
         Ok(ALL)
     );
     assert_eq!(
-        f.choose(IntegratorKind::Whitted, KernelChoice::Auto),
+        choose_kernel(IntegratorKind::Whitted, &f, KernelChoice::Auto),
         Ok(SHADOWS | EMITTERS)
     );
 }

@@ -105,7 +105,6 @@ fn image_arg(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Image
 /// bad options) raise HeronError, where the CLI exits with status 2.
 #[pyfunction]
 #[pyo3(signature = (a, b, *, region=16, alpha=0.01, correction="sidak", mask=None, heatmap=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,

@@ -187,7 +187,6 @@ impl Scene {
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
     #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None, polarization=None, polarizer=None))]
-    #[allow(clippy::too_many_arguments)]
     fn render(
         &self,
         py: Python<'_>,

@@ -102,7 +102,6 @@ pub fn trace<'py>(
 /// distribution: ⟨dσ/dΩ⟩/⟨πa²⟩); the texture's radiance for aristotle.
 #[pyfunction]
 #[pyo3(signature = (model, wavelengths, theta, *, sun_radius=0.2666, droplet_radius=None, k=None, polarisation=None, background=None, drops=None, debye=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn sky_profile<'py>(
     py: Python<'py>,
     model: &str,

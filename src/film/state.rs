@@ -23,7 +23,7 @@ use super::{linear_srgb_f64, Film, SpectralBins, Splats};
 /// An integrator's own per-pixel state, which a resumed render continues from (photon
 /// mapping's photon counts and radii): the film keeps and writes it, but neither adds
 /// nor normalises it, and a merge of shards drops it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct IntegratorPlane {
     /// Whose state it is (`"sppm"`).
     pub name: String,

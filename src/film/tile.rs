@@ -7,13 +7,18 @@ use super::{add_stokes_to_bins, add_to_bins, rgb_squares, xyz_of_sample, Spectra
 use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
-/// What one pixel sample gives the film: radiance, or Stokes radiance in a polarised
-/// render (whose S0 is the radiance and whose S1–S3 go to planes of their own). The tile
-/// sums are generic over it, so an unpolarised render runs code with no Stokes in it
-/// (`STOKES` false).
+/// What one pixel sample or one connection gives the film: radiance, or Stokes radiance
+/// in a polarised render (whose S0 is the radiance and whose S1–S3 go to planes of
+/// their own). The tile sums and splats are generic over it, so an unpolarised render
+/// runs code with no Stokes in it (`STOKES` false); the integrators' transport
+/// (`integrator::transport::Transport::Value`) is one of the two.
 pub trait SampleValue<const N: usize>: Copy {
     const STOKES: bool;
     fn zero() -> Self;
+    /// Adds `self` to `own` when it is finite (a connection to its pixel sample's value).
+    fn add_to(&self, own: &mut Self);
+    /// Splats `self` into `pixel`.
+    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>);
     /// The radiance (S0).
     fn s0(&self) -> SampledSpectrum<N>;
     /// S1, S2, S3 as XYZ, in fixed point; None when any is out of the film's range.
@@ -27,6 +32,16 @@ impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
     #[inline(always)]
     fn zero() -> Self {
         SampledSpectrum::zero()
+    }
+    #[inline]
+    fn add_to(&self, own: &mut Self) {
+        if self.is_finite() {
+            *own += *self;
+        }
+    }
+    #[inline]
+    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>) {
+        splats.add(pixel, self, wl);
     }
     #[inline(always)]
     fn s0(&self) -> SampledSpectrum<N> {
@@ -47,6 +62,16 @@ impl<const N: usize> SampleValue<N> for StokesSpectrum<N> {
     #[inline]
     fn zero() -> Self {
         StokesSpectrum::zero()
+    }
+    #[inline]
+    fn add_to(&self, own: &mut Self) {
+        if self.is_finite() {
+            *own += *self;
+        }
+    }
+    #[inline]
+    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>) {
+        splats.add_stokes(pixel, self, wl);
     }
     #[inline]
     fn s0(&self) -> SampledSpectrum<N> {

@@ -19,46 +19,37 @@
 //!
 //! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
 //! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
-use super::toolkit::{
-    next_hit, pixel_of, roulette, Connection, Connections, LightCarrier, LightPathStart,
-    Unpolarized,
-};
-use super::{Context, TraceCounters};
+use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE};
+use super::toolkit::{next_hit, pixel_of, roulette, Connection, Connections, LightPathStart};
+use super::transport::{LightEvent, Transport};
+use super::{Context, Integrator, PixelIntegrator, TraceCounters};
+use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, TransportMode};
-use crate::camera::CameraWiSample;
+use crate::camera::{CameraRay, CameraWiSample};
+use crate::film::tile::SampleValue;
 use crate::film::Splats;
 use crate::geometry::SpawnPoint;
 use crate::sampler::Sampler;
-use crate::settings::Packets;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::settings::{KernelFlags, Packets};
+use crate::spectrum::SampledWavelengths;
 
 /// Traces one light path and splats its connections to the camera; returns nothing for
-/// the pixel sample's own pixel.
-pub fn radiance<const N: usize>(
+/// the pixel sample's own pixel. What the light path carries besides its scalar
+/// throughput is the transport `T`'s: nothing ([`Unpolarized`](super::transport::Unpolarized)),
+/// or its Stokes vector (`integrator::polarized`), whose connections splat Stokes
+/// radiance. Both trace the same paths with the same random numbers.
+pub(crate) fn radiance<const N: usize, T: Transport<N>>(
     ctx: &Context,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
     splats: &mut Splats,
-) -> SampledSpectrum<N> {
-    radiance_carrying::<N, Unpolarized>(ctx, wl, sampler, counters, splats)
-}
-
-/// [`radiance`] with what the light path carries besides its scalar throughput: nothing
-/// ([`Unpolarized`]), or its Stokes vector (`integrator::polarized`), whose connections
-/// splat Stokes radiance. Both trace the same paths with the same random numbers.
-pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
-    ctx: &Context,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> F::Value {
+) -> T::Value {
     let scene = ctx.scene;
     let cam = &scene.camera;
     let settings = ctx.settings;
     let Some(start) = LightPathStart::sample(ctx, wl, sampler) else {
-        return F::zero();
+        return T::Value::zero();
     };
     let (le, pmf) = (&start.le, start.pmf);
     // Rays leave a light's surface as they leave any surface; other lights' origins are
@@ -68,13 +59,13 @@ pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
 
     // The connections to the camera, their shadow rays traced one by one or, with
     // `--packets paths`, 8 at a time.
-    let mut conns = Connections::<N, F::Value>::new(settings.packets == Packets::Paths);
-    let mut own = F::zero();
+    let mut conns = Connections::<N, T::Value>::new(settings.packets == Packets::Paths);
+    let mut own = T::Value::zero();
     // The splat of a connection from `from` along `cs`, unless its shadow ray is blocked.
-    let connect = |conns: &Connections<N, F::Value>,
+    let connect = |conns: &Connections<N, T::Value>,
                    from: &SpawnPoint,
                    cs: &CameraWiSample,
-                   c: F::Value,
+                   c: T::Value,
                    counters: &mut TraceCounters| {
         let q = ctx.offset.shadow(from, cs.wi, cs.dist, &eye);
         let shadow = match conns.visible(ctx, q, counters) {
@@ -95,8 +86,8 @@ pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
             let emitted = scene.lights[start.index].l(n, cs.wi, wl);
             if !emitted.is_zero() {
                 let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
-                let c =
-                    F::emitted(ctx, start.index, cs.wi, wl).seen(ctx, None, cs.wi, emitted * k, wl);
+                let beam = T::emitted(ctx, start.index, cs.wi, wl);
+                let c = T::seen(&beam, ctx, None, cs.wi, emitted * k, wl);
                 if let Some(c) = connect(&conns, &light_point, &cs, c, counters) {
                     conns.push(ctx, c, (&mut own, splats), wl, counters);
                 }
@@ -105,7 +96,7 @@ pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
     }
 
     let mut beta = start.beta();
-    let mut carried = F::emitted(ctx, start.index, le.dir, wl);
+    let mut carried = T::emitted(ctx, start.index, le.dir, wl);
     // The light path's throughput carries the light's flux, whose size depends on the
     // scene's units (an area light's flux scales with its area); the roulette compares
     // the throughput with where it started, so that a scene scaled by 1e-4 is not
@@ -135,7 +126,13 @@ pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
                 let f = material.eval(wo, wi, wl, &bsdf_ctx).f;
                 if !f.is_zero() {
                     let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
-                    let c = carried.seen(ctx, Some((material, &frame, wi, wo)), cs.wi, c, wl);
+                    let at = LightEvent {
+                        material,
+                        frame: &frame,
+                        to_local: wi,
+                        from_local: wo,
+                    };
+                    let c = T::seen(&carried, ctx, Some(&at), cs.wi, c, wl);
                     if let Some(c) = connect(&conns, &it.spawn_point(), &cs, c, counters) {
                         conns.push(ctx, c, (&mut own, splats), wl, counters);
                     }
@@ -149,7 +146,13 @@ pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
             break;
         };
         beta *= bs.weight();
-        carried.scattered(material, &frame, bs.wi, wo, bs.flags, wl);
+        let at = LightEvent {
+            material,
+            frame: &frame,
+            to_local: bs.wi,
+            from_local: wo,
+        };
+        T::light_scattered(&mut carried, &at, bs.flags, wl);
         if bs.ended_companions {
             bsdf_ctx.companions_alive = false;
         }
@@ -164,5 +167,38 @@ pub(crate) fn radiance_carrying<const N: usize, F: LightCarrier<N>>(
         }
     }
     conns.flush(ctx, (&mut own, splats), wl, counters);
-    F::zero()
+    T::Value::zero()
+}
+
+/// Light tracing.
+pub struct LightTracer;
+
+impl Integrator for LightTracer {
+    const CAPABILITIES: Capabilities = Capabilities {
+        lens: Support::No(LENS_NEEDS_WE),
+        media: false,
+        polarization: Support::Yes,
+        variance: Support::Yes,
+        packets: true,
+        // It traces no camera rays; `paths` batches its connections' shadow rays.
+        auto_packets: Packets::Off,
+        camera_rays: false,
+        steps: false,
+        splats: true,
+        kernel: None,
+    };
+}
+
+impl PixelIntegrator for LightTracer {
+    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        _: CameraRay,
+        _: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+        splats: &mut Splats,
+    ) -> T::Value {
+        radiance::<N, T>(ctx, wl, sampler, counters, splats)
+    }
 }

@@ -6,26 +6,35 @@
 //!   multiple importance sampling;
 //! - `lighttrace`: paths from the lights, connected to the camera and splatted;
 //! - `bdpt`: bidirectional path tracing with every connection strategy and MIS;
-//! - `sppm`: stochastic progressive photon mapping, which `render.rs` runs as
+//! - `sppm`: stochastic progressive photon mapping, which `render/` runs as
 //!   iterations of a camera pass and a photon pass rather than per pixel sample.
+//!
+//! Each is a type implementing [`Integrator`] (what it supports: `capabilities.rs`
+//! holds the rules that read it) and [`PixelIntegrator`] (a value per pixel sample; the
+//! packet engine also steps a [`StepIntegrator`]'s paths) or, for photon mapping,
+//! [`PassIntegrator`]. Each is generic over its [`Transport`]: unpolarised, or
+//! polarised (`polarized.rs`).
 //!
 //! All five see materials and lights only through their methods (`Material::eval`,
 //! `sample`, `pdf`, `flags`; `Light::sample_li`, `pdf_li`, `l`, `le`, `sample_le`), take
 //! what they share from `toolkit` (the next hit, a light chosen and sampled with its
 //! density, that density for MIS, Russian roulette, the start of a light path, the
 //! camera's pixel, shadow rays and media transmittance), and draw every random number
-//! through the [`Sampler`] interface. `render.rs` owns tiles, packets, passes and the
+//! through the [`Sampler`] interface. `render/` owns tiles, packets, passes and the
 //! film, and calls the [`kernel`] chosen for the render once per pixel sample.
 pub mod bdpt;
+pub mod capabilities;
 pub mod lighttrace;
 pub mod path;
 pub mod polarized;
 pub mod sppm;
 pub(crate) mod toolkit;
+pub(crate) mod transport;
 pub mod whitted;
 
 use crate::accel::embree::{self, Hit};
 use crate::camera::CameraRay;
+use crate::film::state::IntegratorPlane;
 use crate::film::Splats;
 use crate::geometry::{Ray, RayOffset};
 use crate::sampler::Sampler;
@@ -35,8 +44,18 @@ use crate::settings::{KernelFlags, ALL, MEDIA, SPECULAR};
 use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
+use bdpt::Bidirectional;
+pub use capabilities::{choose_kernel, kernel_flags, Capabilities, Support};
+use lighttrace::LightTracer;
+use path::PathTracer;
+use polarized::Polarized;
+use sppm::PhotonMapping;
+use toolkit::ShadowSink;
 pub(crate) use toolkit::WALKS;
 pub use toolkit::{Deferred, PathState};
+pub(crate) use transport::Tracer;
+use transport::{Transport, Unpolarized};
+use whitted::Whitted;
 
 /// What an integrator needs to trace: the scene, its committed Embree scene and the
 /// render's settings (the scene's, with flags applied).
@@ -82,28 +101,94 @@ pub type KernelFn<const N: usize, O> = fn(
 /// camera ray in the camera's frame (`integrator::polarized`).
 pub type StokesFn<const N: usize> = KernelFn<N, StokesSpectrum<N>>;
 
-fn polarized_path<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    ray: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    _: &mut Splats,
-) -> StokesSpectrum<N> {
-    polarized::radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
+/// Every integrator: what it supports, which the render's rules read
+/// (`capabilities.rs`).
+pub trait Integrator {
+    const CAPABILITIES: Capabilities;
 }
 
-fn polarized_whitted<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    ray: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    _: &mut Splats,
-) -> StokesSpectrum<N> {
-    polarized::whitted_radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
+/// An integrator that returns a value per pixel sample (pbrt-v4's `RayIntegrator`):
+/// whitted, path, lighttrace and bdpt. The engines call [`PixelIntegrator::sample`]
+/// through a [`KernelFn`] chosen once per render for the lanes `N`, the kernel flags `K`
+/// and the transport `T`.
+pub(crate) trait PixelIntegrator: Integrator {
+    /// One pixel sample along the camera ray `ray` at the wavelengths `wl`: its value
+    /// for the pixel (radiance, or Stokes radiance), contributions to other pixels in
+    /// `splats`. `first_hit` is the camera ray's closest hit when it was already traced
+    /// (in an Embree packet); `None` traces it here.
+    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        ray: CameraRay,
+        first_hit: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+        splats: &mut Splats,
+    ) -> T::Value;
+}
+
+/// A pixel integrator whose camera paths the packet engine can advance step by step
+/// (whitted, path): a path's state at the camera, and one step of it.
+pub(crate) trait StepIntegrator: PixelIntegrator {
+    fn start<const N: usize>(cam: &CameraRay) -> PathState<N>;
+
+    /// One step of the path in state `s` whose ray `ray` has the closest hit `hit`;
+    /// `ray` becomes the next ray. Returns false when the path has ended.
+    fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+        t: &mut Tracer<N, S, T>,
+        s: &mut PathState<N>,
+        ray: &mut Ray,
+        hit: Option<Hit>,
+    ) -> bool;
+}
+
+/// A progressive integrator, run as passes whose per-pixel state carries over from one
+/// pass to the next (pbrt-v4's `SPPMIntegrator`, which overrides `Integrator::Render`):
+/// photon mapping. The film keeps that state as its opaque integrator plane, so a
+/// checkpoint resumes it.
+pub trait PassIntegrator: Integrator {
+    /// The name of the film's plane that keeps the per-pixel state, and its values per
+    /// pixel.
+    const PLANE: (&'static str, usize);
+
+    /// The per-pixel state before the first pass, as that plane.
+    fn initial_plane(pixels: usize) -> IntegratorPlane;
+
+    /// Pass `k` from the per-pixel state `plane`, which it updates, on the current rayon
+    /// pool. `cancelled` is polled as it goes: once it says so the pass returns early,
+    /// and its result must be thrown away.
+    fn pass<const N: usize>(
+        ctx: &Context,
+        plane: &mut IntegratorPlane,
+        k: u32,
+        cancelled: &(dyn Fn() -> bool + Sync),
+    ) -> Pass<N>;
+}
+
+/// What one pass of a [`PassIntegrator`] gives the film.
+pub struct Pass<const N: usize> {
+    /// The wavelengths every sample of the pass carries.
+    pub wl: SampledWavelengths<N>,
+    /// Each pixel's own sample of the pass (row by row), for the film's sums.
+    pub l: Vec<SampledSpectrum<N>>,
+    /// What the pass adds to the film's splat planes, already in the film's fixed point
+    /// (`film/fixed.rs`): XYZ per pixel, and the spectral bins.
+    pub splat: Vec<i128>,
+    pub splat_bins: Vec<i128>,
+    /// Contributions to those planes left out as not finite or out of range.
+    pub nonfinite: u64,
+    pub counters: TraceCounters,
+}
+
+/// The declared capabilities of integrator `kind`.
+pub fn capabilities(kind: IntegratorKind) -> Capabilities {
+    match kind {
+        IntegratorKind::Whitted => Whitted::CAPABILITIES,
+        IntegratorKind::Path => PathTracer::CAPABILITIES,
+        IntegratorKind::LightTrace => LightTracer::CAPABILITIES,
+        IntegratorKind::Bdpt => Bidirectional::CAPABILITIES,
+        IntegratorKind::Sppm => PhotonMapping::CAPABILITIES,
+    }
 }
 
 /// The kernel flags a polarised render with integrator `kind` of a scene whose flags
@@ -119,97 +204,30 @@ pub fn stokes_flags(kind: IntegratorKind, k: KernelFlags) -> KernelFlags {
 }
 
 /// The polarised kernel of integrator `kind` with `N` lanes for kernel flags `k` (from
-/// [`stokes_flags`]), or why there is none.
-pub fn stokes_kernel<const N: usize>(
-    kind: IntegratorKind,
-    k: KernelFlags,
-) -> Result<StokesFn<N>, String> {
-    match kind {
+/// [`stokes_flags`]); `None` for an integrator without polarised transport
+/// (`capabilities::check_camera` refuses it first).
+pub fn stokes_kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> Option<StokesFn<N>> {
+    Some(match kind {
         IntegratorKind::Path if k & MEDIA != 0 => {
-            Ok(polarized_path::<N, { ALL & !SPECULAR }>)
+            PathTracer::sample::<N, { ALL & !SPECULAR }, Polarized>
         }
-        IntegratorKind::Path => Ok(polarized_path::<N, { ALL & !SPECULAR & !MEDIA }>),
-        IntegratorKind::Whitted => Ok(polarized_whitted::<N, { ALL & !MEDIA }>),
-        IntegratorKind::LightTrace => Ok(polarized_lighttrace::<N>),
-        IntegratorKind::Bdpt => Ok(bdpt::polarized_radiance::<N>),
-        IntegratorKind::Sppm => Err(
-            "integrator sppm: polarised transport (polarization = true) is implemented for integrator = \"path\", \"whitted\", \"lighttrace\" and \"bdpt\"; photon mapping's photons carry no Stokes vectors".into(),
-        ),
-    }
-}
-
-fn polarized_lighttrace<const N: usize>(
-    ctx: &Context,
-    _: CameraRay,
-    _: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> StokesSpectrum<N> {
-    lighttrace::radiance_carrying::<N, polarized::Beam<N>>(ctx, wl, sampler, counters, splats)
-}
-
-fn whitted_k<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    ray: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    _: &mut Splats,
-) -> SampledSpectrum<N> {
-    whitted::radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
-}
-
-fn path_k<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    ray: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    _: &mut Splats,
-) -> SampledSpectrum<N> {
-    path::radiance::<N, K>(ctx, ray, first_hit, wl, sampler, counters)
-}
-
-fn lighttrace_any<const N: usize>(
-    ctx: &Context,
-    _: CameraRay,
-    _: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> SampledSpectrum<N> {
-    lighttrace::radiance(ctx, wl, sampler, counters, splats)
-}
-
-fn bdpt_any<const N: usize>(
-    ctx: &Context,
-    ray: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> SampledSpectrum<N> {
-    bdpt::radiance(ctx, ray, first_hit, wl, sampler, counters, splats)
+        IntegratorKind::Path => PathTracer::sample::<N, { ALL & !SPECULAR & !MEDIA }, Polarized>,
+        IntegratorKind::Whitted => Whitted::sample::<N, { ALL & !MEDIA }, Polarized>,
+        IntegratorKind::LightTrace => LightTracer::sample::<N, ALL, Polarized>,
+        IntegratorKind::Bdpt => Bidirectional::sample::<N, ALL, Polarized>,
+        IntegratorKind::Sppm => return None,
+    })
 }
 
 /// One step of a path whose ray has the closest hit given, for the packet engine (see
-/// `whitted::step`, `path::step`): shadow rays are deferred to `Deferred`, which the
-/// engine traces with the packet's and resolves before the next step.
-pub type StepFn<const N: usize> = fn(
-    &Context,
+/// `whitted::step`, `path::step`): the tracer's shadow rays are deferred to its
+/// `Deferred`, which the engine traces with the packet's and resolves before the next
+/// step.
+pub(crate) type StepFn<const N: usize> = for<'t> fn(
+    &mut Tracer<'t, N, Deferred<N>, Unpolarized>,
     &mut PathState<N>,
     &mut Ray,
     Option<Hit>,
-    &SampledWavelengths<N>,
-    &mut Sampler,
-    &mut TraceCounters,
-    &mut Deferred<N>,
 ) -> bool;
 
 /// A path at the camera, ready for its first step along the camera ray.
@@ -218,88 +236,84 @@ pub type StartFn<const N: usize> = fn(&CameraRay) -> PathState<N>;
 /// What the packet engine needs of an integrator: its start and its step, specialised
 /// to the kernel flags as [`RadianceFn`]s are.
 #[derive(Clone, Copy)]
-pub struct PathFns<const N: usize> {
+pub(crate) struct PathFns<const N: usize> {
     pub start: StartFn<N>,
     pub step: StepFn<N>,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn whitted_step<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    s: &mut PathState<N>,
-    ray: &mut Ray,
-    hit: Option<Hit>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut Deferred<N>,
-) -> bool {
-    whitted::step::<N, K, _>(ctx, s, ray, hit, wl, sampler, counters, shadows)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn path_step<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    s: &mut PathState<N>,
-    ray: &mut Ray,
-    hit: Option<Hit>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut Deferred<N>,
-) -> bool {
-    path::step::<N, K, _>(ctx, s, ray, hit, wl, sampler, counters, shadows)
-}
-
-/// Every kernel of one integrator, indexed by its flags (`ALL` is 31). The path tracer
-/// has no `SPECULAR` flag, so its entries with that bit are the ones without it; the
-/// Whitted tracer has no `MEDIA` flag (scenes with media are refused under it).
+/// Every kernel of one integrator, indexed by its flags (`ALL` is 31), as radiance
+/// functions or as packet-engine steps. The path tracer has no `SPECULAR` flag, so its
+/// entries with that bit are the ones without it; the Whitted tracer has no `MEDIA`
+/// flag (scenes with media are refused under it).
 macro_rules! kernels {
-    ($f:ident, $n:ident, $drop:expr; $($k:literal)*) => {
-        kernels!($f, $n, $drop, RadianceFn; $($k)*)
+    ($i:ident, $n:ident, $drop:expr) => {
+        kernels!(@sample $i, $n, $drop; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
+            16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
     };
-    ($f:ident, $n:ident, $drop:expr, $t:ident; $($k:literal)*) => {
-        [$($f::<$n, { $k & !$drop }> as $t<$n>),*]
+    ($i:ident, $n:ident, $drop:expr, step) => {
+        kernels!(@step $i, $n, $drop; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
+            16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
+    };
+    (@sample $i:ident, $n:ident, $drop:expr; $($k:literal)*) => {
+        [$($i::sample::<$n, { $k & !$drop }, Unpolarized> as RadianceFn<$n>),*]
+    };
+    (@step $i:ident, $n:ident, $drop:expr; $($k:literal)*) => {
+        [$($i::step::<$n, { $k & !$drop }, Deferred<$n>, Unpolarized> as StepFn<$n>),*]
     };
 }
 
 /// The radiance function of integrator `kind` with `N` lanes, specialised to the kernel
-/// flags `k` (from [`crate::scene::Features::choose`]). Light tracing and BDPT have one
+/// flags `k` (from [`capabilities::choose_kernel`]). Light tracing and BDPT have one
 /// kernel.
 pub fn kernel<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> RadianceFn<N> {
     let k = (k & ALL) as usize;
     match kind {
-        IntegratorKind::Whitted => {
-            kernels!(whitted_k, N, MEDIA; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
-                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k]
-        }
-        IntegratorKind::Path => kernels!(path_k, N, SPECULAR; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
-                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
-        IntegratorKind::LightTrace => lighttrace_any::<N>,
-        IntegratorKind::Bdpt => bdpt_any::<N>,
-        // Photon mapping runs its own iterations (`sppm::iteration`, called by
-        // `render.rs`), not a function per pixel sample; this entry, the general path
-        // tracer, is never called for it.
-        IntegratorKind::Sppm => path_k::<N, { ALL & !SPECULAR }>,
+        IntegratorKind::Whitted => kernels!(Whitted, N, MEDIA)[k],
+        IntegratorKind::Path => kernels!(PathTracer, N, SPECULAR)[k],
+        IntegratorKind::LightTrace => LightTracer::sample::<N, ALL, Unpolarized>,
+        IntegratorKind::Bdpt => Bidirectional::sample::<N, ALL, Unpolarized>,
+        // Photon mapping runs in passes (`PassIntegrator`), not a function per pixel
+        // sample; this entry, the general path tracer, is never called for it.
+        IntegratorKind::Sppm => PathTracer::sample::<N, { ALL & !SPECULAR }, Unpolarized>,
     }
 }
 
 /// The start and step of integrator `kind` with `N` lanes and kernel flags `k`, for the
-/// packet engine; `None` for light tracing, BDPT and photon mapping, which run one path
-/// at a time.
-pub fn path_fns<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> Option<PathFns<N>> {
+/// packet engine; `None` for an integrator without steps (`Capabilities::steps`).
+pub(crate) fn path_fns<const N: usize>(kind: IntegratorKind, k: KernelFlags) -> Option<PathFns<N>> {
     let k = (k & ALL) as usize;
     match kind {
         IntegratorKind::Whitted => Some(PathFns {
-            start: whitted::start::<N>,
-            step: kernels!(whitted_step, N, MEDIA, StepFn; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
-                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
+            start: Whitted::start::<N>,
+            step: kernels!(Whitted, N, MEDIA, step)[k],
         }),
         IntegratorKind::Path => Some(PathFns {
-            start: path::start::<N>,
-            step: kernels!(path_step, N, SPECULAR, StepFn; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15
-                16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)[k],
+            start: PathTracer::start::<N>,
+            step: kernels!(PathTracer, N, SPECULAR, step)[k],
         }),
         IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packet engine's steps exist for exactly the integrators that declare them.
+    #[test]
+    fn declared_steps_match_the_step_functions() {
+        for &name in IntegratorKind::NAMES {
+            let kind = IntegratorKind::parse(name).unwrap();
+            assert_eq!(
+                capabilities(kind).steps,
+                path_fns::<1>(kind, 0).is_some(),
+                "{name}"
+            );
+            assert_eq!(
+                capabilities(kind).polarization == Support::Yes,
+                stokes_kernel::<1>(kind, 0).is_some(),
+                "{name}"
+            );
+        }
     }
 }

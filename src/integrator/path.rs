@@ -74,58 +74,61 @@
 //! Transmittance in heron's media is exact (homogeneous: exp(−σ_t ℓ) per stretch, through
 //! index-matched boundaries), so ratio tracking, which estimates it in heterogeneous
 //! media, has nothing to add here.
+use super::capabilities::{Capabilities, Support};
 use super::toolkit::{
-    lane_mean, light_pdf, next_hit, roulette, sample_light, Carrier, Finish, Immediate, PathState,
-    ShadowSink, TransmittanceWalk, Unpolarized, Vertex, MAX_CROSSINGS,
+    lane_mean, light_pdf, roulette, sample_light, Finish, Immediate, PathState, ShadowSink,
+    TransmittanceWalk, Vertex, MAX_CROSSINGS,
 };
-use super::{Context, TraceCounters};
+use super::transport::{follow, Scatter, Tracer, Transport};
+use super::{Context, Integrator, PixelIntegrator, StepIntegrator, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{LobeFlags, Material};
 use crate::camera::CameraRay;
+use crate::film::Splats;
 use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::SurfacePoint;
 use crate::math::warp::power_heuristic;
 use crate::math::Frame;
 use crate::medium::{Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
-use crate::scene::{Scene, NO_LIGHT};
-use crate::settings::{on, KernelFlags, MediumNee, EMITTERS, ESCAPE, MEDIA, SHADOWS};
+use crate::scene::{Features, Scene, NO_LIGHT};
+use crate::settings::{on, KernelFlags, MediumNee, Packets, EMITTERS, ESCAPE, MEDIA, SHADOWS};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
-/// Radiance arriving along the camera ray `ray` at the wavelengths `wl`.
+/// Radiance arriving along the camera ray `ray` at the wavelengths `wl`; for polarised
+/// transport `T`, the Stokes radiance in the camera's frame (`integrator::polarized`).
 ///
 /// `K` is the kernel ([`KernelFlags`]): without `SHADOWS` there is no next-event
 /// estimation (the scene has no light to sample, or no surface to light), without
 /// `EMITTERS` no emission lookup at hits, without `ESCAPE` nothing along escaping rays.
 /// The random numbers read per bounce are the same in every kernel.
-pub fn radiance<const N: usize, const K: KernelFlags>(
+pub(crate) fn radiance<const N: usize, const K: KernelFlags, T: Transport<N>>(
     ctx: &Context,
     cam: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
-) -> SampledSpectrum<N> {
+) -> T::Value {
+    let mut carry = T::at_camera(ctx, &cam);
     let mut s = PathState::<N>::at_camera(&cam);
-    let mut ray = cam.ray;
-    let mut pending = first_hit;
-    loop {
-        let hit = next_hit(ctx, &ray, &mut pending, counters);
-        if !step::<N, K, _>(
-            ctx,
-            &mut s,
-            &mut ray,
-            hit,
-            wl,
-            sampler,
-            counters,
-            &mut Immediate,
-        ) {
-            break;
-        }
-    }
-    s.l
+    let mut t = Tracer {
+        ctx,
+        wl,
+        sampler,
+        counters,
+        shadows: &mut Immediate,
+        carry: &mut carry,
+    };
+    follow(
+        &mut t,
+        cam.ray,
+        &mut s,
+        first_hit,
+        step::<N, K, Immediate, T>,
+    );
+    T::delivered(carry, s.l)
 }
 
 /// The path's state at the camera: what [`step`] starts from.
@@ -137,58 +140,23 @@ pub fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
 /// One step of the path whose ray `ray` has the closest hit `hit`: the segment through a
 /// medium, a boundary crossed, the light found along an escaping ray, or a surface
 /// vertex; `ray` becomes the next ray. Returns false when the path has ended. Shadow
-/// rays go to `shadows` (the packet engine traces them after the step, before the next).
-#[allow(clippy::too_many_arguments)]
+/// rays go to the tracer's sink (the packet engine traces them after the step, before
+/// the next); every contribution and every scattering event goes to its transport
+/// (nothing more for unpolarised transport, the Mueller product for
+/// `integrator::polarized`).
 #[inline(always)]
-pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
-    ctx: &Context,
+pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+    t: &mut Tracer<N, S, T>,
     s: &mut PathState<N>,
     ray: &mut Ray,
     hit: Option<Hit>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
 ) -> bool {
-    step_carrying::<N, K, S, _>(
-        ctx,
-        s,
-        ray,
-        hit,
-        wl,
-        sampler,
-        counters,
-        shadows,
-        &mut Unpolarized,
-    )
-}
-
-/// [`step`] with what the path carries besides its scalar throughput (`carry`: nothing
-/// for unpolarised transport, the Mueller product for `integrator::polarized`), which
-/// receives every contribution and every scattering event.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-pub(crate) fn step_carrying<
-    const N: usize,
-    const K: KernelFlags,
-    S: ShadowSink<N>,
-    C: Carrier<N>,
->(
-    ctx: &Context,
-    s: &mut PathState<N>,
-    ray: &mut Ray,
-    hit: Option<Hit>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
-    carry: &mut C,
-) -> bool {
+    let (ctx, wl) = (t.ctx, t.wl);
     let scene = ctx.scene;
     if on(K, MEDIA) && s.medium != NO_MEDIUM {
         // A closed boundary always stops a ray inside; a ray that escapes it leaked.
         let Some(h) = &hit else { return false };
-        match medium_segment::<N, K, S, C>(ctx, s, ray, h, wl, sampler, counters, shadows, carry) {
+        match medium_segment::<N, K, S, T>(t, s, ray, h) {
             Segment::Scattered => return true,
             Segment::Ended => return false,
             Segment::Crossed => {}
@@ -225,8 +193,7 @@ pub(crate) fn step_carrying<
                 let le = scene.lights[i as usize].le(ray.dir, wl);
                 if !le.is_zero() {
                     let (prev_p, dir) = (s.prev_p, ray.dir);
-                    let found = (i as usize, dir, wl);
-                    s.add_found_light::<K, C>(carry, found, le, mis, || {
+                    s.add_found_light::<K, S, T>(t, (i as usize, dir), le, mis, || {
                         light_pdf(ctx, i as usize, prev_p, dir, None)
                     });
                 }
@@ -234,9 +201,7 @@ pub(crate) fn step_carrying<
         }
         return false;
     };
-    surface_vertex::<N, K, S, C>(
-        ctx, s, ray, &hit, mis, wl, sampler, counters, shadows, carry,
-    )
+    surface_vertex::<N, K, S, T>(t, s, ray, &hit, mis)
 }
 
 impl<const N: usize> PathState<N> {
@@ -244,19 +209,18 @@ impl<const N: usize> PathState<N> {
     /// whole after a delta lobe, else weighted against light sampling, whose density
     /// `p_light` gives (the power heuristic after a surface, the balance heuristic over
     /// the lanes after a medium vertex); `mis` is the lanes' mean r_u. `found` is the
-    /// light's index, the ray's direction and the wavelengths, for `carry`.
+    /// light's index and the ray's direction, for the transport.
     #[inline(always)]
-    fn add_found_light<const K: KernelFlags, C: Carrier<N>>(
+    fn add_found_light<const K: KernelFlags, S, T: Transport<N>>(
         &mut self,
-        carry: &mut C,
-        found: (usize, Vec3, &SampledWavelengths<N>),
+        t: &mut Tracer<N, S, T>,
+        (light, dir): (usize, Vec3),
         le: SampledSpectrum<N>,
         mis: f32,
         p_light: impl FnOnce() -> f32,
     ) {
-        let (light, dir, wl) = found;
         if self.specular_bounce {
-            carry.found(&mut self.l, self.beta * le / mis, light, dir, wl);
+            t.found(&mut self.l, self.beta * le / mis, light, dir);
             return;
         }
         let p_l = p_light();
@@ -266,7 +230,7 @@ impl<const N: usize> PathState<N> {
         } else {
             self.beta * le * (power_heuristic(self.prev_pdf, p_l) / mis)
         };
-        carry.found(&mut self.l, c, light, dir, wl);
+        t.found(&mut self.l, c, light, dir);
     }
 }
 
@@ -285,22 +249,17 @@ enum Segment {
 /// then a free flight sampled by the hero's σ_t, and either scattering (under
 /// [`MediumNee::Collision`] a light sample there, then a direction) or the surface, with
 /// the lanes' weights and rescaled probabilities updated.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Carrier<N>>(
-    ctx: &Context,
+fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+    tc: &mut Tracer<N, S, T>,
     s: &mut PathState<N>,
     ray: &mut Ray,
     h: &Hit,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
-    carry: &mut C,
 ) -> Segment {
+    let (ctx, wl) = (tc.ctx, tc.wl);
     let m = &ctx.scene.media[s.medium as usize];
     let sigma_t = m.sigma_t(wl);
-    let u_dist = sampler.get_1d();
+    let u_dist = tc.sampler.get_1d();
     let forced = on(K, SHADOWS) && ctx.settings.medium_nee == MediumNee::Forced;
     // Forced: each lane's chance 1 − e^{−σ_λ d} that a free flight collides within the
     // segment, the normalisation of its truncated distance density.
@@ -310,9 +269,9 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
         SampledSpectrum::splat(1.0)
     };
     if forced {
-        let u_forced = sampler.get_1d();
-        let u_light = sampler.get_1d();
-        let u_light_point = sampler.get_2d();
+        let u_forced = tc.sampler.get_1d();
+        let u_light = tc.sampler.get_1d();
+        let u_light_point = tc.sampler.get_2d();
         if s.depth < ctx.settings.max_depth {
             let f = ForcedSample {
                 dir: ray.dir,
@@ -323,13 +282,13 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
                 u: u_forced,
             };
             if let Some((ld, wi, light)) =
-                forced_direct_light(ctx, s, m, &f, u_light, u_light_point, wl, counters, shadows)
+                forced_direct_light(tc, s, m, &f, (u_light, u_light_point))
             {
                 let v = Vertex::Medium {
                     medium: m,
                     d_in: ray.dir,
                 };
-                carry.lit(&mut s.l, ld, &v, wi, wi, light, wl);
+                tc.lit(&mut s.l, ld, Scatter::new(&v, wi, wi), light);
             }
         }
     }
@@ -374,11 +333,11 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
     let (u_light, u_light_point) = if forced {
         (0.0, Vec2::ZERO)
     } else {
-        (sampler.get_1d(), sampler.get_2d())
+        (tc.sampler.get_1d(), tc.sampler.get_2d())
     };
-    let u_node = sampler.get_1d();
-    let u_dir = sampler.get_2d();
-    let u_rr = sampler.get_1d();
+    let u_node = tc.sampler.get_1d();
+    let u_dir = tc.sampler.get_2d();
+    let u_rr = tc.sampler.get_1d();
     let alive = s.bsdf_ctx.companions_alive;
     if on(K, SHADOWS) && !forced {
         let v = MediumVertex {
@@ -389,14 +348,12 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
             r_u: s.r_u,
             q_scale: SampledSpectrum::splat(1.0),
         };
-        if let Some((ld, wi, light)) =
-            light_from_medium(ctx, s, m, &v, u_light, u_light_point, wl, counters, shadows)
-        {
+        if let Some((ld, wi, light)) = light_from_medium(tc, s, m, &v, (u_light, u_light_point)) {
             let v = Vertex::Medium {
                 medium: m,
                 d_in: ray.dir,
             };
-            carry.lit(&mut s.l, ld, &v, wi, wi, light, wl);
+            tc.lit(&mut s.l, ld, Scatter::new(&v, wi, wi), light);
         }
     }
     let (wi, pv, q) = sample_direction(ctx, s.depth, m, ray.dir, u_node, u_dir, wl);
@@ -419,7 +376,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
         medium: m,
         d_in: ray.dir,
     };
-    carry.scattered(&v, wi, wi, LobeFlags::NONE, wl);
+    tc.scattered(Scatter::new(&v, wi, wi), LobeFlags::NONE);
     *ray = Ray::new(p, wi, 0.0, f32::INFINITY);
     if s.beta.is_zero() {
         return Segment::Ended;
@@ -465,19 +422,15 @@ struct ForcedSample<const N: usize> {
 /// technique has the density σ_λ e^{−σ_λ t} q_λ(ω) T_λ(light) of reaching the same
 /// vertex and leaving toward the light, which is (1 − e^{−σ_λ d}) q_λ T_λ times this
 /// technique's density of the vertex.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn forced_direct_light<const N: usize, S: ShadowSink<N>>(
-    ctx: &Context,
+fn forced_direct_light<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
+    tc: &mut Tracer<N, S, T>,
     s: &PathState<N>,
     m: &Medium,
     f: &ForcedSample<N>,
-    u_light: f32,
-    u_light_point: Vec2,
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
+    u: (f32, Vec2),
 ) -> Option<(SampledSpectrum<N>, Vec3, usize)> {
+    let wl = tc.wl;
     let s0 = f.sigma_t.0[0];
     let c0 = f.collide.0[0];
     if !(s0 > 0.0 && c0 > 0.0) {
@@ -506,7 +459,7 @@ fn forced_direct_light<const N: usize, S: ShadowSink<N>>(
         r_u,
         q_scale: f.collide,
     };
-    light_from_medium(ctx, s, m, &v, u_light, u_light_point, wl, counters, shadows)
+    light_from_medium(tc, s, m, &v, u)
 }
 
 /// The medium vertices of a path, from its first, whose direction is drawn with the
@@ -602,20 +555,17 @@ struct MediumVertex<const N: usize> {
 /// its transmittance through the media on the way, and the balance heuristic over
 /// (technique, hero) pairs against direction sampling, whose density toward the light
 /// is q_λ(ω) T_λ (T_λ: the chance of flying there unscattered) times `q_scale`.
-/// Returns the contribution, the direction toward the light and the light's index.
-#[allow(clippy::too_many_arguments)]
+/// `u` is the light choice's number and the point on the light's. Returns the
+/// contribution, the direction toward the light and the light's index.
 #[inline(always)]
-fn light_from_medium<const N: usize, S: ShadowSink<N>>(
-    ctx: &Context,
+fn light_from_medium<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
+    t: &mut Tracer<N, S, T>,
     s: &PathState<N>,
     m: &Medium,
     v: &MediumVertex<N>,
-    u_light: f32,
-    u_light_point: Vec2,
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
+    (u_light, u_light_point): (f32, Vec2),
 ) -> Option<(SampledSpectrum<N>, Vec3, usize)> {
+    let (ctx, wl) = (t.ctx, t.wl);
     let cl = sample_light(ctx, v.p, u_light, u_light_point, wl)?;
     let ls = &cl.sample;
     let f = m.phase(v.dir, ls.wi, wl);
@@ -635,27 +585,22 @@ fn light_from_medium<const N: usize, S: ShadowSink<N>>(
         delta: ls.delta,
         alive: s.bsdf_ctx.companions_alive,
     };
-    shadows
-        .transmit(ctx, walk, finish, wl, counters)
+    t.shadows
+        .transmit(ctx, walk, finish, wl, t.counters)
         .map(|c| (c, ls.wi, cl.index))
 }
 
 /// A surface vertex: the emission found there, next-event estimation, and the BSDF's
 /// continuation with Russian roulette. Returns false when the path ends.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Carrier<N>>(
-    ctx: &Context,
+fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+    t: &mut Tracer<N, S, T>,
     s: &mut PathState<N>,
     ray: &mut Ray,
     hit: &Hit,
     mis: f32,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
-    carry: &mut C,
 ) -> bool {
+    let (ctx, wl) = (t.ctx, t.wl);
     let scene = ctx.scene;
     let (it, material) = scene.interaction(ray, hit, ctx.offset.is_robust());
     // Every query of this vertex's material sees its uv (zero unless textured).
@@ -676,8 +621,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
                 p: it.position,
                 n: it.n_outward,
             };
-            let found = (emitter as usize, dir, wl);
-            s.add_found_light::<K, C>(carry, found, le, mis, || {
+            s.add_found_light::<K, S, T>(t, (emitter as usize, dir), le, mis, || {
                 light_pdf(ctx, emitter as usize, prev_p, dir, Some(&sp))
             });
         }
@@ -687,11 +631,11 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
     }
     s.depth += 1;
 
-    let u_light = sampler.get_1d();
-    let u_light_point = sampler.get_2d();
-    let u_lobe = sampler.get_1d();
-    let u_dir = sampler.get_2d();
-    let u_rr = sampler.get_1d();
+    let u_light = t.sampler.get_1d();
+    let u_light_point = t.sampler.get_2d();
+    let u_lobe = t.sampler.get_1d();
+    let u_dir = t.sampler.get_2d();
+    let u_rr = t.sampler.get_1d();
 
     let frame = it.frame();
     let wo_local = frame.to_local(wo);
@@ -703,23 +647,24 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
             frame: &frame,
             wo_local,
         };
-        if let Some((ld, wi, wi_local, light)) = surface_direct_light::<N, K, S>(
-            ctx,
-            s,
-            &v,
-            mis,
-            u_light,
-            u_light_point,
-            wl,
-            counters,
-            shadows,
-        ) {
+        if let Some((ld, wi, wi_local, light)) =
+            surface_direct_light::<N, K, S, T>(t, s, &v, mis, (u_light, u_light_point))
+        {
             let v = Vertex::Surface {
                 material,
                 frame: &frame,
                 wo_local,
             };
-            carry.lit(&mut s.l, ld, &v, wi, wi_local, light, wl);
+            t.lit(
+                &mut s.l,
+                ld,
+                Scatter {
+                    v: &v,
+                    wi,
+                    wi_local,
+                },
+                light,
+            );
         }
     }
 
@@ -744,7 +689,12 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, C: Car
         frame: &frame,
         wo_local,
     };
-    carry.scattered(&v, wi, bs.wi, bs.flags, wl);
+    let at = Scatter {
+        v: &v,
+        wi,
+        wi_local: bs.wi,
+    };
+    t.scattered(at, bs.flags);
     *ray = ctx.offset.spawn(&it.spawn_point(), wi);
     if on(K, MEDIA) && bs.is_transmission() {
         // Through a dielectric around a medium (a glass of milk) into or out of it.
@@ -776,20 +726,17 @@ struct SurfaceVertex<'a> {
 /// Next-event estimation at a surface vertex: a light sample, weighted by the power
 /// heuristic against the BSDF's density (delta lights: weight 1), through the media on
 /// the way (kernels with `MEDIA`) or past occluders. Returns the contribution, the
-/// direction toward the light (world and local) and the light's index.
-#[allow(clippy::too_many_arguments)]
+/// direction toward the light (world and local) and the light's index; `u` is the light
+/// choice's number and the point on the light's.
 #[inline(always)]
-fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
-    ctx: &Context,
+fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+    t: &mut Tracer<N, S, T>,
     s: &PathState<N>,
     v: &SurfaceVertex,
     mis: f32,
-    u_light: f32,
-    u_light_point: Vec2,
-    wl: &SampledWavelengths<N>,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
+    (u_light, u_light_point): (f32, Vec2),
 ) -> Option<(SampledSpectrum<N>, Vec3, Vec3, usize)> {
+    let (ctx, wl) = (t.ctx, t.wl);
     let it = v.it;
     let cl = sample_light(ctx, it.position, u_light, u_light_point, wl)?;
     let ls = &cl.sample;
@@ -813,8 +760,9 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
         let q = ctx
             .offset
             .shadow(&it.spawn_point(), ls.wi, ls.dist, &ls.target());
-        return shadows
-            .test(ctx, q, counters, || {
+        return t
+            .shadows
+            .test(ctx, q, t.counters, || {
                 s.beta * f * ls.l * (weight(cl.pdf) / (cl.pdf * mis))
             })
             .map(|c| (c, ls.wi, wi_local, cl.index));
@@ -832,8 +780,8 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
         l: ls.l,
         scale: weight(cl.pdf) / (cl.pdf * mis),
     };
-    shadows
-        .transmit(ctx, walk, finish, wl, counters)
+    t.shadows
+        .transmit(ctx, walk, finish, wl, t.counters)
         .map(|c| (c, ls.wi, wi_local, cl.index))
 }
 
@@ -851,5 +799,60 @@ fn medium_outside(current: u32, scene: &Scene, geom: u32) -> u32 {
         NO_MEDIUM
     } else {
         current
+    }
+}
+
+/// The path tracer.
+pub struct PathTracer;
+
+impl Integrator for PathTracer {
+    const CAPABILITIES: Capabilities = Capabilities {
+        lens: Support::Yes,
+        media: true,
+        polarization: Support::Yes,
+        variance: Support::Yes,
+        packets: true,
+        auto_packets: Packets::Camera,
+        camera_rays: true,
+        steps: true,
+        splats: false,
+        kernel: Some(kernel_flags),
+    };
+}
+
+/// The kernel flags the path tracer is specialised on: next-event estimation, emitters,
+/// escaping rays and media (`scene::features`).
+fn kernel_flags(f: &Features) -> KernelFlags {
+    let bit = |on: bool, flag: KernelFlags| if on { flag } else { 0 };
+    bit(f.nee, SHADOWS) | bit(f.emitters, EMITTERS) | bit(f.escape, ESCAPE) | bit(f.media, MEDIA)
+}
+
+impl PixelIntegrator for PathTracer {
+    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        ray: CameraRay,
+        first_hit: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+        _: &mut Splats,
+    ) -> T::Value {
+        radiance::<N, K, T>(ctx, ray, first_hit, wl, sampler, counters)
+    }
+}
+
+impl StepIntegrator for PathTracer {
+    fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
+        start(cam)
+    }
+
+    #[inline(always)]
+    fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+        t: &mut Tracer<N, S, T>,
+        s: &mut PathState<N>,
+        ray: &mut Ray,
+        hit: Option<Hit>,
+    ) -> bool {
+        step::<N, K, S, T>(t, s, ray, hit)
     }
 }

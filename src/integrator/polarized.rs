@@ -5,8 +5,8 @@
 //! carrying per lane a 4 × 4 Mueller product besides its scalar throughput, so that the
 //! camera receives a Stokes vector per wavelength (Wilkie & Weidlich 2012, "Polarised
 //! light in computer graphics", SIGGRAPH Asia course, §§ 4–5; Mitsuba 3's polarised
-//! variants, Jakob et al. 2022, do the same). It is `path::step_carrying` with the
-//! [`Carrier`] of this file.
+//! variants, Jakob et al. 2022, do the same). It is `path::step` (or `whitted::step`,
+//! light tracing, BDPT) with the transport [`Polarized`] of this file.
 //!
 //! **The Mueller product.** Every event's Mueller matrix is its scalar weight (what the
 //! unpolarised path tracer multiplies its throughput by: f |cos θ| / pdf at a surface,
@@ -45,17 +45,15 @@
 //!
 //! **What is not here yet.** Polarised area lights, photon mapping and the packet
 //! engine of paths.
-use super::toolkit::{next_hit, Carrier, Immediate, LightCarrier, PathState, Vertex};
-use super::{path, whitted};
-use super::{Context, TraceCounters};
-use crate::accel::embree::Hit;
+use super::bdpt::{self, Bdpt, Subpaths};
+use super::toolkit::Vertex;
+use super::transport::{LightEvent, Scatter, Transport};
+use super::Context;
 use crate::bsdf::{LobeFlags, Material, Polarizing};
 use crate::camera::CameraRay;
 use crate::math::Frame;
 use crate::optics::mueller::Mueller;
-use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::settings::KernelFlags;
 use crate::spectrum::stokes::{any_perpendicular, mueller_from_rows, rotate_basis, StokesSpectrum};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Mat4, Vec3, Vec4};
@@ -123,7 +121,7 @@ impl<const N: usize> Beam<N> {
         }
     }
 
-    /// The beam after scattering at a surface (`LightCarrier::scattered`).
+    /// The beam after scattering at a surface (`Transport::light_scattered`).
     #[inline]
     pub(crate) fn scatter(
         &self,
@@ -269,18 +267,39 @@ impl<const N: usize> Chain<N> {
 
 /// What a polarised camera path carries: its [`Chain`] and the Stokes radiance found
 /// so far.
-struct Polarized<'a, const N: usize> {
-    scene: &'a Scene,
+pub(crate) struct CameraPath<const N: usize> {
     chain: Chain<N>,
     out: StokesSpectrum<N>,
 }
 
-impl<const N: usize> Carrier<N> for Polarized<'_, N> {
+/// Polarised transport: camera paths carry a [`Chain`], light paths a [`Beam`], BDPT
+/// both per segment of its subpaths (`bdpt::carrier`).
+pub(crate) struct Polarized;
+
+impl<const N: usize> Transport<N> for Polarized {
     const POLARIZED: bool = true;
+    type Value = StokesSpectrum<N>;
+    type Camera = CameraPath<N>;
+    type Light = Beam<N>;
+    type Bdpt = bdpt::PolarizedSubpaths<N>;
+
+    #[inline]
+    fn at_camera(ctx: &Context, cam: &CameraRay) -> CameraPath<N> {
+        CameraPath {
+            chain: Chain::at_camera(ctx, cam.ray.dir),
+            out: StokesSpectrum::zero(),
+        }
+    }
+
+    #[inline]
+    fn delivered(cam: CameraPath<N>, _: SampledSpectrum<N>) -> StokesSpectrum<N> {
+        cam.out
+    }
 
     #[inline]
     fn found(
-        &mut self,
+        cam: &mut CameraPath<N>,
+        ctx: &Context,
         _: &mut SampledSpectrum<N>,
         c: SampledSpectrum<N>,
         light: usize,
@@ -288,37 +307,97 @@ impl<const N: usize> Carrier<N> for Polarized<'_, N> {
         wl: &SampledWavelengths<N>,
     ) {
         // `dir` points toward the light: its light travels along −dir.
-        let beam = Beam::emitted(self.scene, light, -dir, wl);
-        self.out += self.chain.receive(&beam, -dir, c);
+        let beam = Beam::emitted(ctx.scene, light, -dir, wl);
+        cam.out += cam.chain.receive(&beam, -dir, c);
     }
 
     #[inline]
     fn lit(
-        &mut self,
+        cam: &mut CameraPath<N>,
+        ctx: &Context,
         _: &mut SampledSpectrum<N>,
         c: SampledSpectrum<N>,
-        v: &Vertex,
-        wi: Vec3,
-        wi_local: Vec3,
+        at: Scatter,
         light: usize,
         wl: &SampledWavelengths<N>,
     ) {
         // Light samples reach the non-delta lobes only; the light travels along −wi.
-        let chain = self.chain.past(v, wi, wi_local, non_delta(v), wl);
-        let beam = Beam::emitted(self.scene, light, -wi, wl);
-        self.out += chain.receive(&beam, -wi, c);
+        let chain = cam
+            .chain
+            .past(at.v, at.wi, at.wi_local, non_delta(at.v), wl);
+        let beam = Beam::emitted(ctx.scene, light, -at.wi, wl);
+        cam.out += chain.receive(&beam, -at.wi, c);
     }
 
     #[inline]
     fn scattered(
-        &mut self,
-        v: &Vertex,
-        wi: Vec3,
-        wi_local: Vec3,
+        cam: &mut CameraPath<N>,
+        at: Scatter,
         flags: LobeFlags,
         wl: &SampledWavelengths<N>,
     ) {
-        self.chain = self.chain.past(v, wi, wi_local, flags, wl);
+        cam.chain = cam.chain.past(at.v, at.wi, at.wi_local, flags, wl);
+    }
+
+    #[inline]
+    fn emitted(ctx: &Context, light: usize, d: Vec3, wl: &SampledWavelengths<N>) -> Beam<N> {
+        Beam::emitted(ctx.scene, light, d, wl)
+    }
+
+    #[inline]
+    fn light_scattered(
+        b: &mut Beam<N>,
+        e: &LightEvent,
+        flags: LobeFlags,
+        wl: &SampledWavelengths<N>,
+    ) {
+        *b = b.scatter(e.material, e.frame, e.to_local, e.from_local, flags, wl);
+    }
+
+    #[inline]
+    fn seen(
+        b: &Beam<N>,
+        ctx: &Context,
+        at: Option<&LightEvent>,
+        d: Vec3,
+        c: SampledSpectrum<N>,
+        wl: &SampledWavelengths<N>,
+    ) -> StokesSpectrum<N> {
+        let chain = Chain::at_camera(ctx, -d);
+        let chain = match at {
+            None => chain,
+            Some(e) => {
+                let v = Vertex::Surface {
+                    material: e.material,
+                    frame: e.frame,
+                    wo_local: e.to_local,
+                };
+                let from = e.frame.to_world(e.from_local);
+                chain.past(&v, from, e.from_local, non_delta(&v), wl)
+            }
+        };
+        let travel = match at {
+            None => d,
+            Some(e) => -e.frame.to_world(e.from_local),
+        };
+        chain.receive(b, travel, c)
+    }
+
+    #[inline]
+    fn subpaths(b: &Bdpt<N>, paths: &Subpaths<N>, dir: Vec3) -> bdpt::PolarizedSubpaths<N> {
+        bdpt::PolarizedSubpaths::new(b, paths, dir)
+    }
+
+    #[inline]
+    fn strategy(
+        x: &bdpt::PolarizedSubpaths<N>,
+        b: &Bdpt<N>,
+        paths: &Subpaths<N>,
+        st: (usize, usize),
+        sampled: Option<&bdpt::Vertex<N>>,
+        c: SampledSpectrum<N>,
+    ) -> StokesSpectrum<N> {
+        x.value(b, paths, st, sampled, c)
     }
 }
 
@@ -331,173 +410,4 @@ pub(crate) fn non_delta(v: &Vertex) -> LobeFlags {
         }
         Vertex::Medium { .. } => LobeFlags::NONE,
     }
-}
-
-impl<'a, const N: usize> Polarized<'a, N> {
-    /// The carrier of a camera ray.
-    fn at_camera(ctx: &Context<'a>, cam: &CameraRay) -> Self {
-        Polarized {
-            scene: ctx.scene,
-            chain: Chain::at_camera(ctx, cam.ray.dir),
-            out: StokesSpectrum::zero(),
-        }
-    }
-}
-
-/// A polarised light path (light tracing): its [`Beam`].
-impl<const N: usize> LightCarrier<N> for Beam<N> {
-    type Value = StokesSpectrum<N>;
-
-    #[inline]
-    fn zero() -> StokesSpectrum<N> {
-        StokesSpectrum::zero()
-    }
-
-    #[inline]
-    fn emitted(ctx: &Context, light: usize, d: Vec3, wl: &SampledWavelengths<N>) -> Self {
-        Beam::emitted(ctx.scene, light, d, wl)
-    }
-
-    #[inline]
-    fn scattered(
-        &mut self,
-        material: &Material,
-        frame: &Frame,
-        to_local: Vec3,
-        from_local: Vec3,
-        flags: LobeFlags,
-        wl: &SampledWavelengths<N>,
-    ) {
-        *self = self.scatter(material, frame, to_local, from_local, flags, wl);
-    }
-
-    #[inline]
-    fn seen(
-        &self,
-        ctx: &Context,
-        at: Option<(&Material, &Frame, Vec3, Vec3)>,
-        d: Vec3,
-        c: SampledSpectrum<N>,
-        wl: &SampledWavelengths<N>,
-    ) -> StokesSpectrum<N> {
-        let chain = Chain::at_camera(ctx, -d);
-        let chain = match at {
-            None => chain,
-            Some((material, frame, to_local, from_local)) => {
-                let v = Vertex::Surface {
-                    material,
-                    frame,
-                    wo_local: to_local,
-                };
-                let from = frame.to_world(from_local);
-                chain.past(&v, from, from_local, non_delta(&v), wl)
-            }
-        };
-        let travel = match at {
-            None => d,
-            Some((_, frame, _, from_local)) => -frame.to_world(from_local),
-        };
-        chain.receive(self, travel, c)
-    }
-}
-
-/// The Stokes radiance arriving along the camera ray `cam` at the wavelengths `wl`, in
-/// the camera's frame, from the path tracer with the kernel flags `K`
-/// (`path::radiance`'s).
-pub fn radiance<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    cam: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-) -> StokesSpectrum<N> {
-    let s = PathState::<N>::at_camera(&cam);
-    follow(
-        ctx,
-        cam,
-        s,
-        first_hit,
-        sampler,
-        counters,
-        |s, ray, hit, sampler, c, carry| {
-            path::step_carrying::<N, K, _, _>(
-                ctx,
-                s,
-                ray,
-                hit,
-                wl,
-                sampler,
-                c,
-                &mut Immediate,
-                carry,
-            )
-        },
-    )
-}
-
-/// The same from the seed's Whitted tracer (`whitted::step_carrying`): its direct
-/// lighting light by light through the surface's non-delta lobes, and its delta
-/// continuations, each with its Mueller matrix.
-pub fn whitted_radiance<const N: usize, const K: KernelFlags>(
-    ctx: &Context,
-    cam: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-) -> StokesSpectrum<N> {
-    let s = whitted::start::<N>(&cam);
-    follow(
-        ctx,
-        cam,
-        s,
-        first_hit,
-        sampler,
-        counters,
-        |s, ray, hit, sampler, c, carry| {
-            whitted::step_carrying::<N, K, _, _>(
-                ctx,
-                s,
-                ray,
-                hit,
-                wl,
-                sampler,
-                c,
-                &mut Immediate,
-                carry,
-            )
-        },
-    )
-}
-
-/// The one-path-at-a-time loop over an integrator's `step` from the camera ray `cam`
-/// and the path state `s` at it, with the polarised carrier; its Stokes radiance.
-#[inline(always)]
-fn follow<const N: usize>(
-    ctx: &Context,
-    cam: CameraRay,
-    mut s: PathState<N>,
-    first_hit: Option<Option<Hit>>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    mut step: impl FnMut(
-        &mut PathState<N>,
-        &mut crate::geometry::Ray,
-        Option<Hit>,
-        &mut Sampler,
-        &mut TraceCounters,
-        &mut Polarized<'_, N>,
-    ) -> bool,
-) -> StokesSpectrum<N> {
-    let mut carry = Polarized::at_camera(ctx, &cam);
-    let mut ray = cam.ray;
-    let mut pending = first_hit;
-    loop {
-        let hit = next_hit(ctx, &ray, &mut pending, counters);
-        if !step(&mut s, &mut ray, hit, sampler, counters, &mut carry) {
-            break;
-        }
-    }
-    carry.out
 }

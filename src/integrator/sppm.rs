@@ -31,7 +31,7 @@
 //! bookkeeping written in radiance: with τ rescaled by R'²/R² at each update, as
 //! Hachisuka & Jensen do, τ/(πR²) after the update equals (τ + Φ)/(πR²) before it, so
 //! T = τ/(πR²) only ever grows by Φ/(πR²). Kept so, the sums are radiance like every
-//! other film's and need no rescaling, and the film adds them as splats (`render.rs`).
+//! other film's and need no rescaling, and the film adds them as splats (`render/progressive.rs`).
 //!
 //! **Wavelengths: one set per iteration.** Every camera path and photon of an iteration
 //! carries the same hero and companions (pbrt-v4 does the same). A photon's contribution
@@ -56,8 +56,9 @@
 //!
 //! Not supported: participating media (refused with the other integrators that do not
 //! trace them, `scene::features`).
+use super::capabilities::{Capabilities, Support};
 use super::toolkit::{light_pdf, next_hit, roulette, sample_light, LightPathStart};
-use super::{Context, TraceCounters};
+use super::{Context, Integrator, Pass, PassIntegrator, TraceCounters};
 use crate::bsdf::{BsdfContext, LobeFlags, Material, TransportMode};
 use crate::camera::CameraRay;
 use crate::film::fixed::{to_fixed, to_fixed3, AtomicFixed, LIMIT};
@@ -69,7 +70,7 @@ use crate::math::warp::power_heuristic;
 use crate::math::Frame;
 use crate::sampler::Sampler;
 use crate::scene::NO_LIGHT;
-use crate::settings::WavelengthSampler;
+use crate::settings::{Packets, WavelengthSampler};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{IVec3, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
@@ -812,6 +813,58 @@ pub fn update_radius(n: f32, r2: f32, m: u32, alpha: f32) -> (f32, f32) {
     let m = m as f32;
     let n_new = n + alpha * m;
     (n_new, r2 * n_new / (n + m))
+}
+
+/// Stochastic progressive photon mapping.
+pub struct PhotonMapping;
+
+impl Integrator for PhotonMapping {
+    const CAPABILITIES: Capabilities = Capabilities {
+        lens: Support::Yes,
+        media: false,
+        polarization: Support::No(
+            "polarised transport (polarization = true) is implemented for integrator = \"path\", \"whitted\", \"lighttrace\" and \"bdpt\"; photon mapping's photons carry no Stokes vectors",
+        ),
+        variance: Support::No(
+            "photon mapping's pixels are not means of independent samples (each iteration's radii depend on the ones before), so it has no per-pixel variance; use integrator path or bdpt for --variance",
+        ),
+        // Rays one at a time: the camera pass follows specular chains and the photons
+        // scatter from wherever the lights put them, so neither has packets.
+        packets: false,
+        auto_packets: Packets::Off,
+        camera_rays: true,
+        steps: false,
+        splats: true,
+        kernel: None,
+    };
+}
+
+impl PassIntegrator for PhotonMapping {
+    const PLANE: (&'static str, usize) = (SppmPixels::PLANE, 2);
+
+    fn initial_plane(pixels: usize) -> IntegratorPlane {
+        SppmPixels::new(pixels).into_plane()
+    }
+
+    /// An [`iteration`]; its photons' sums go to the film's splat planes.
+    fn pass<const N: usize>(
+        ctx: &Context,
+        plane: &mut IntegratorPlane,
+        k: u32,
+        cancelled: &(dyn Fn() -> bool + Sync),
+    ) -> Pass<N> {
+        let mut pixels = SppmPixels::from_plane(std::mem::take(plane));
+        let it = iteration::<N>(ctx, &mut pixels, k, cancelled);
+        *plane = pixels.into_plane();
+        Pass {
+            wl: it.wl,
+            l: it.l,
+            splat: it.photons.xyz.iter().flatten().map(|a| a.load()).collect(),
+            splat_bins: it.photons.bins.iter().map(|a| a.load()).collect(),
+            nonfinite: it.photons.nonfinite.load(Relaxed),
+            counters: it.counters,
+        }
+    }
 }
 
 #[cfg(test)]

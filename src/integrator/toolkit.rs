@@ -11,15 +11,15 @@
 //! either rule.
 use super::{Context, TraceCounters};
 use crate::accel::embree::{Hit, RayQuery};
-use crate::bsdf::{BsdfContext, LobeFlags, Material};
+use crate::bsdf::{BsdfContext, Material};
 use crate::camera::{Camera, CameraRay};
+use crate::film::tile::SampleValue;
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
 use crate::math::Frame;
 use crate::medium::{Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
-use crate::spectrum::stokes::StokesSpectrum;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -412,7 +412,7 @@ impl<const N: usize> PathState<N> {
     }
 }
 
-/// Where a path scatters, as a [`Carrier`] needs to know it: a surface (its material,
+/// Where a path scatters, as a [`Transport`](super::transport::Transport) needs to know it: a surface (its material,
 /// shading frame and ωo in that frame) or a point in a medium reached along `d_in`.
 #[derive(Clone, Copy)]
 pub(crate) enum Vertex<'a> {
@@ -425,173 +425,6 @@ pub(crate) enum Vertex<'a> {
         medium: &'a Medium,
         d_in: Vec3,
     },
-}
-
-/// What a path carries besides its scalar throughput, and what it does with the light
-/// it finds. The path tracer (`path::step`) computes every contribution as a scalar per
-/// lane (throughput, BSDF or phase value, MIS weight, transmittance, radiance) and hands
-/// it here with the event it came through: unpolarised transport ([`Unpolarized`]) adds
-/// it to the radiance; polarised transport (`integrator::polarized`) multiplies it by
-/// the path's normalised Mueller product, so both share the sampling, the MIS and the
-/// media estimators line for line. Each event's full Mueller matrix is its scalar
-/// weight times its matrix divided by its [0][0] element (`bsdf::polarization`), which
-/// is why the two factor.
-pub(crate) trait Carrier<const N: usize> {
-    /// Whether contributions need their light one by one (the Whitted tracer sums its
-    /// lights' before scaling them when they do not).
-    const POLARIZED: bool;
-
-    /// The path reached light `light` along its ray `dir` (by BSDF or phase sampling,
-    /// or escaping); `c` is the contribution.
-    fn found(
-        &mut self,
-        l: &mut SampledSpectrum<N>,
-        c: SampledSpectrum<N>,
-        light: usize,
-        dir: Vec3,
-        wl: &SampledWavelengths<N>,
-    );
-
-    /// Light `light`, sampled along `wi` (world; `wi_local` in a surface's frame) from
-    /// the vertex `v`, scattered there toward the path's previous vertex; `c` is the
-    /// contribution.
-    #[allow(clippy::too_many_arguments)]
-    fn lit(
-        &mut self,
-        l: &mut SampledSpectrum<N>,
-        c: SampledSpectrum<N>,
-        v: &Vertex,
-        wi: Vec3,
-        wi_local: Vec3,
-        light: usize,
-        wl: &SampledWavelengths<N>,
-    );
-
-    /// The path continues from `v` along `wi` (world; `wi_local` in a surface's frame)
-    /// by a lobe of `flags` (empty in a medium).
-    fn scattered(
-        &mut self,
-        v: &Vertex,
-        wi: Vec3,
-        wi_local: Vec3,
-        flags: LobeFlags,
-        wl: &SampledWavelengths<N>,
-    );
-}
-
-/// Unpolarised transport: contributions are summed, events change nothing else.
-#[derive(Clone, Copy)]
-pub(crate) struct Unpolarized;
-
-impl<const N: usize> Carrier<N> for Unpolarized {
-    const POLARIZED: bool = false;
-
-    #[inline(always)]
-    fn found(
-        &mut self,
-        l: &mut SampledSpectrum<N>,
-        c: SampledSpectrum<N>,
-        _: usize,
-        _: Vec3,
-        _: &SampledWavelengths<N>,
-    ) {
-        *l += c;
-    }
-
-    #[inline(always)]
-    fn lit(
-        &mut self,
-        l: &mut SampledSpectrum<N>,
-        c: SampledSpectrum<N>,
-        _: &Vertex,
-        _: Vec3,
-        _: Vec3,
-        _: usize,
-        _: &SampledWavelengths<N>,
-    ) {
-        *l += c;
-    }
-
-    #[inline(always)]
-    fn scattered(&mut self, _: &Vertex, _: Vec3, _: Vec3, _: LobeFlags, _: &SampledWavelengths<N>) {
-    }
-}
-
-/// What a light path carries besides its scalar throughput (light tracing; `bdpt.rs`
-/// keeps its own per vertex): nothing for unpolarised transport ([`Unpolarized`]); in a
-/// polarised render, the normalised Stokes vector of the light on the current segment
-/// (`integrator::polarized::Beam`). Its connections to the camera carry
-/// [`LightCarrier::Value`].
-pub(crate) trait LightCarrier<const N: usize>: Copy {
-    type Value: ConnectionValue<N>;
-
-    fn zero() -> Self::Value;
-
-    /// The light `light` emits along the unit `d`.
-    fn emitted(ctx: &Context, light: usize, d: Vec3, wl: &SampledWavelengths<N>) -> Self;
-
-    /// The light scatters at a surface, arriving from `from_local` (toward where it
-    /// came from) and leaving along `to_local`, by a lobe of `flags` (local frame).
-    fn scattered(
-        &mut self,
-        material: &Material,
-        frame: &Frame,
-        to_local: Vec3,
-        from_local: Vec3,
-        flags: LobeFlags,
-        wl: &SampledWavelengths<N>,
-    );
-
-    /// What the camera receives of a connection whose scalar value is `c`, the light
-    /// travelling along the unit `d` to the camera: from the light itself (`at`
-    /// None), or scattered toward it at a surface `at` = (material, frame, `d` and
-    /// the direction the light came from, local) by the material's non-delta lobes.
-    fn seen(
-        &self,
-        ctx: &Context,
-        at: Option<(&Material, &Frame, Vec3, Vec3)>,
-        d: Vec3,
-        c: SampledSpectrum<N>,
-        wl: &SampledWavelengths<N>,
-    ) -> Self::Value;
-}
-
-impl<const N: usize> LightCarrier<N> for Unpolarized {
-    type Value = SampledSpectrum<N>;
-
-    #[inline(always)]
-    fn zero() -> SampledSpectrum<N> {
-        SampledSpectrum::zero()
-    }
-
-    #[inline(always)]
-    fn emitted(_: &Context, _: usize, _: Vec3, _: &SampledWavelengths<N>) -> Self {
-        Unpolarized
-    }
-
-    #[inline(always)]
-    fn scattered(
-        &mut self,
-        _: &Material,
-        _: &Frame,
-        _: Vec3,
-        _: Vec3,
-        _: LobeFlags,
-        _: &SampledWavelengths<N>,
-    ) {
-    }
-
-    #[inline(always)]
-    fn seen(
-        &self,
-        _: &Context,
-        _: Option<(&Material, &Frame, Vec3, Vec3)>,
-        _: Vec3,
-        c: SampledSpectrum<N>,
-        _: &SampledWavelengths<N>,
-    ) -> SampledSpectrum<N> {
-        c
-    }
 }
 
 /// Where a vertex's shadow rays go. The one-path-at-a-time engine traces each at once
@@ -855,42 +688,7 @@ pub(crate) struct Connections<const N: usize, V = SampledSpectrum<N>> {
 /// Connections kept before they are added (up to 8 of them with shadow rays: a packet).
 const CONNECTIONS_CAP: usize = 16;
 
-/// What a connection carries: radiance, or in a polarised render Stokes radiance
-/// (`integrator::polarized`).
-pub(crate) trait ConnectionValue<const N: usize>: Copy {
-    /// Adds the connection to the pixel sample's own value (when it is finite).
-    fn add_to(&self, own: &mut Self);
-    /// Splats it into `pixel`.
-    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>);
-}
-
-impl<const N: usize> ConnectionValue<N> for SampledSpectrum<N> {
-    #[inline]
-    fn add_to(&self, own: &mut Self) {
-        if self.is_finite() {
-            *own += *self;
-        }
-    }
-    #[inline]
-    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>) {
-        splats.add(pixel, self, wl);
-    }
-}
-
-impl<const N: usize> ConnectionValue<N> for StokesSpectrum<N> {
-    #[inline]
-    fn add_to(&self, own: &mut Self) {
-        if self.is_finite() {
-            *own += *self;
-        }
-    }
-    #[inline]
-    fn splat(&self, splats: &mut Splats, pixel: u32, wl: &SampledWavelengths<N>) {
-        splats.add_stokes(pixel, self, wl);
-    }
-}
-
-impl<const N: usize, V: ConnectionValue<N>> Connections<N, V> {
+impl<const N: usize, V: SampleValue<N>> Connections<N, V> {
     pub fn new(batched: bool) -> Self {
         Connections {
             batched,

@@ -14,16 +14,19 @@
 //! surface with both (the course's glossy over glass) does both, each at full weight.
 //! Light reaching a diffuse surface through glass or off other diffuse surfaces is
 //! missing: that is the `path` integrator's job.
-use super::toolkit::{next_hit, Carrier, Immediate, PathState, ShadowSink, Unpolarized, Vertex};
-use super::{Context, TraceCounters};
+use super::capabilities::{Capabilities, Support};
+use super::toolkit::{Immediate, PathState, ShadowSink, Vertex};
+use super::transport::{follow, Scatter, Tracer, Transport};
+use super::{Context, Integrator, PixelIntegrator, StepIntegrator, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::LobeFlags;
 use crate::camera::CameraRay;
+use crate::film::Splats;
 use crate::geometry::{Interaction, Ray};
 use crate::light::Light;
 use crate::sampler::Sampler;
-use crate::scene::NO_LIGHT;
-use crate::settings::{on, KernelFlags, EMITTERS, ESCAPE, SHADOWS, SPECULAR};
+use crate::scene::{Features, NO_LIGHT};
+use crate::settings::{on, KernelFlags, Packets, EMITTERS, ESCAPE, SHADOWS, SPECULAR};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
@@ -32,7 +35,10 @@ const DELTA: LobeFlags = LobeFlags::SPECULAR
     .union(LobeFlags::REFLECTION)
     .union(LobeFlags::TRANSMISSION);
 
-/// Radiance arriving along `ray` at the wavelengths `wl`.
+/// Radiance arriving along `ray` at the wavelengths `wl` (Stokes radiance, in the
+/// camera's frame, for polarised transport `T`: the direct lighting light by light
+/// through the surface's non-delta lobes and the delta continuations, each with its
+/// Mueller matrix).
 ///
 /// Random numbers, in order: per non-delta light at a diffuse or glossy hit, a 2D point
 /// on the light; per continuation through a surface with both a reflecting and a
@@ -41,33 +47,32 @@ const DELTA: LobeFlags = LobeFlags::SPECULAR
 /// `K` is the kernel ([`KernelFlags`]): code for a feature whose flag is off is not
 /// compiled into this instance (shadow rays, specular continuation, area-light
 /// emission, radiance along escaping rays).
-pub fn radiance<const N: usize, const K: KernelFlags>(
+pub(crate) fn radiance<const N: usize, const K: KernelFlags, T: Transport<N>>(
     ctx: &Context,
     cam: CameraRay,
     first_hit: Option<Option<Hit>>,
     wl: &SampledWavelengths<N>,
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
-) -> SampledSpectrum<N> {
+) -> T::Value {
+    let mut carry = T::at_camera(ctx, &cam);
     let mut s = start::<N>(&cam);
-    let mut ray = cam.ray;
-    let mut pending = first_hit;
-    loop {
-        let hit = next_hit(ctx, &ray, &mut pending, counters);
-        if !step::<N, K, _>(
-            ctx,
-            &mut s,
-            &mut ray,
-            hit,
-            wl,
-            sampler,
-            counters,
-            &mut Immediate,
-        ) {
-            break;
-        }
-    }
-    s.l
+    let mut t = Tracer {
+        ctx,
+        wl,
+        sampler,
+        counters,
+        shadows: &mut Immediate,
+        carry: &mut carry,
+    };
+    follow(
+        &mut t,
+        cam.ray,
+        &mut s,
+        first_hit,
+        step::<N, K, Immediate, T>,
+    );
+    T::delivered(carry, s.l)
 }
 
 /// The path's state at the camera: what [`step`] starts from (the seed's tracer samples
@@ -82,59 +87,23 @@ pub fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
 /// One shader call of the seed's loop for the ray `ray` with closest hit `hit`: the
 /// radiance along an escaping ray, or the emission, direct lighting and specular
 /// continuation at a hit; `ray` becomes the next ray. Returns false when the path ends.
-/// Shadow rays go to `shadows`.
-#[allow(clippy::too_many_arguments)]
+/// Shadow rays go to the tracer's sink; polarised, each light's contribution goes to
+/// the transport on its own.
 #[inline(always)]
-pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>>(
-    ctx: &Context,
+pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+    t: &mut Tracer<N, S, T>,
     s: &mut PathState<N>,
     ray: &mut Ray,
     hit: Option<Hit>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
 ) -> bool {
-    step_carrying::<N, K, S, _>(
-        ctx,
-        s,
-        ray,
-        hit,
-        wl,
-        sampler,
-        counters,
-        shadows,
-        &mut Unpolarized,
-    )
-}
-
-/// [`step`] with what the path carries besides its scalar throughput (`carry`, as
-/// `path::step_carrying`'s): polarised, each light's contribution goes to it on its own.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-pub(crate) fn step_carrying<
-    const N: usize,
-    const K: KernelFlags,
-    S: ShadowSink<N>,
-    C: Carrier<N>,
->(
-    ctx: &Context,
-    s: &mut PathState<N>,
-    ray: &mut Ray,
-    hit: Option<Hit>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
-    carry: &mut C,
-) -> bool {
+    let (ctx, wl) = (t.ctx, t.wl);
     let scene = ctx.scene;
     let Some(hit) = hit else {
         if on(K, ESCAPE) {
-            if C::POLARIZED {
+            if T::POLARIZED {
                 for &i in &scene.infinite_lights {
                     let le = scene.lights[i as usize].le(ray.dir, wl);
-                    carry.found(&mut s.l, s.beta * le, i as usize, ray.dir, wl);
+                    t.found(&mut s.l, s.beta * le, i as usize, ray.dir);
                 }
             } else {
                 s.l += s.beta * scene.escaped_radiance(ray.dir, wl);
@@ -149,7 +118,7 @@ pub(crate) fn step_carrying<
         let emitter = scene.shapes[hit.geom_id as usize].light;
         if emitter != NO_LIGHT {
             let c = s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
-            carry.found(&mut s.l, c, emitter as usize, ray.dir, wl);
+            t.found(&mut s.l, c, emitter as usize, ray.dir);
         }
     }
     let flags = material.flags();
@@ -158,22 +127,25 @@ pub(crate) fn step_carrying<
     if on(K, SHADOWS) && flags.has_non_specular() {
         let bsdf_ctx = &s.bsdf_ctx;
         let f = |wi| material.eval(wo_local, frame.to_local(wi), wl, bsdf_ctx).f;
-        if C::POLARIZED {
+        if T::POLARIZED {
             let v = Vertex::Surface {
                 material,
                 frame: &frame,
                 wo_local,
             };
             let (beta, l) = (s.beta, &mut s.l);
-            direct_lighting(ctx, &it, wl, sampler, counters, shadows, f, |c, wi, i| {
-                carry.lit(l, beta * c, &v, wi, frame.to_local(wi), i, wl)
+            direct_lighting(t, &it, f, |carry, c, wi, i| {
+                let at = Scatter {
+                    v: &v,
+                    wi,
+                    wi_local: frame.to_local(wi),
+                };
+                T::lit(carry, ctx, l, beta * c, at, i, wl)
             });
         } else {
             let mut lr = SampledSpectrum::<N>::zero();
-            direct_lighting(ctx, &it, wl, sampler, counters, shadows, f, |c, _, _| {
-                lr += c
-            });
-            shadows.add_scaled(&mut s.l, s.beta, lr);
+            direct_lighting(t, &it, f, |_, c, _, _| lr += c);
+            t.shadows.add_scaled(&mut s.l, s.beta, lr);
         }
     }
     if !on(K, SPECULAR) || !flags.is_specular() {
@@ -182,7 +154,7 @@ pub(crate) fn step_carrying<
     // Delta lobes choose among themselves with one number, drawn only when there is
     // a choice (reflection and transmission); a delta's direction needs none.
     let choice = flags.contains(LobeFlags::REFLECTION | LobeFlags::TRANSMISSION);
-    let uc = if choice { sampler.get_1d() } else { 0.5 };
+    let uc = if choice { t.sampler.get_1d() } else { 0.5 };
     let Some(bs) = material.sample(wo_local, uc, Vec2::ZERO, wl, &s.bsdf_ctx) else {
         return false;
     };
@@ -202,28 +174,29 @@ pub(crate) fn step_carrying<
         frame: &frame,
         wo_local,
     };
-    carry.scattered(&v, wi, bs.wi, bs.flags, wl);
+    let at = Scatter {
+        v: &v,
+        wi,
+        wi_local: bs.wi,
+    };
+    t.scattered(at, bs.flags);
     *ray = ctx.offset.spawn(&it.spawn_point(), wi);
     true
 }
 
 /// f(ωi) L_i cos θi / pdf for every light but the environment that reaches the shading
-/// point unoccluded (as far as `shadows` knows now; the packet engine adds the rest
-/// later), given to `add` with ωi and the light's index, ωi being the unit direction
-/// toward the light and `f` the BSDF there. Lights with extent (the sun's disk, area
-/// lights) are sampled at one point.
-#[allow(clippy::too_many_arguments)]
+/// point unoccluded (as far as the tracer's shadow sink knows now; the packet engine
+/// adds the rest later), given to `add` with the transport's camera state, ωi and the
+/// light's index, ωi being the unit direction toward the light and `f` the BSDF there.
+/// Lights with extent (the sun's disk, area lights) are sampled at one point.
 #[inline]
-fn direct_lighting<const N: usize, S: ShadowSink<N>>(
-    ctx: &Context,
+fn direct_lighting<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
+    t: &mut Tracer<N, S, T>,
     it: &Interaction,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    shadows: &mut S,
     f: impl Fn(Vec3) -> SampledSpectrum<N>,
-    mut add: impl FnMut(SampledSpectrum<N>, Vec3, usize),
+    mut add: impl FnMut(&mut T::Camera, SampledSpectrum<N>, Vec3, usize),
 ) {
+    let (ctx, wl) = (t.ctx, t.wl);
     let x = it.position;
     let from = it.spawn_point();
     let n = it.normal;
@@ -234,7 +207,7 @@ fn direct_lighting<const N: usize, S: ShadowSink<N>>(
         let u = if light.is_delta() {
             Vec2::ZERO
         } else {
-            sampler.get_2d()
+            t.sampler.get_2d()
         };
         let Some(ls) = light.sample_li(x, u, wl) else {
             continue;
@@ -244,8 +217,71 @@ fn direct_lighting<const N: usize, S: ShadowSink<N>>(
             continue;
         }
         let q = ctx.offset.shadow(&from, ls.wi, ls.dist, &ls.target());
-        if let Some(c) = shadows.test(ctx, q, counters, || f(ls.wi) * (ls.l * (cos / ls.pdf))) {
-            add(c, ls.wi, i);
+        let c = t
+            .shadows
+            .test(ctx, q, t.counters, || f(ls.wi) * (ls.l * (cos / ls.pdf)));
+        if let Some(c) = c {
+            add(t.carry, c, ls.wi, i);
         }
+    }
+}
+
+/// The seed's Whitted tracer.
+pub struct Whitted;
+
+impl Integrator for Whitted {
+    const CAPABILITIES: Capabilities = Capabilities {
+        lens: Support::Yes,
+        media: false,
+        polarization: Support::Yes,
+        variance: Support::Yes,
+        packets: true,
+        // Most of its paths end at their first hit: packets of paths keep Embree's
+        // packets full (BENCHMARKS.md, "Packets of paths").
+        auto_packets: Packets::Paths,
+        camera_rays: true,
+        steps: true,
+        splats: false,
+        kernel: Some(kernel_flags),
+    };
+}
+
+/// The kernel flags the Whitted tracer is specialised on: shadow rays, specular
+/// continuation, emitters and escaping rays (`scene::features`).
+fn kernel_flags(f: &Features) -> KernelFlags {
+    let bit = |on: bool, flag: KernelFlags| if on { flag } else { 0 };
+    bit(f.shadows, SHADOWS)
+        | bit(f.specular, SPECULAR)
+        | bit(f.emitters, EMITTERS)
+        | bit(f.escape, ESCAPE)
+}
+
+impl PixelIntegrator for Whitted {
+    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        ray: CameraRay,
+        first_hit: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+        _: &mut Splats,
+    ) -> T::Value {
+        radiance::<N, K, T>(ctx, ray, first_hit, wl, sampler, counters)
+    }
+}
+
+impl StepIntegrator for Whitted {
+    fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
+        start(cam)
+    }
+
+    #[inline(always)]
+    fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+        t: &mut Tracer<N, S, T>,
+        s: &mut PathState<N>,
+        ray: &mut Ray,
+        hit: Option<Hit>,
+    ) -> bool {
+        step::<N, K, S, T>(t, s, ray, hit)
     }
 }

@@ -13,11 +13,13 @@ use crate::camera::CameraRay;
 use crate::checkpoint::{Checkpoint, FilmKey, Shard};
 use crate::film::planes::Layout;
 use crate::film::state::FilmState;
+use crate::film::state::IntegratorPlane;
 use crate::film::tile::{SampleValue, TileResult, TileSums};
 use crate::film::{add_splat_squares, Film, SpectralBins, Splats};
 use crate::geometry::{Ray, ShapeKind};
-use crate::integrator::sppm::SppmPixels;
-use crate::integrator::{self, Context, Deferred, PathState, TraceCounters, WALKS};
+use crate::integrator::sppm::PhotonMapping;
+use crate::integrator::PassIntegrator;
+use crate::integrator::{self, Context, Deferred, PathState, TraceCounters, Tracer, WALKS};
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene};
 use crate::settings::{IntegratorKind, KernelFlags, Lanes, Packets, RenderSettings};
@@ -28,11 +30,11 @@ use std::time::{Duration, Instant};
 
 mod passes;
 mod paths;
-mod sppm;
+mod progressive;
 mod tile;
 
 use passes::render_passes;
-use sppm::render_sppm;
+use progressive::render_progressive;
 
 /// Square tile edge in pixels; a multiple of the packet width.
 const TILE: u32 = 16;
@@ -238,30 +240,9 @@ fn render_with(
     opts: &RenderOptions,
 ) -> Result<(Checkpoint, RenderStats)> {
     let kind = opts.settings.integrator;
-    if scene.camera.lens.is_some()
-        && matches!(kind, IntegratorKind::LightTrace | IntegratorKind::Bdpt)
-    {
-        return Err(HeronError::Invalid(format!(
-            "integrator {}: the lens camera (camera.type = \"lens\") has no importance function We and no connection to the film yet, which light tracing and BDPT need to reach the camera from the lights; use integrator = \"path\" or \"whitted\"",
-            kind.name()
-        )));
-    }
-    if !opts.settings.polarization {
-        let which = if opts.settings.polarizer.is_some() {
-            Some("--polarizer")
-        } else if scene.camera.polarizer.is_some() {
-            Some("camera.polarizer")
-        } else {
-            None
-        };
-        if let Some(w) = which {
-            return Err(HeronError::Invalid(format!(
-                "{w}: an analyser needs polarised transport; set [render] polarization = true or pass --polarization"
-            )));
-        }
-    }
+    let caps = integrator::capabilities(kind);
+    integrator::capabilities::check_camera(scene, &opts.settings).map_err(HeronError::Invalid)?;
     if opts.settings.polarization {
-        integrator::stokes_kernel::<1>(kind, 0).map_err(HeronError::Invalid)?;
         // The sky's polarisation is tabulated here, before the workers start.
         if let Some(sky) = &scene.sky {
             sky.linear_table();
@@ -274,54 +255,33 @@ fn render_with(
         offset: opts.settings.ray_offset(kind),
     };
     // The kernel is decided here, once per render, from what the scene uses.
-    let k = Features::of(scene)
-        .choose(kind, opts.settings.kernel)
+    let k = integrator::choose_kernel(kind, &Features::of(scene), opts.settings.kernel)
         .map_err(HeronError::Invalid)?;
+    integrator::capabilities::check_variance(kind, opts.variance).map_err(HeronError::Invalid)?;
     // Polarised transport has two kernels: with media and without.
     let k = if opts.settings.polarization {
         integrator::stokes_flags(kind, k)
     } else {
         k
     };
+    let mut opts = opts.clone();
+    // `auto` resolved: the provenance records what ran.
+    opts.settings.packets =
+        integrator::capabilities::packets(kind, opts.settings.packets, opts.settings.polarization);
     if kind == IntegratorKind::Sppm {
-        // Rays one at a time: the camera pass follows specular chains and the photons
-        // scatter from wherever the lights put them, so neither has packets.
-        let mut opts = opts.clone();
-        opts.settings.packets = Packets::Off;
         let (state, mut stats) = match opts.settings.lanes {
-            Lanes::One => render_sppm::<1>(&ctx, pool, &opts),
-            Lanes::Four => render_sppm::<4>(&ctx, pool, &opts),
-            Lanes::Eight => render_sppm::<8>(&ctx, pool, &opts),
+            Lanes::One => render_progressive::<PhotonMapping, 1>(&ctx, pool, &opts),
+            Lanes::Four => render_progressive::<PhotonMapping, 4>(&ctx, pool, &opts),
+            Lanes::Eight => render_progressive::<PhotonMapping, 8>(&ctx, pool, &opts),
         }?;
         stats.kernel = k;
         return Ok((state, stats));
     }
-    let mut opts = opts.clone();
-    // `auto` resolved: the provenance records what ran (light tracing has no camera
-    // rays, so no camera packets).
-    opts.settings.packets = match (kind, opts.settings.packets) {
-        (IntegratorKind::Whitted, Packets::Auto) => Packets::Paths,
-        (IntegratorKind::LightTrace, Packets::Paths) => Packets::Paths,
-        (IntegratorKind::LightTrace, _) => Packets::Off,
-        (_, Packets::Auto) => Packets::Camera,
-        (_, p) => p,
-    };
-    // Light tracing and BDPT have no steps: with `paths`, each pixel sample sends its
-    // connections' shadow rays 8 at a time (toolkit `Connections`).
-    if opts.settings.polarization
-        && opts.settings.packets == Packets::Paths
-        && integrator::path_fns::<1>(kind, 0).is_some()
-    {
-        // The packet engine's steps carry scalar throughputs: camera packets only (light
-        // tracing's and BDPT's connections carry Stokes vectors in their packets).
-        opts.settings.packets = Packets::Camera;
-    }
-    let paths =
-        opts.settings.packets == Packets::Paths && integrator::path_fns::<1>(kind, 0).is_some();
+    let paths = opts.settings.packets == Packets::Paths && caps.steps;
     let polarized = opts.settings.polarization;
     let integrate = move |n: Lanes| -> SampleFn {
         if polarized {
-            // Checked above: the integrator has a polarised kernel.
+            // Checked above (`check_camera`): the integrator has a polarised kernel.
             const WHY: &str = "a polarised kernel";
             return match n {
                 Lanes::One => {
@@ -361,7 +321,7 @@ fn render_with(
     // Sobol' digits then serve fewer samples) and waits for its slowest tile: at 2²⁰ a
     // 512² Whitted render was 3-5% slower than in one pass.
     let npix = (scene.camera.width * scene.camera.height).max(1);
-    let pass = if kind.splats() {
+    let pass = if caps.splats {
         ((1u32 << 20) / npix).max(1)
     } else {
         ((1u32 << 22) / npix).max(1)
@@ -399,7 +359,7 @@ fn layout(scene: &Scene, opts: &RenderOptions) -> Layout {
 
 /// Whether the render's integrator splats (so that splat buffers are needed).
 fn kind_splats(opts: &RenderOptions) -> bool {
-    opts.settings.integrator.splats()
+    integrator::capabilities(opts.settings.integrator).splats
 }
 
 /// The per-sample function of a render, one per lane count (see

@@ -41,7 +41,7 @@ pub(super) fn render_passes(
     // Unnormalised sums over the whole render: XYZ and bins per pixel, finite samples per
     // pixel, and splatted XYZ.
     let key = settings_key(ctx.scene, opts, pass_spp);
-    let mut state = initial_state(ctx.scene, opts, key, passes.len())?;
+    let mut state = initial_state(ctx.scene, opts, key, passes.len(), None)?;
     let mut stats = RenderStats {
         resumed_from: opts.resume.as_ref().map(|c| c.film.spp_done),
         ..Default::default()
@@ -162,28 +162,28 @@ impl RenderStats {
 }
 
 /// The film's state a render starts from: the checkpoint `opts` resumes, checked against
-/// this render (its settings `key`, its film's planes and at most `passes` passes), or
-/// an empty film.
+/// this render (its settings `key`, its film's planes, at most `passes` passes and the
+/// integrator's own plane: its name and values per pixel, and its initial state), or an
+/// empty film.
 pub(super) fn initial_state(
     scene: &Scene,
     opts: &RenderOptions,
     key: FilmKey,
     passes: usize,
+    plane: Option<OwnPlane>,
 ) -> Result<Checkpoint> {
     let layout = layout(scene, opts);
-    let sppm = opts.settings.integrator == IntegratorKind::Sppm;
     match &opts.resume {
-        // Photon mapping keeps N and R² per pixel.
         Some(c) => c.resume(
             &key,
             opts.shard,
             &layout,
             passes,
-            sppm.then_some((SppmPixels::PLANE, 2)),
+            plane.map(|p| (p.name, p.per_pixel)),
         ),
         None => {
             let mut film = FilmState::new(layout);
-            film.integrator = sppm.then(|| SppmPixels::new(layout.pixels()).into_plane());
+            film.integrator = plane.map(|p| (p.initial)(layout.pixels()));
             Ok(Checkpoint {
                 key,
                 shard: opts.shard,
@@ -192,6 +192,15 @@ pub(super) fn initial_state(
             })
         }
     }
+}
+
+/// A progressive integrator's own plane of the film (`PassIntegrator::PLANE`): its name,
+/// its values per pixel and its state before the first pass.
+#[derive(Clone, Copy)]
+pub(super) struct OwnPlane {
+    pub name: &'static str,
+    pub per_pixel: usize,
+    pub initial: fn(usize) -> IntegratorPlane,
 }
 
 /// When a render last wrote a checkpoint and a preview, for the decisions at the end

@@ -120,16 +120,15 @@ pub(super) fn render_tile_paths<const N: usize, const VARIANCE: bool>(
         for k in 0..PACKET {
             let Some(lane) = &mut lanes[k] else { continue };
             shadows[k].clear();
-            if (fns.step)(
+            let mut t = Tracer {
                 ctx,
-                &mut lane.state,
-                &mut lane.ray,
-                hits[k],
-                &lane.wl,
-                &mut samplers[k],
-                &mut counters,
-                &mut shadows[k],
-            ) {
+                wl: &lane.wl,
+                sampler: &mut samplers[k],
+                counters: &mut counters,
+                shadows: &mut shadows[k],
+                carry: &mut (),
+            };
+            if (fns.step)(&mut t, &mut lane.state, &mut lane.ray, hits[k]) {
                 going |= 1 << k;
             }
             rounds = rounds.max(shadows[k].tests.len());

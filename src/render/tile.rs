@@ -40,6 +40,8 @@ pub(super) fn render_tile<const N: usize, const VARIANCE: bool, O: SampleValue<N
     }; PACKET];
     let mut wls = [SampledWavelengths::<N>::sample_uniform(0.0); PACKET];
     let mut cams: [Option<CameraRay>; PACKET] = [None; PACKET];
+    let camera_packets = opts.settings.packets.camera()
+        && integrator::capabilities(opts.settings.integrator).camera_rays;
     for y in 0..h {
         if cancelled(opts) {
             break;
@@ -82,9 +84,7 @@ pub(super) fn render_tile<const N: usize, const VARIANCE: bool, O: SampleValue<N
                             }
                         },
                     );
-                let hits = if opts.settings.packets.camera()
-                    && opts.settings.integrator.uses_camera_rays()
-                {
+                let hits = if camera_packets {
                     counters.rays += traced.count_ones() as u64;
                     Some(ctx.accel.intersect8(&rays, traced))
                 } else {

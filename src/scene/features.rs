@@ -3,10 +3,12 @@
 //! Only materials that some shape uses count: a material defined in the file but bound
 //! to no shape never meets a ray.
 //!
-//! [`Features::kernel`] turns the features into [`KernelFlags`] (defined in
-//! `crate::settings`), which the renderer uses, once per render, to pick an integrator
-//! monomorphised over them (a `const K: u32` generic next to the lane count N): code
-//! behind a flag that is off is not in that kernel at all. The flags:
+//! Each integrator that is specialised turns the features into the
+//! [`KernelFlags`](crate::settings::KernelFlags) it needs (its declared
+//! `Capabilities::kernel`; `integrator::capabilities::choose_kernel` applies it), which
+//! the renderer uses, once per render, to pick an integrator monomorphised over them (a
+//! `const K: u32` generic next to the lane count N): code behind a flag that is off is
+//! not in that kernel at all. The flags:
 //!
 //! - `SHADOWS`: shadow rays (Whitted) or next-event estimation (path tracer);
 //! - `SPECULAR`: specular continuation past the first hit (Whitted only);
@@ -25,10 +27,6 @@
 //! build refuses scenes that need what it lacks (`scripts/bench_kernels.py`).
 use super::{Scene, NO_LIGHT};
 use crate::light::Light;
-use crate::settings::{
-    flag_names, IntegratorKind, KernelChoice, KernelFlags, ALL, EMITTERS, ESCAPE, MEDIA, SHADOWS,
-    SPECULAR, STRIPPED,
-};
 
 /// The parts of the transport a scene uses. Each field is conservative: when it is true
 /// the part may be needed; when it is false the renderer can skip it without changing
@@ -60,13 +58,6 @@ pub struct Features {
     /// sample free flights and scatter in it, and shadow rays pass media boundaries with
     /// their transmittance. When false, none of that code is in the kernel.
     pub media: bool,
-}
-
-/// The flags of `k` this build was made without (usually none, hence a function:
-/// clippy rejects a mask that is a constant zero).
-#[inline]
-fn stripped_of(k: KernelFlags) -> KernelFlags {
-    k & STRIPPED
 }
 
 impl Features {
@@ -102,61 +93,5 @@ impl Features {
             escape: !scene.infinite_lights.is_empty(),
             media: !scene.media.is_empty(),
         }
-    }
-
-    /// The kernel flags `kind` needs for these features. The Whitted tracer is
-    /// specialised on shadows, specular, emitters and escape; the path tracer on shadows
-    /// (its next-event estimation), emitters, escape and media; light tracing and BDPT
-    /// always run their general kernel, and so does photon mapping's (its iterations are not
-    /// per-sample kernels).
-    pub fn kernel(&self, kind: IntegratorKind) -> KernelFlags {
-        let bit = |on: bool, f: KernelFlags| if on { f } else { 0 };
-        match kind {
-            IntegratorKind::Whitted => {
-                bit(self.shadows, SHADOWS)
-                    | bit(self.specular, SPECULAR)
-                    | bit(self.emitters, EMITTERS)
-                    | bit(self.escape, ESCAPE)
-            }
-            IntegratorKind::Path => {
-                bit(self.nee, SHADOWS)
-                    | bit(self.emitters, EMITTERS)
-                    | bit(self.escape, ESCAPE)
-                    | bit(self.media, MEDIA)
-            }
-            IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm => ALL,
-        }
-    }
-
-    /// The kernel a render with `kind` runs: the specialised one for `Auto`, every flag
-    /// for `General`. Errors if the scene needs a flag this build was made without.
-    pub fn choose(
-        &self,
-        kind: IntegratorKind,
-        choice: KernelChoice,
-    ) -> Result<KernelFlags, String> {
-        if self.media && kind != IntegratorKind::Path {
-            return Err(format!(
-                "the scene has participating media (a shape's medium), which only the path integrator renders, not {}; use --integrator path",
-                kind.name()
-            ));
-        }
-        let need = self.kernel(kind);
-        let specialised = !matches!(
-            kind,
-            IntegratorKind::LightTrace | IntegratorKind::Bdpt | IntegratorKind::Sppm
-        );
-        let missing = stripped_of(need);
-        if specialised && missing != 0 {
-            return Err(format!(
-                "this heron was built without {} (HERON_STRIP), which the scene needs",
-                flag_names(missing)
-            ));
-        }
-        Ok(match choice {
-            KernelChoice::Auto => need,
-            KernelChoice::General => ALL,
-            KernelChoice::Forced(k) => k & ALL,
-        } & !STRIPPED)
     }
 }

@@ -1,63 +1,14 @@
-//! What a strategy's contribution is composed of: radiance (`Unpolarized`), or Stokes
-//! radiance from the camera subpath's Mueller chain and the light subpath's beam
-//! (`Polarized`).
+//! What a strategy of polarised BDPT carries: Stokes radiance from the camera subpath's
+//! Mueller chain and the light subpath's beam (the BDPT state of the transport
+//! `integrator::polarized::Polarized`; unpolarised BDPT carries nothing).
 use super::*;
-
-/// What BDPT's subpaths carry besides their scalar throughputs, and what a strategy's
-/// connection then carries.
-pub(super) trait BdptCarrier<const N: usize>: Sized {
-    type Value: ConnectionValue<N>;
-
-    fn zero() -> Self::Value;
-
-    /// From the two subpaths, once traced; `dir` is the camera ray's direction.
-    fn new(b: &Bdpt<N>, light: &[Vertex<N>], camera: &[Vertex<N>], dir: Vec3) -> Self;
-
-    /// The value of strategy (s, t) whose scalar contribution is `c`, with the vertex
-    /// `sampled` for it (s = 1: the light's; t = 1: the camera's).
-    fn value(
-        &self,
-        b: &Bdpt<N>,
-        light: &[Vertex<N>],
-        camera: &[Vertex<N>],
-        st: (usize, usize),
-        sampled: Option<&Vertex<N>>,
-        c: SampledSpectrum<N>,
-    ) -> Self::Value;
-}
-
-impl<const N: usize> BdptCarrier<N> for Unpolarized {
-    type Value = SampledSpectrum<N>;
-
-    #[inline(always)]
-    fn zero() -> SampledSpectrum<N> {
-        SampledSpectrum::zero()
-    }
-
-    #[inline(always)]
-    fn new(_: &Bdpt<N>, _: &[Vertex<N>], _: &[Vertex<N>], _: Vec3) -> Self {
-        Unpolarized
-    }
-
-    #[inline(always)]
-    fn value(
-        &self,
-        _: &Bdpt<N>,
-        _: &[Vertex<N>],
-        _: &[Vertex<N>],
-        _: (usize, usize),
-        _: Option<&Vertex<N>>,
-        c: SampledSpectrum<N>,
-    ) -> SampledSpectrum<N> {
-        c
-    }
-}
+use crate::spectrum::stokes::StokesSpectrum;
 
 /// Polarised BDPT: the camera subpath's [`Chain`] on each of its segments and the light
 /// subpath's [`Beam`] on each of its, from which every strategy's Stokes radiance is the
 /// camera side's chain through the connection's two events applied to the light side's
 /// beam (`integrator::polarized` has the convention).
-pub(super) struct Polarized<const N: usize> {
+pub(crate) struct PolarizedSubpaths<const N: usize> {
     /// `chains[i]`: on the segment from camera vertex i to i − 1 (i ≥ 1).
     chains: [Chain<N>; MAX_VERTICES],
     /// `beams[j]`: on the segment from light vertex j − 1 to j (j ≥ 1).
@@ -87,14 +38,11 @@ impl<const N: usize> Bdpt<'_, N> {
     }
 }
 
-impl<const N: usize> BdptCarrier<N> for Polarized<N> {
-    type Value = StokesSpectrum<N>;
-
-    fn zero() -> StokesSpectrum<N> {
-        StokesSpectrum::zero()
-    }
-
-    fn new(b: &Bdpt<N>, light: &[Vertex<N>], camera: &[Vertex<N>], dir: Vec3) -> Self {
+impl<const N: usize> PolarizedSubpaths<N> {
+    /// From the two subpaths, once traced; `dir` is the camera ray's direction.
+    pub(crate) fn new(b: &Bdpt<N>, paths: &Subpaths<N>, dir: Vec3) -> Self {
+        let light = &paths.light[..paths.n_light];
+        let camera = &paths.camera[..paths.n_camera];
         let (scene, wl) = (b.scene(), b.wl);
         let mut chains = [Chain::at_camera(b.ctx, dir); MAX_VERTICES];
         for i in 1..camera.len().saturating_sub(1) {
@@ -121,18 +69,20 @@ impl<const N: usize> BdptCarrier<N> for Polarized<N> {
                 wl,
             );
         }
-        Polarized { chains, beams }
+        PolarizedSubpaths { chains, beams }
     }
 
-    fn value(
+    /// The Stokes radiance of strategy (s, t) whose scalar contribution is `c`, with the
+    /// vertex `sampled` for it (s = 1: the light's; t = 1: the camera's).
+    pub(crate) fn value(
         &self,
         b: &Bdpt<N>,
-        light: &[Vertex<N>],
-        camera: &[Vertex<N>],
+        paths: &Subpaths<N>,
         (s, t): (usize, usize),
         sampled: Option<&Vertex<N>>,
         c: SampledSpectrum<N>,
     ) -> StokesSpectrum<N> {
+        let (light, camera) = (&paths.light, &paths.camera);
         let (scene, wl) = (b.scene(), b.wl);
         if s == 0 {
             // The camera subpath reached a light: an emitting surface, or the lights at

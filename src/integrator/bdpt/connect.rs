@@ -1,14 +1,13 @@
 //! Connecting a light subpath's vertex to a camera subpath's: the geometry term, the
 //! shadow ray, the power heuristic's weight over every strategy, and the connection's
 //! contribution.
-use super::carrier::BdptCarrier;
 use super::*;
 
 impl<'a, const N: usize> Bdpt<'a, N> {
     /// Geometry term between two vertices with their visibility: 0 when blocked (or
     /// degenerate), else the term and the shadow ray still to trace (deferred by
     /// `conns`).
-    pub(super) fn g<V: ConnectionValue<N>>(
+    pub(super) fn g<V: SampleValue<N>>(
         &self,
         a: &Vertex<N>,
         b: &Vertex<N>,
@@ -41,7 +40,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     /// The shadow ray between two points, with the render's `RayOffset` cutoffs (points
     /// too close to tell apart count as blocked): `Err` when it is known to be blocked,
     /// else the query still to trace (`None`: traced and clear).
-    pub(super) fn shadow<V: ConnectionValue<N>>(
+    pub(super) fn shadow<V: SampleValue<N>>(
         &self,
         from: &SpawnPoint,
         w: Vec3,
@@ -162,19 +161,17 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     /// Strategy (s, t): its MIS-weighted contribution to the camera's pixel, or (for
     /// t = 1) a splat; None when it adds nothing. Its shadow ray is traced now or
     /// deferred, as `conns` does.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn connect<C: BdptCarrier<N>>(
+    pub(super) fn connect<T: Transport<N>>(
         &self,
-        carry: &C,
-        light: &mut [Vertex<N>],
-        camera: &mut [Vertex<N>],
-        s: usize,
-        t: usize,
+        carry: &T::Bdpt,
+        paths: &mut Subpaths<N>,
+        (s, t): (usize, usize),
         sampler: &mut Sampler,
-        conns: &Connections<N, C::Value>,
+        conns: &Connections<N, T::Value>,
         counters: &mut TraceCounters,
-    ) -> Option<Connection<N, C::Value>> {
+    ) -> Option<Connection<N, T::Value>> {
         let scene = self.scene();
+        let (light, camera) = (&mut paths.light[..], &mut paths.camera[..]);
         // A camera path that reached a light is only used as such (s = 0).
         if t > 1 && s != 0 && camera[t - 1].kind == Kind::Light {
             return None;
@@ -214,7 +211,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             sampled = Some(cv);
             let w = self.mis_weight(light, camera, sampled, s, t);
             return Some(Connection {
-                c: carry.value(self, light, camera, (s, t), sampled.as_ref(), c * w),
+                c: T::strategy(carry, self, paths, (s, t), sampled.as_ref(), c * w),
                 splat: Some(pixel_of(cam, cs.raster)),
                 shadow,
             });
@@ -288,7 +285,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         }
         let c = l * self.mis_weight(light, camera, sampled, s, t);
         Some(Connection {
-            c: carry.value(self, light, camera, (s, t), sampled.as_ref(), c),
+            c: T::strategy(carry, self, paths, (s, t), sampled.as_ref(), c),
             splat: None,
             shadow,
         })

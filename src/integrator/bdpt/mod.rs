@@ -30,33 +30,34 @@
 //! bounce), then per camera bounce lobe 1D and direction 2D, then for each (s = 1, t)
 //! connection the light choice 1D and point 2D. Subpaths are at most [`MAX_VERTICES`]
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
+use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE};
 use super::polarized::{non_delta, Beam, Chain};
 use super::toolkit::{
-    next_hit, pixel_of, Connection, ConnectionValue, Connections, LightPathStart, Unpolarized,
-    Vertex as Event,
+    next_hit, pixel_of, Connection, Connections, LightPathStart, Vertex as Event,
 };
-use super::{Context, TraceCounters};
+use super::transport::Transport;
+use super::{Context, Integrator, PixelIntegrator, TraceCounters};
 use crate::accel::embree::{Hit, RayQuery};
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::camera::CameraRay;
+use crate::film::tile::SampleValue;
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::Light;
 use crate::math::Frame;
 use crate::sampler::Sampler;
 use crate::scene::{Scene, NO_LIGHT};
-use crate::settings::Packets;
-use crate::spectrum::stokes::StokesSpectrum;
+use crate::settings::{KernelFlags, Packets};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
-/// Vertices per subpath.
 mod carrier;
 mod connect;
 mod subpaths;
 
-use carrier::{BdptCarrier, Polarized};
+pub(crate) use carrier::PolarizedSubpaths;
 
+/// Vertices per subpath.
 pub const MAX_VERTICES: usize = 24;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,8 +70,9 @@ enum Kind {
     Surface,
 }
 
+/// A vertex of a subpath.
 #[derive(Clone, Copy, Debug)]
-struct Vertex<const N: usize> {
+pub(crate) struct Vertex<const N: usize> {
     kind: Kind,
     beta: SampledSpectrum<N>,
     p: Vec3,
@@ -212,9 +214,20 @@ fn infinite_position_density(scene: &Scene, w: Vec3) -> f32 {
     }
 }
 
-struct Bdpt<'a, const N: usize> {
+/// One pixel sample's render context and wavelengths, which every strategy shares.
+pub(crate) struct Bdpt<'a, const N: usize> {
     ctx: &'a Context<'a>,
     wl: &'a SampledWavelengths<N>,
+}
+
+/// The two subpaths of a pixel sample, on the stack: `light[..n_light]` and
+/// `camera[..n_camera]` are traced; a strategy's MIS weight rewrites vertices near its
+/// connection and restores them.
+pub(crate) struct Subpaths<const N: usize> {
+    light: [Vertex<N>; MAX_VERTICES],
+    camera: [Vertex<N>; MAX_VERTICES],
+    n_light: usize,
+    n_camera: usize,
 }
 
 impl<'a, const N: usize> Bdpt<'a, N> {
@@ -318,8 +331,12 @@ fn direction<const N: usize>(a: &Vertex<N>, b: &Vertex<N>) -> Vec3 {
 }
 
 /// The MIS-weighted sum of every strategy for one pixel sample; t = 1 strategies go to
-/// `splats`.
-pub fn radiance<const N: usize>(
+/// `splats`. What the subpaths carry besides their scalar throughputs is the transport
+/// `T`'s: nothing, or their Mueller matrices and Stokes vectors (polarised BDPT, whose
+/// value is the Stokes radiance in the camera's frame and whose t = 1 strategies splat
+/// Stokes radiance). Both trace the same subpaths and strategies with the same random
+/// numbers.
+pub(crate) fn radiance<const N: usize, T: Transport<N>>(
     ctx: &Context,
     cam: CameraRay,
     first_hit: Option<Option<Hit>>,
@@ -327,74 +344,72 @@ pub fn radiance<const N: usize>(
     sampler: &mut Sampler,
     counters: &mut TraceCounters,
     splats: &mut Splats,
-) -> SampledSpectrum<N> {
-    radiance_carrying::<N, Unpolarized>(ctx, cam, first_hit, wl, sampler, counters, splats)
-}
-
-/// The Stokes radiance of one pixel sample of polarised BDPT, in the camera's frame;
-/// t = 1 strategies splat Stokes radiance.
-pub(crate) fn polarized_radiance<const N: usize>(
-    ctx: &Context,
-    cam: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> StokesSpectrum<N> {
-    radiance_carrying::<N, Polarized<N>>(ctx, cam, first_hit, wl, sampler, counters, splats)
-}
-
-/// [`radiance`] with what the subpaths carry besides their scalar throughputs: nothing
-/// ([`Unpolarized`]), or their Mueller matrices and Stokes vectors ([`Polarized`]).
-/// Both trace the same subpaths and strategies with the same random numbers.
-fn radiance_carrying<const N: usize, C: BdptCarrier<N>>(
-    ctx: &Context,
-    cam: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> C::Value {
+) -> T::Value {
     // The pinhole's ray (render.rs refuses BDPT with a lens camera).
     let ray = cam.ray;
     let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
     let b = Bdpt { ctx, wl };
-    let mut light = [Vertex::<N>::EMPTY; MAX_VERTICES];
-    let mut camera = [Vertex::<N>::EMPTY; MAX_VERTICES];
-    let n_light = b.light_subpath(&mut light, max_depth + 1, sampler, counters);
-    let n_camera = b.camera_subpath(
+    let mut paths = Subpaths {
+        light: [Vertex::<N>::EMPTY; MAX_VERTICES],
+        camera: [Vertex::<N>::EMPTY; MAX_VERTICES],
+        n_light: 0,
+        n_camera: 0,
+    };
+    paths.n_light = b.light_subpath(&mut paths.light, max_depth + 1, sampler, counters);
+    paths.n_camera = b.camera_subpath(
         ray,
         first_hit,
-        &mut camera,
+        &mut paths.camera,
         max_depth + 2,
         sampler,
         counters,
     );
-    let carry = C::new(&b, &light[..n_light], &camera[..n_camera], ray.dir);
-    let mut l = C::zero();
-    let mut conns = Connections::<N, C::Value>::new(ctx.settings.packets == Packets::Paths);
-    for t in 1..=n_camera {
-        for s in 0..=n_light {
+    let carry = T::subpaths(&b, &paths, ray.dir);
+    let mut l = T::Value::zero();
+    let mut conns = Connections::<N, T::Value>::new(ctx.settings.packets == Packets::Paths);
+    for t in 1..=paths.n_camera {
+        for s in 0..=paths.n_light {
             let depth = s as isize + t as isize - 2;
             if (s == 1 && t == 1) || depth < 0 || depth > max_depth as isize {
                 continue;
             }
-            if let Some(c) = b.connect(
-                &carry,
-                &mut light,
-                &mut camera,
-                s,
-                t,
-                sampler,
-                &conns,
-                counters,
-            ) {
+            if let Some(c) = b.connect::<T>(&carry, &mut paths, (s, t), sampler, &conns, counters) {
                 conns.push(ctx, c, (&mut l, splats), wl, counters);
             }
         }
     }
     conns.flush(ctx, (&mut l, splats), wl, counters);
     l
+}
+
+/// Bidirectional path tracing.
+pub struct Bidirectional;
+
+impl Integrator for Bidirectional {
+    const CAPABILITIES: Capabilities = Capabilities {
+        lens: Support::No(LENS_NEEDS_WE),
+        media: false,
+        polarization: Support::Yes,
+        variance: Support::Yes,
+        packets: true,
+        auto_packets: Packets::Camera,
+        camera_rays: true,
+        steps: false,
+        splats: true,
+        kernel: None,
+    };
+}
+
+impl PixelIntegrator for Bidirectional {
+    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        ray: CameraRay,
+        first_hit: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+        splats: &mut Splats,
+    ) -> T::Value {
+        radiance::<N, T>(ctx, ray, first_hit, wl, sampler, counters, splats)
+    }
 }

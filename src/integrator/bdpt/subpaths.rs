@@ -2,22 +2,37 @@
 //! vertex with its forward and reverse area densities.
 use super::*;
 
+/// Where a subpath's random walk starts: its first ray (whose closest hit `first_hit`
+/// holds when already traced), the throughput and solid-angle density `pdf` it was
+/// sampled with, how many bounces it may take and whether it carries radiance or
+/// importance.
+pub(super) struct Walk<const N: usize> {
+    ray: Ray,
+    first_hit: Option<Option<Hit>>,
+    beta: SampledSpectrum<N>,
+    pdf: f32,
+    max_bounces: usize,
+    mode: TransportMode,
+}
+
 impl<'a, const N: usize> Bdpt<'a, N> {
-    /// Follows a subpath from `ray` (sampled with solid-angle density `pdf`), storing
-    /// vertices after `path[0]`; returns the number stored.
-    #[allow(clippy::too_many_arguments)]
+    /// Follows a subpath from `w.ray`, storing vertices after `path[0]`; returns the
+    /// number stored.
     pub(super) fn random_walk(
         &self,
-        mut ray: Ray,
-        first_hit: Option<Option<Hit>>,
-        mut beta: SampledSpectrum<N>,
-        pdf: f32,
-        max_bounces: usize,
-        mode: TransportMode,
+        w: Walk<N>,
         path: &mut [Vertex<N>],
         sampler: &mut Sampler,
         counters: &mut TraceCounters,
     ) -> usize {
+        let Walk {
+            mut ray,
+            first_hit,
+            mut beta,
+            pdf,
+            max_bounces,
+            mode,
+        } = w;
         if max_bounces == 0 {
             return 0;
         }
@@ -133,17 +148,15 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         path[0] = v;
         let beta = start.beta();
         let ray = self.ctx.offset.spawn(&le.spawn_point(), le.dir);
-        let n = self.random_walk(
+        let walk = Walk {
             ray,
-            None,
+            first_hit: None,
             beta,
-            le.pdf_dir,
-            max_vertices - 1,
-            TransportMode::Importance,
-            path,
-            sampler,
-            counters,
-        );
+            pdf: le.pdf_dir,
+            max_bounces: max_vertices - 1,
+            mode: TransportMode::Importance,
+        };
+        let n = self.random_walk(walk, path, sampler, counters);
         if v.infinite {
             // Light paths from infinity: their first vertex's density is positional
             // (per area across the rays), and the origin's is the directions'.
@@ -160,7 +173,6 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     }
 
     /// The camera subpath for the camera ray `ray`; returns its number of vertices.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn camera_subpath(
         &self,
         ray: Ray,
@@ -178,17 +190,15 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         v.pdf_fwd = 1.0;
         path[0] = v;
         let pdf_dir = cam.pdf_we(ray.dir).1;
-        let n = self.random_walk(
+        let walk = Walk {
             ray,
             first_hit,
-            SampledSpectrum::splat(1.0),
-            pdf_dir,
-            max_vertices - 1,
-            TransportMode::Radiance,
-            path,
-            sampler,
-            counters,
-        );
+            beta: SampledSpectrum::splat(1.0),
+            pdf: pdf_dir,
+            max_bounces: max_vertices - 1,
+            mode: TransportMode::Radiance,
+        };
+        let n = self.random_walk(walk, path, sampler, counters);
         n + 1
     }
 }
