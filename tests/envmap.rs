@@ -202,7 +202,8 @@ fn a_mitsuba_envmap_converts_to_an_environment_table() {
     std::fs::write(&p, xml).unwrap();
     let imported = import_scene(&p, &ImportOptions::default()).unwrap();
     assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
-    let env = imported.table["environment"].as_table().unwrap();
+    let table = imported.table();
+    let env = table["environment"].as_table().unwrap();
     assert_eq!(env["map"].as_str(), Some("maps/sky.exr"));
     assert_eq!(env["scale"].as_float(), Some(2.5));
     let rows = env["transform"].as_array().unwrap();
@@ -269,7 +270,7 @@ fn a_pbrt_image_infinite_light_is_an_equal_area_map_in_its_frame() {
             "{:?}",
             imp.warnings
         );
-        let env = imp.table["environment"].as_table().unwrap().clone();
+        let env = imp.table()["environment"].as_table().unwrap().clone();
         let film = run(&load_imported(&imp).unwrap(), IntegratorKind::Path, 4, 1);
         (env, film.xyz[12][1])
     };

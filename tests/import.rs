@@ -119,7 +119,7 @@ fn sensor_film_sampler_and_integrator_convert_with_mitsuba_s_conventions() {
     </sensor>
 </scene>"#;
     let (_d, r) = import_text(text);
-    let t = r.unwrap().table;
+    let t = r.unwrap().table();
     assert_eq!(v3(get(&t, "camera.eye")), DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(v3(get(&t, "camera.look_at")), DVec3::new(1.0, 2.0, 2.0));
     assert_eq!(v3(get(&t, "camera.up")), DVec3::Y);
@@ -162,7 +162,7 @@ fn sensor_film_sampler_and_integrator_convert_with_mitsuba_s_conventions() {
         let mut o = ImportOptions::default();
         o.defines.insert("spp".into(), "9".into());
         let (_d, r) = import_with(&text, &o);
-        let t = r.unwrap().table;
+        let t = r.unwrap().table();
         let tan_y = 0.5 / f(get(&t, "camera.d"));
         assert!(
             (tan_y - want_tan_y).abs() < 1e-12,
@@ -197,7 +197,7 @@ fn bsdfs_convert_to_heron_materials_and_say_what_changes() {
 "#;
     let (_d, r) = import_text(&scene(body));
     let imp = r.unwrap();
-    let t = &imp.table;
+    let t = &imp.table();
     assert_eq!(get(t, "materials.wall.type").as_str(), Some("lambertian"));
     assert_eq!(
         v3(get(t, "materials.wall.rho_d")),
@@ -261,7 +261,7 @@ fn shapes_and_emitters_land_where_their_transforms_put_them() {
 "#;
     let (_d, r) = import_text(&scene(body));
     let imp = r.unwrap();
-    let t = &imp.table;
+    let t = &imp.table();
     // The rectangle [-1, 1]² scaled, turned so its normal (+z) points down (−y), lifted.
     let o = v3(get(t, "shapes.0.origin"));
     let (e1, e2) = (v3(get(t, "shapes.0.edge1")), v3(get(t, "shapes.0.edge2")));
@@ -352,7 +352,7 @@ fn obj_and_ply_meshes_take_the_transform() {
     let p = write(dir.path(), "scene.xml", &xml);
     let imp = import_scene(&p, &ImportOptions::default()).unwrap();
     assert_eq!(
-        get(&imp.table, "shapes.0.file").as_str(),
+        get(&imp.table(), "shapes.0.file").as_str(),
         Some("meshes/tet.obj")
     );
     let scene = load_imported(&imp).unwrap();
@@ -500,7 +500,7 @@ fn includes_are_spliced_and_a_cycle_is_an_error() {
         &scene("<include filename=\"materials.xml\"/><shape type=\"sphere\"><ref id=\"grey\"/></shape>"),
     );
     let imp = import_scene(&p, &ImportOptions::default()).unwrap();
-    assert_eq!(f(get(&imp.table, "materials.grey.rho_d")), 0.25);
+    assert_eq!(f(get(&imp.table(), "materials.grey.rho_d")), 0.25);
     let p = write(
         dir.path(),
         "loop.xml",
@@ -597,7 +597,7 @@ fn pbrt_materials_lights_and_shapes_convert_with_pbrt_s_conventions() {
     );
     let (_d, r) = import_pbrt(&text);
     let imp = r.unwrap();
-    let t = &imp.table;
+    let t = &imp.table();
     // fov spans the shorter axis (here the height): tan(15°) = 0.5 / d.
     assert!((0.5 / f(get(t, "camera.d")) - 15f64.to_radians().tan()).abs() < 1e-9);
     assert_eq!(get(t, "materials.dielectric-1.ior").as_str(), Some("N-BK7"));
@@ -703,7 +703,8 @@ ObjectInstance \"thing\"
     let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}{body}"));
     let imp = r.unwrap();
     assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
-    let sh = shapes(&imp.table);
+    let t = imp.table();
+    let sh = shapes(&t);
     // The definition itself gives no shape; the world's sphere after it has the CTM
     // and material of before ObjectBegin (the definition's Translate and Material end
     // at ObjectEnd); then two shapes per instance, in the instances' order.
@@ -790,7 +791,8 @@ ObjectEnd
 ";
     let p = write(dir.path(), "scene.pbrt", &format!("{PBRT_CAMERA}{body}"));
     let imp = import_scene(&p, &ImportOptions::default()).unwrap();
-    let sh = shapes(&imp.table);
+    let t = imp.table();
+    let sh = shapes(&t);
     assert_eq!(sh.len(), 1, "{sh:#?}");
     assert_eq!(sh[0]["file"].as_str(), Some("prism60.ply"));
     let rows: Vec<Vec<f64>> = sh[0]["transform"]
@@ -850,7 +852,7 @@ Shape \"trianglemesh\" \"point3 P\" [ -1 0 -1  1 0 -1  0 1 -1 ] \"integer indice
         b.warnings
     );
     assert_eq!(shapes_len(&a), 4);
-    assert_eq!(a.table, b.table);
+    assert_eq!(a.table(), b.table());
     // The TOML `heron convert` writes is the same but for the comment naming the source.
     let body = |i: &Imported| {
         i.to_toml(dir.path())
@@ -873,7 +875,7 @@ Shape \"trianglemesh\" \"point3 P\" [ -1 0 -1  1 0 -1  0 1 -1 ] \"integer indice
 }
 
 fn shapes_len(i: &Imported) -> usize {
-    shapes(&i.table).len()
+    shapes(&i.table()).len()
 }
 
 #[test]
@@ -960,7 +962,8 @@ Shape \"sphere\" \"float radius\" 0.2
             && !w.contains('\n'),
         "{w}"
     );
-    let sh = shapes(&imp.table);
+    let t = imp.table();
+    let sh = shapes(&t);
     assert_eq!(sh.len(), 2);
     assert!(sh[0].get("emission").is_none());
     // The area light still applies outside the definition.
@@ -1001,7 +1004,7 @@ fn blackbody_tabulated_and_file_spectra_convert_to_the_same_spectra() {
     let p = write(dir.path(), "scene.xml", &scene(body));
     let imp = import_scene(&p, &ImportOptions::default()).unwrap();
     assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
-    assert_eq!(f(get(&imp.table, "shapes.0.emission.blackbody")), 4000.0);
+    assert_eq!(f(get(&imp.table(), "shapes.0.emission.blackbody")), 4000.0);
     let s = load_imported(&imp).unwrap();
     let heron::light::Light::Area(light) = &s.lights[0] else {
         panic!("{:?}", s.lights[0]);
@@ -1077,7 +1080,7 @@ fn pbrt_spectra_convert_as_pbrt_normalises_them() {
     let p = write(dir.path(), "scene.pbrt", &text);
     let imp = import_scene(&p, &ImportOptions::default()).unwrap();
     assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
-    let t = &imp.table;
+    let t = &imp.table();
     assert_eq!(f(get(t, "shapes.0.emission.blackbody")), 3000.0);
     assert_eq!(f(get(t, "shapes.0.emission.scale")), 2.0);
     let s = load_imported(&imp).unwrap();
@@ -1143,7 +1146,7 @@ fn a_pbrt_spectral_film_sets_heron_s_spectral_bins() {
     let imp = r.unwrap();
     assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
     assert_eq!(
-        get(&imp.table, "render.spectral_bins").as_integer(),
+        get(&imp.table(), "render.spectral_bins").as_integer(),
         Some(16)
     );
     assert_eq!(load_imported(&imp).unwrap().settings.spectral_bins, 16);
@@ -1154,7 +1157,7 @@ fn a_pbrt_spectral_film_sets_heron_s_spectral_bins() {
     let (_d, r) = import_pbrt(&format!("{cam}Shape \"sphere\"\n"));
     let imp = r.unwrap();
     assert_eq!(
-        get(&imp.table, "render.spectral_bins").as_integer(),
+        get(&imp.table(), "render.spectral_bins").as_integer(),
         Some(8)
     );
     assert!(
@@ -1192,7 +1195,8 @@ fn a_mitsuba_bitmap_reflectance_converts_to_a_texture() {
         <transform name="to_uv"><scale x="2"/></transform></texture></bsdf></shape>"#;
     let p = write(dir.path(), "scene.xml", &scene(body));
     let imp = import_scene(&p, &ImportOptions::default()).unwrap();
-    let textured: Vec<&str> = get(&imp.table, "materials")
+    let t = imp.table();
+    let textured: Vec<&str> = get(&t, "materials")
         .as_table()
         .unwrap()
         .values()

@@ -1426,3 +1426,28 @@ fn blackbody_and_tabulated_colours_load_as_their_spectra() {
         assert!((v - want).abs() < 1e-6, "{l}: {v} vs {want}");
     }
 }
+
+/// The schema writes back what it read (`Serialize` beside `Deserialize`, the importers'
+/// path to `heron convert`): every scene of `scenes/`, read, written as TOML and read
+/// again, is the same `SceneFile`, and writing it twice gives the same text.
+#[test]
+fn every_scene_file_round_trips_through_the_schema() {
+    use heron::scene::load::parse_scene_file;
+    let mut n = 0;
+    for entry in std::fs::read_dir(scenes_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let file = parse_scene_file(&text).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        let written = toml::to_string(&toml::Table::try_from(&file).unwrap()).unwrap();
+        let again = parse_scene_file(&written)
+            .unwrap_or_else(|e| panic!("{path:?} written back: {e}\n{written}"));
+        assert_eq!(format!("{file:?}"), format!("{again:?}"), "{path:?}");
+        let twice = toml::to_string(&toml::Table::try_from(&again).unwrap()).unwrap();
+        assert_eq!(written, twice, "{path:?}");
+        n += 1;
+    }
+    assert!(n >= 20, "{n} scene files");
+}

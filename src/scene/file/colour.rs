@@ -1,33 +1,35 @@
 //! Colours: a number (grey), `[r, g, b]` in linear sRGB, a named spectrum, a blackbody
 //! or a table of samples, as read from a scene file, and their conversion to spectra
-//! (reflectances uplifted to bounded spectra, emissions to unbounded ones).
-use super::leaves::{finite_f32, number, raw};
+//! (reflectances uplifted to bounded spectra, emissions to unbounded ones). As the other
+//! leaves (`leaves.rs`), a colour keeps its numbers as written and is read in f32.
+use super::leaves::{finite_f32, number, one_key, raw};
 use super::show::show;
 use super::*;
+use serde::ser::{Serialize, SerializeMap, Serializer};
 
 /// A colour as written in a file, before it is known whether it is a reflectance or an
 /// emission.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Colour {
-    Grey(f32),
-    Rgb([f32; 3]),
+    Grey(f64),
+    Rgb([f64; 3]),
     /// One of [`NAMED_SPECTRA`] times `scale`.
     Named {
         spectrum: String,
-        scale: f32,
+        scale: f64,
     },
     /// Planck's law at `kelvin` scaled to luminance Y = 1, times `scale`
     /// (`{ blackbody = 5000 }`; emissions only).
     Blackbody {
-        kelvin: f32,
-        scale: f32,
+        kelvin: f64,
+        scale: f64,
     },
     /// A tabulated spectrum, (wavelength nm, value) pairs with increasing wavelengths,
     /// linear between them and held at the end values beyond them, times `scale`
     /// (`{ samples = [[400, 0.1], [700, 0.8]] }`).
     Samples {
-        samples: Vec<(f32, f32)>,
-        scale: f32,
+        samples: Vec<(f64, f64)>,
+        scale: f64,
     },
 }
 
@@ -45,8 +47,8 @@ impl Colour {
     /// The colour's RGB components if it is given as RGB (grey is `[g, g, g]`).
     pub fn rgb(&self) -> Option<[f32; 3]> {
         match *self {
-            Colour::Grey(g) => Some([g; 3]),
-            Colour::Rgb(c) => Some(c),
+            Colour::Grey(g) => Some([g as f32; 3]),
+            Colour::Rgb(c) => Some(c.map(|x| x as f32)),
             Colour::Named { .. } | Colour::Blackbody { .. } | Colour::Samples { .. } => None,
         }
     }
@@ -55,30 +57,38 @@ impl Colour {
     /// name was checked on load, so it exists).
     fn named_spectrum(&self) -> Option<DenseSpectrum> {
         match self {
-            Colour::Named { spectrum, scale } => named(spectrum).map(|s| s.scaled(*scale)),
-            Colour::Blackbody { kelvin, scale } => {
-                Some(crate::spectrum::blackbody::blackbody_unit(*kelvin as f64).scaled(*scale))
-            }
+            Colour::Named { spectrum, scale } => named(spectrum).map(|s| s.scaled(*scale as f32)),
+            Colour::Blackbody { kelvin, scale } => Some(
+                crate::spectrum::blackbody::blackbody_unit(*kelvin as f32 as f64)
+                    .scaled(*scale as f32),
+            ),
             Colour::Samples { samples, scale } => {
-                Some(DenseSpectrum::from_samples(samples).scaled(*scale))
+                Some(DenseSpectrum::from_samples(&samples_f32(samples)).scaled(*scale as f32))
             }
             _ => None,
         }
     }
 
-    /// The colour as a scene file writes it (for messages).
+    /// The colour as a scene file writes it (for messages), its numbers in f32.
     pub fn describe(&self) -> String {
         match self {
-            Colour::Grey(x) => format!("{x}"),
-            Colour::Rgb(c) => format!("[{}, {}, {}]", c[0], c[1], c[2]),
+            Colour::Grey(x) => format!("{}", *x as f32),
+            Colour::Rgb(c) => format!("[{}, {}, {}]", c[0] as f32, c[1] as f32, c[2] as f32),
             Colour::Named { spectrum, scale } => {
-                format!("{{ spectrum = {spectrum:?}, scale = {scale} }}")
+                format!("{{ spectrum = {spectrum:?}, scale = {} }}", *scale as f32)
             }
             Colour::Blackbody { kelvin, scale } => {
-                format!("{{ blackbody = {kelvin}, scale = {scale} }}")
+                format!(
+                    "{{ blackbody = {}, scale = {} }}",
+                    *kelvin as f32, *scale as f32
+                )
             }
             Colour::Samples { samples, scale } => {
-                format!("{{ samples = ({} pairs), scale = {scale} }}", samples.len())
+                format!(
+                    "{{ samples = ({} pairs), scale = {} }}",
+                    samples.len(),
+                    *scale as f32
+                )
             }
         }
     }
@@ -100,8 +110,8 @@ impl Reflectance {
     /// 1e-6); a named spectrum is itself times its scale.
     pub fn spectrum(&self) -> DenseSpectrum {
         match &self.0 {
-            Colour::Grey(g) => DenseSpectrum::constant(*g),
-            Colour::Rgb(rgb) => rgb_to_reflectance(*rgb),
+            Colour::Grey(g) => DenseSpectrum::constant(*g as f32),
+            Colour::Rgb(rgb) => rgb_to_reflectance(rgb.map(|x| x as f32)),
             Colour::Named { .. } | Colour::Blackbody { .. } | Colour::Samples { .. } => self
                 .0
                 .named_spectrum()
@@ -118,9 +128,10 @@ impl Emission {
     pub fn spectrum(&self) -> DenseSpectrum {
         match &self.0 {
             Colour::Grey(g) => {
-                named("D65").map_or_else(|| rgb_to_illuminant([*g; 3]), |d65| d65.scaled(*g))
+                let g = *g as f32;
+                named("D65").map_or_else(|| rgb_to_illuminant([g; 3]), |d65| d65.scaled(g))
             }
-            Colour::Rgb(rgb) => rgb_to_illuminant(*rgb),
+            Colour::Rgb(rgb) => rgb_to_illuminant(rgb.map(|x| x as f32)),
             Colour::Named { .. } | Colour::Blackbody { .. } | Colour::Samples { .. } => self
                 .0
                 .named_spectrum()
@@ -132,9 +143,14 @@ impl Emission {
 pub(super) const COLOUR_FORMS: &str =
     "a colour: a number, [r, g, b], { spectrum = \"E\" | \"D65\" | \"A\", scale = number }, { blackbody = kelvin, scale = number } or { samples = [[nm, value], ...], scale = number }";
 
+/// The (wavelength, value) pairs in f32.
+fn samples_f32(samples: &[(f64, f64)]) -> Vec<(f32, f32)> {
+    samples.iter().map(|&(l, x)| (l as f32, x as f32)).collect()
+}
+
 /// `samples = [[nm, value], ...]`: at least two pairs of finite numbers, wavelengths
-/// strictly increasing, values ≥ 0.
-pub(super) fn spectral_samples(v: &toml::Value) -> Result<Vec<(f32, f32)>, String> {
+/// strictly increasing, values ≥ 0 (in f32; kept as written).
+pub(super) fn spectral_samples(v: &toml::Value) -> Result<Vec<(f64, f64)>, String> {
     let bad = || {
         format!(
             "expected samples = [[wavelength_nm, value], ...] (at least two pairs of finite numbers, values >= 0), got {}",
@@ -144,7 +160,7 @@ pub(super) fn spectral_samples(v: &toml::Value) -> Result<Vec<(f32, f32)>, Strin
     let toml::Value::Array(rows) = v else {
         return Err(bad());
     };
-    let mut out = Vec::with_capacity(rows.len());
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(rows.len());
     for r in rows {
         match r {
             toml::Value::Array(p) if p.len() == 2 => {
@@ -156,13 +172,15 @@ pub(super) fn spectral_samples(v: &toml::Value) -> Result<Vec<(f32, f32)>, Strin
                     return Err(bad());
                 }
                 if let Some(&(prev, _)) = out.last() {
+                    let prev = prev as f32;
                     if !(l > prev) {
                         return Err(format!(
                             "expected samples with strictly increasing wavelengths, got {l} nm after {prev} nm"
                         ));
                     }
                 }
-                out.push((l, x));
+                // Both are numbers: finite_f32 read them.
+                out.push((number(&p[0]).unwrap_or(0.0), number(&p[1]).unwrap_or(0.0)));
             }
             _ => return Err(bad()),
         }
@@ -178,8 +196,7 @@ pub(super) fn colour(v: &toml::Value) -> Result<Colour, String> {
     let shape_err = || format!("expected {COLOUR_FORMS}, got {}", show(v));
     let comp = |x: &toml::Value| {
         number(x)
-            .map(|x| x as f32)
-            .filter(|x| x.is_finite())
+            .filter(|x| (*x as f32).is_finite())
             .ok_or_else(|| format!("expected a colour with finite components, got {}", show(v)))
     };
     match v {
@@ -194,8 +211,7 @@ pub(super) fn colour(v: &toml::Value) -> Result<Colour, String> {
             let scale = match t.get("scale") {
                 None => 1.0,
                 Some(s) => number(s)
-                    .map(|x| x as f32)
-                    .filter(|x| x.is_finite())
+                    .filter(|x| (*x as f32).is_finite())
                     .ok_or_else(|| format!("expected scale = a finite number, got {}", show(s)))?,
             };
             let kind = ["spectrum", "blackbody", "samples"]
@@ -235,10 +251,7 @@ pub(super) fn colour(v: &toml::Value) -> Result<Colour, String> {
                                 show(&t["blackbody"])
                             )
                         })?;
-                    Ok(Colour::Blackbody {
-                        kelvin: k as f32,
-                        scale,
-                    })
+                    Ok(Colour::Blackbody { kelvin: k, scale })
                 }
                 "samples" => Ok(Colour::Samples {
                     samples: spectral_samples(&t["samples"])?,
@@ -284,7 +297,7 @@ impl<'de> Deserialize<'de> for Reflectance {
         }
         let ok = match &c {
             Colour::Named { scale, .. } | Colour::Samples { scale, .. } => {
-                *scale >= 0.0 && c.max_value() <= 1.0
+                *scale as f32 >= 0.0 && c.max_value() <= 1.0
             }
             _ => c
                 .rgb()
@@ -314,7 +327,7 @@ impl<'de> Deserialize<'de> for Emission {
         let ok = match &c {
             Colour::Named { scale, .. }
             | Colour::Blackbody { scale, .. }
-            | Colour::Samples { scale, .. } => *scale >= 0.0,
+            | Colour::Samples { scale, .. } => *scale as f32 >= 0.0,
             _ => c.rgb().is_some_and(|x| x.iter().all(|&x| x >= 0.0)),
         };
         if !ok {
@@ -335,5 +348,46 @@ impl<'de> Deserialize<'de> for Emission {
             )));
         }
         Ok(e)
+    }
+}
+
+/// `{ key = value }`, with `scale` unless it is 1 (the default).
+fn scaled_table<S: Serializer, T: Serialize + ?Sized>(
+    s: S,
+    key: &str,
+    value: &T,
+    scale: f64,
+) -> Result<S::Ok, S::Error> {
+    if scale == 1.0 {
+        return one_key(s, key, value);
+    }
+    let mut m = s.serialize_map(Some(2))?;
+    m.serialize_entry(key, value)?;
+    m.serialize_entry("scale", &scale)?;
+    m.end()
+}
+
+impl Serialize for Colour {
+    /// The colour in the form [`colour`] reads it.
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Colour::Grey(g) => s.serialize_f64(*g),
+            Colour::Rgb(c) => c.serialize(s),
+            Colour::Named { spectrum, scale } => scaled_table(s, "spectrum", spectrum, *scale),
+            Colour::Blackbody { kelvin, scale } => scaled_table(s, "blackbody", kelvin, *scale),
+            Colour::Samples { samples, scale } => scaled_table(s, "samples", samples, *scale),
+        }
+    }
+}
+
+impl Serialize for Reflectance {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
+    }
+}
+
+impl Serialize for Emission {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
     }
 }

@@ -9,7 +9,13 @@
 //! check their own range while they are deserialized, so that an out-of-range number is
 //! reported with the key path serde is at, in the words "expected …, got …". Checks that
 //! involve several keys (ρd + ρs ≤ 1, zero-area triangles, material names) are in
-//! [`super::load`].
+//! [`super::load`]. The leaves keep their numbers as written (f64) and give them in f32
+//! (`get`), the precision heron renders in.
+//!
+//! The schema serialises too, each optional key left out when unset: the importers
+//! ([`super::import`]) build these structs rather than tables of string keys, so that a
+//! renamed or retyped key is a compile error there, and `heron convert` writes them.
+//! Serialising what was read gives the same values back.
 //!
 //! Example (the seed lecture's default scene is `scenes/default.toml`):
 //!
@@ -70,34 +76,34 @@ pub use show::show;
 pub const MAX_RESOLUTION: u32 = 16384;
 
 /// The whole scene file.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// Radiance of rays that leave the scene; default black.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub background: Option<Emission>,
     pub camera: CameraFile,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub render: Option<RenderFile>,
     /// Materials by name. A TOML table has no order that survives parsing, so the loaded
     /// scene lists materials sorted by name (the order of this map).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub materials: BTreeMap<String, MaterialFile>,
     #[serde(default)]
     pub shapes: Vec<ShapeFile>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<LightFile>,
     /// A rainbow sky over the background; needs a `sun` light.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sky: Option<SkyFile>,
     /// An environment map in place of the background.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub environment: Option<EnvironmentFile>,
 }
 
 /// `[environment]`: radiance at infinity from an image (src/light/envmap.rs), e.g.
 /// `map = "sky.exr"`, importance-sampled by its texels.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentFile {
     /// The image, relative to the scene file: OpenEXR (`.exr`, its R, G, B channels),
@@ -106,158 +112,158 @@ pub struct EnvironmentFile {
     pub map: String,
     /// `latlong` (default; Mitsuba's equirectangular layout, +y up) or `equal-area`
     /// (pbrt-v4's octahedral square).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mapping: Option<String>,
     /// Multiplies the image's radiance; default 1.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<NonNegativeNumber>,
     /// The map's orientation: a 4 × 4 affine matrix (rows) whose 3 × 3 part is
     /// orthogonal (a rotation, or a mirror); the translation is ignored (the map is at
     /// infinity). Default the identity.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<Vec<Vec<f64>>>,
 }
 
 /// `[sky]`: a sky model seen by rays that leave the scene (src/sky).
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SkyFile {
     /// constant, aristotle, descartes, airy or mie.
     pub model: String,
     /// Drop radius in mm (airy, mie).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub droplet_radius: Option<PositiveNumber>,
     /// Internal reflections to include (descartes, airy): a subset of [1, 2]; default
     /// both.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orders: Option<Vec<u32>>,
     /// unpolarised (default), s or p (descartes, airy, mie).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarisation: Option<String>,
     /// Multiplies the model's radiance; default 1.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<PositiveNumber>,
     /// A drop-size distribution (airy, mie) instead of `droplet_radius`, e.g.
     /// `{ distribution = "lognormal", median_mm = 0.5, sigma = 0.1 }` (crate::drops).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drops: Option<crate::drops::DropsFile>,
     /// Only this term p of the Debye series (mie): 2 the primary bow, 3 the secondary.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub debye: Option<u32>,
 }
 
 /// `[camera]`: the seed's pinhole camera, or (`type = "lens"`) a film behind a lens
 /// prescription (`lens = "file"` or `[[camera.surface]]` tables).
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraFile {
     pub eye: Point3,
     pub look_at: Point3,
     /// Default `[0, 1, 0]`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub up: Option<Direction3>,
     /// Camera constant d (distance to an image plane of height 1); default 1. Pinhole
     /// only.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub d: Option<PositiveNumber>,
     pub resolution: Resolution,
     /// "pinhole" (the default) or "lens".
-    #[serde(default, rename = "type")]
+    #[serde(default, rename = "type", skip_serializing_if = "Option::is_none")]
     pub kind: Option<String>,
     /// The lens: a prescription file (heron's TOML or pbrt-v4's `.dat`), relative to
     /// the scene file …
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lens: Option<String>,
     /// … or its surfaces inline.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface: Option<Vec<toml::Value>>,
     /// Film diagonal in mm; default 43.27 (35 mm film, 36 × 24).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub film_diagonal: Option<PositiveNumber>,
     /// Film behind the last vertex (mm) …
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub film_distance: Option<PositiveNumber>,
     /// … or focused on a point this far in front of the film (scene units).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub focus_distance: Option<PositiveNumber>,
     /// Wavelength (nm) of the focus and of the exposure's normalisation; default the
     /// prescription's reference wavelength.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub focus_wavelength: Option<PositiveNumber>,
     /// Millimetres per scene unit; default 1000 (the scene in metres).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mm_per_unit: Option<PositiveNumber>,
     /// Stop the lens down (or open it) to this f-number (paraxial, at the focus
     /// wavelength, object at infinity).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub f_number: Option<PositiveNumber>,
     /// An ideal linear polariser in front of the lens, its axis this many degrees from
     /// the image's horizontal, counter-clockwise as the photographer sees it (polarised
     /// renders only: `[render] polarization`).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarizer: Option<f32>,
     /// Exit-pupil sampling: "bounds" (default) or "rear-element".
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pupil: Option<String>,
     /// Where the film's centre sits in the image plane (mm from the optical axis, +x
     /// toward the image's right, +y toward its top); default [0, 0].
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub film_offset: Option<Point2>,
 }
 
 /// `[render]`: every key optional, defaults from `RenderSettings::default()`.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderFile {
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spp: Option<PositiveCount>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_depth: Option<PositiveCount>,
     /// The seed's ray offset ε.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub epsilon: Option<PositiveNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
     /// whitted (the seed's tracer, the default) or path.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub integrator: Option<String>,
     /// Path depth from which Russian roulette may end paths (path integrator); default 5.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rr_depth: Option<u32>,
     /// How the path integrator picks a light: power (default) or uniform.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light_sampler: Option<String>,
     /// How rays leave surfaces: auto (default: epsilon for whitted, robust otherwise),
     /// epsilon or robust.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub offset: Option<String>,
     /// Where the path tracer samples lights from a segment through a medium: forced
     /// (default) or collision.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium_nee: Option<String>,
     /// The fraction of phase samples drawn about the sun at medium vertices, in [0, 1).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun_guide: Option<f64>,
     /// SPPM: photons per iteration (0: one per pixel).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sppm_photons: Option<i64>,
     /// SPPM: the share α of new photons a pixel keeps, in (0, 1) (default 2/3).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sppm_alpha: Option<f64>,
     /// SPPM: the initial gather radius in scene units (0: automatic).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sppm_radius: Option<f64>,
     /// Accumulate the mean spectral radiance in this many equal bins over 360–830 nm
     /// (0, the default: none); `--spectral-bins` overrides it.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectral_bins: Option<i64>,
     /// Polarised transport (default false); `--polarization` turns it on.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarization: Option<bool>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum MaterialFile {
     Lambertian(LambertianFile),
@@ -284,84 +290,84 @@ impl MaterialFile {
 }
 
 /// A linear polariser sheet (src/bsdf/polarizer.rs): light passes straight through.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PolarizerFile {
     /// The transmission axis's angle in degrees from `axis` projected onto the sheet,
     /// counter-clockwise seen from the side the normal points to (default 0).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle: Option<f32>,
     /// A world direction whose projection onto the sheet is the axis at angle 0
     /// (default [0, 1, 0]; the sheet's own first axis where it is parallel to the normal).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis: Option<Direction3>,
     /// Intensity transmittance along the axis, in (0, 1] (default 1).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transmittance: Option<f32>,
     /// t_along / t_across, at least 1 (default: an ideal polariser, t_across = 0).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extinction_ratio: Option<f32>,
 }
 
 /// A linear retarder, a wave plate (src/bsdf/retarder.rs): light passes straight through.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RetarderFile {
     /// Retardance in waves (0.25: a quarter-wave plate, 0.5: a half-wave plate; default
     /// 0.25), the same at every wavelength.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub retardance: Option<f32>,
     /// The fast axis's angle in degrees, as a polarizer's `angle`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle: Option<f32>,
     /// As a polarizer's `axis`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis: Option<Direction3>,
 }
 
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LambertianFile {
     /// ρd; or, instead, `texture`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rho_d: Option<Reflectance>,
     /// An image of ρd over the surface's uv (src/bsdf/texture.rs), relative to the scene
     /// file: PNG (sRGB-decoded), OpenEXR or Radiance HDR (linear); linear sRGB,
     /// components clamped to [0, 1].
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub texture: Option<String>,
 }
 
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MirrorFile {
     /// Default 1 (the lecture's ideal mirror).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rho_s: Option<Reflectance>,
 }
 
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DielectricFile {
     pub ior: IorSpec,
     /// Default true; false is the lecture's pure refraction.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fresnel: Option<bool>,
     /// GGX roughness α in [0, 1]; 0 (default) is the smooth interface.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub roughness: Option<UnitNumber>,
     /// Index of the medium outside the surface (the side its normal points to); default 1.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outside_ior: Option<IorSpec>,
 }
 
 /// A metal with a spectral complex index, smooth or rough.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConductorFile {
     pub metal: MetalSpec,
     /// GGX roughness α in [0, 1]; 0 (default) is the smooth metal.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub roughness: Option<UnitNumber>,
 }
 
@@ -372,25 +378,29 @@ pub struct ConductorFile {
 pub enum MetalSpec {
     Named(String),
     Table(String),
-    Constant { n: f32, k: f32 },
+    /// Kept as written, read in f32.
+    Constant {
+        n: f64,
+        k: f64,
+    },
 }
 
 /// The seed's modified Phong model, optionally over a refractive base (`ior`).
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GlossyFile {
     pub rho_d: Reflectance,
     pub rho_s: UnitNumber,
     pub shininess: PositiveNumber,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ior: Option<IorSpec>,
     /// Only allowed together with `ior`; default true.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fresnel: Option<bool>,
 }
 
 /// `[[shapes]]`, tagged by `type`.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum ShapeFile {
     Sphere(SphereFile),
@@ -416,6 +426,25 @@ impl ShapeFile {
             ShapeFile::Quad(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
             ShapeFile::Mesh(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
             ShapeFile::Waves(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
+        }
+    }
+
+    /// The entry's material name, emission and two-sidedness, to be set (as the
+    /// importers give every shape of an element its surface).
+    pub fn surface_mut(
+        &mut self,
+    ) -> (
+        &mut Option<String>,
+        &mut Option<Emission>,
+        &mut Option<bool>,
+    ) {
+        match self {
+            ShapeFile::Sphere(x) => (&mut x.material, &mut x.emission, &mut x.two_sided),
+            ShapeFile::Triangle(x) => (&mut x.material, &mut x.emission, &mut x.two_sided),
+            ShapeFile::Plane(x) => (&mut x.material, &mut x.emission, &mut x.two_sided),
+            ShapeFile::Quad(x) => (&mut x.material, &mut x.emission, &mut x.two_sided),
+            ShapeFile::Mesh(x) => (&mut x.material, &mut x.emission, &mut x.two_sided),
+            ShapeFile::Waves(x) => (&mut x.material, &mut x.emission, &mut x.two_sided),
         }
     }
 
@@ -445,77 +474,77 @@ impl ShapeFile {
     }
 }
 
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SphereFile {
     pub center: Point3,
     pub radius: PositiveNumber,
     /// Required unless `emission` is given (then default: black, a pure emitter).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// Radiance emitted from the surface: the shape becomes an area light.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Emission>,
     /// Emit from both sides (default: only the side the outward normal points to).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumFile>,
 }
 
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TriangleFile {
     /// Counter-clockwise seen from the front: the geometric normal is
     /// (v1 − v0) × (v2 − v0).
     pub vertices: [Point3; 3],
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Emission>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumFile>,
 }
 
 /// An infinite plane, stored as a square of half-extent `size` centred at `point`.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneFile {
     pub point: Point3,
     pub normal: Direction3,
     /// Half-extent of the square; default 1000.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub size: Option<PositiveNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Emission>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumFile>,
 }
 
 /// The parallelogram origin + s·edge1 + t·edge2, s, t ∈ [0, 1]; normal edge1 × edge2.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct QuadFile {
     pub origin: Point3,
     pub edge1: Direction3,
     pub edge2: Direction3,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Emission>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumFile>,
 }
 
@@ -524,31 +553,31 @@ pub struct QuadFile {
 /// h = Σ aᵢ sin(2π (dᵢ · x)/λᵢ + φᵢ), x the vertex's position in the quad's plane (along
 /// edge1 and edge2, from the origin) and dᵢ a unit direction in that plane (a sum of
 /// sine waves, the simplest ocean of Tessendorf 2001's §3).
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct WavesFile {
     pub origin: Point3,
     pub edge1: Direction3,
     pub edge2: Direction3,
     /// Cells along edge1 and edge2 (default [128, 128]).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<[PositiveCount; 2]>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub waves: Vec<WaveFile>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Emission>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only, which a sheet of
     /// waves is not: given here so that the error says so).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumFile>,
 }
 
 /// One sine wave of a `waves` surface.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct WaveFile {
     /// Height of the crest above the mean surface, in scene units (≥ 0).
@@ -563,39 +592,39 @@ pub struct WaveFile {
 }
 
 /// A triangle mesh: a Wavefront OBJ file, or a PLY file (by its `.ply` extension).
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshFile {
     /// Relative to the folder of the scene file.
     pub file: String,
     /// Material of the OBJ objects/groups not listed in `groups`; may be left out when
     /// `groups` covers every object of the file.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// OBJ object or group name (`o NAME` / `g NAME`) -> material name.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub groups: BTreeMap<String, String>,
     /// Uniform scale, applied before the translation; default 1.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<PositiveNumber>,
     /// Default `[0, 0, 0]`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub translate: Option<Point3>,
     /// An affine 4×4 matrix, row by row (last row `[0, 0, 0, 1]`), applied after
     /// `scale` and `translate`: Mitsuba's `to_world`, as `heron convert` writes it.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<Vec<Vec<f64>>>,
     /// Use the file's texture coordinates (u, v) as (u, 1 − v): default true for OBJ
     /// (whose images start at the bottom row), false for PLY, as Mitsuba 3 reads them.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flip_tex_coords: Option<bool>,
     /// Radiance emitted by every triangle of the mesh: it becomes an area light.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Emission>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumFile>,
 }
 
@@ -607,31 +636,31 @@ pub struct MeshFile {
 /// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
 /// `sigma_a`, `sigma_s` (per scene unit) and `g` in (−1, 1). The keys are checked
 /// against the type in `load/media.rs`.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MediumFile {
     #[serde(rename = "type")]
     pub kind: String,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius_mm: Option<PositiveNumber>,
     /// A drop-size distribution instead of one radius (the `[sky] drops` table).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drops: Option<crate::drops::DropsFile>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub number_density: Option<PositiveNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub liquid_water_content: Option<PositiveNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub absorption: Option<bool>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lambda_step: Option<PositiveNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub forward_cutoff: Option<NonNegativeNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sigma_a: Option<NonNegativeNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sigma_s: Option<NonNegativeNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub g: Option<f32>,
 }
 
@@ -660,7 +689,7 @@ impl MediumType {
 }
 
 /// `[[lights]]`, tagged by `type`.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum LightFile {
     Point(PointLightFile),
@@ -677,7 +706,7 @@ impl LightFile {
 
 /// A spot light (pbrt-v4's falloff): full intensity within cone_angle − cone_delta of
 /// its axis, smoothly down to 0 at cone_angle.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpotLightFile {
     pub position: Point3,
@@ -686,12 +715,12 @@ pub struct SpotLightFile {
     /// Radiant intensity on the axis, a colour.
     pub intensity: Emission,
     /// Half-angle of the cone in degrees, in (0, 90]; default 30.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cone_angle: Option<PositiveNumber>,
     /// Width of the falloff ring in degrees, in [0, cone_angle]; default 5.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cone_delta: Option<NonNegativeNumber>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarization: Option<LightPolarizationFile>,
 }
 
@@ -700,32 +729,39 @@ pub struct SpotLightFile {
 /// frame of `axis` projected across each ray (`light::polarization`). `linear` and
 /// `circular` are in [−1, 1] with linear² + circular² ≤ 1; `linear` defaults to 1
 /// without `circular`, else to 0; `circular` to 0. Read only by polarised renders.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightPolarizationFile {
     pub axis: Direction3,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub linear: Option<f32>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub circular: Option<f32>,
 }
 
 /// A finite number ≥ 0 (for angles that may be 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NonNegativeNumber(pub f32);
+pub struct NonNegativeNumber(pub f64);
 
-#[derive(Debug, serde::Deserialize)]
+impl NonNegativeNumber {
+    /// The number in f32.
+    pub fn get(&self) -> f32 {
+        self.0 as f32
+    }
+}
+
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointLightFile {
     pub position: Point3,
     /// Radiant intensity, a colour.
     pub intensity: Emission,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarization: Option<LightPolarizationFile>,
 }
 
 /// The sun: a directional light with the solar disk's extent.
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SunLightFile {
     /// The direction the light travels; normalised on load.
@@ -733,16 +769,16 @@ pub struct SunLightFile {
     /// Irradiance at normal incidence, a colour; the disk's radiance is E/Ω.
     pub irradiance: Emission,
     /// Angular radius in degrees, in (0, 90); default 0.2666.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angular_radius: Option<PositiveNumber>,
     /// The opening through which all sunlight that reaches the scene passes (a window, a
     /// slit); light tracing and BDPT start the sun's paths on it.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub portal: Option<PortalFile>,
 }
 
 /// A parallelogram origin + s·edge1 + t·edge2, s, t ∈ [0, 1].
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PortalFile {
     pub origin: Point3,
@@ -750,13 +786,13 @@ pub struct PortalFile {
     pub edge2: Direction3,
 }
 
-#[derive(Debug, serde::Deserialize)]
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DirectionalLightFile {
     /// The direction the light travels; normalised on load.
     pub direction: Direction3,
     pub radiance: Emission,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarization: Option<LightPolarizationFile>,
 }
 

@@ -1,12 +1,15 @@
-//! Scenes written for other renderers, converted to the TOML heron renders: Mitsuba 3's
-//! XML (`xml.rs` reads the document, `mitsuba.rs` converts its objects) and pbrt-v4's
-//! scene files (`pbrt.rs`). `heron render
+//! Scenes written for other renderers, converted to heron's scene: Mitsuba 3's XML
+//! (`xml.rs` reads the document, `mitsuba/` converts its objects) and pbrt-v4's scene
+//! files (`pbrt/`). The converters build the scene schema's own structs
+//! ([`SceneFile`], `schema.rs` the values both share), so a schema key renamed or
+//! retyped is a compile error here rather than a table the loader refuses. `heron render
 //! scene.xml` renders the conversion; `heron convert scene.xml -o scene.toml` writes it
 //! for editing. What heron cannot carry over is a [`Diagnostic`]: a warning naming the
 //! file, line and element, or an error with `strict`.
 mod mitsuba;
 mod pbrt;
 mod props;
+mod schema;
 mod transform;
 mod xml;
 
@@ -14,6 +17,7 @@ pub use mitsuba::{DISK_SEGMENTS, UNBOUNDED_DEPTH};
 pub use xml::Diagnostic;
 
 use crate::error::{HeronError, Result};
+use crate::scene::file::{LambertianFile, MaterialFile, SceneFile, ShapeFile};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -46,12 +50,12 @@ pub struct ImportOptions {
     pub defines: BTreeMap<String, String>,
 }
 
-/// A converted scene: heron's scene table (mesh paths relative to the source file's
-/// folder) and the warnings.
+/// A converted scene: heron's scene (the paths of meshes, textures and the environment
+/// map relative to the source file's folder) and the warnings.
 #[derive(Clone, Debug)]
 pub struct Imported {
     pub source: PathBuf,
-    pub table: toml::Table,
+    pub scene: SceneFile,
     pub warnings: Vec<Diagnostic>,
 }
 
@@ -71,7 +75,7 @@ pub fn import_scene(path: &Path, options: &ImportOptions) -> Result<Imported> {
             let c = mitsuba::convert(&root, path, options.strict).map_err(error)?;
             Ok(Imported {
                 source: path.to_path_buf(),
-                table: c.table,
+                scene: c.scene,
                 warnings: c.warnings,
             })
         }
@@ -79,7 +83,7 @@ pub fn import_scene(path: &Path, options: &ImportOptions) -> Result<Imported> {
             let c = pbrt::convert(path, options.strict).map_err(error)?;
             Ok(Imported {
                 source: path.to_path_buf(),
-                table: c.table,
+                scene: c.scene,
                 warnings: c.warnings,
             })
         }
@@ -97,7 +101,7 @@ pub fn import_mitsuba_str(text: &str, path: &Path, options: &ImportOptions) -> R
     let c = mitsuba::convert(&root, path, options.strict).map_err(error)?;
     Ok(Imported {
         source: path.to_path_buf(),
-        table: c.table,
+        scene: c.scene,
         warnings: c.warnings,
     })
 }
@@ -108,36 +112,47 @@ pub fn import_pbrt_str(text: &str, path: &Path, options: &ImportOptions) -> Resu
     let c = pbrt::convert_str(text, path, options.strict).map_err(error)?;
     Ok(Imported {
         source: path.to_path_buf(),
-        table: c.table,
+        scene: c.scene,
         warnings: c.warnings,
     })
 }
 
 impl Imported {
+    /// The scene as a TOML table, its keys and values as `heron convert` writes them and
+    /// its files relative to the source's folder (for looking at it by key path).
+    pub fn table(&self) -> toml::Table {
+        toml::Table::try_from(&self.scene).expect("a scene serialises to a TOML table")
+    }
+
     /// The scene as heron's TOML, for a file in folder `out_dir` (the paths of meshes,
-    /// textures and the environment map rewritten relative to it), opened by a comment naming the source and listing the warnings.
+    /// textures and the environment map rewritten relative to it), opened by a comment
+    /// naming the source and listing the warnings. The keys are sorted (the order of
+    /// `toml::Table`), as the scene's tables were before they were typed.
     pub fn to_toml(&self, out_dir: &Path) -> String {
-        let mut table = self.table.clone();
+        let mut scene = self.scene.clone();
         let src_dir = self.source.parent().unwrap_or(Path::new(""));
-        // Every file the table names (meshes, textures, the environment map) is relative
+        // Every file the scene names (meshes, textures, the environment map) is relative
         // to the source file; rewritten relative to the output's folder.
-        let rebase = |v: Option<&mut toml::Value>| {
-            if let Some(toml::Value::String(f)) = v {
-                let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
-                *f = rel.to_string_lossy().replace('\\', "/");
-            }
+        let rebase = |f: &mut String| {
+            let rel = mitsuba::relative_to(&src_dir.join(&*f), out_dir);
+            *f = rel.to_string_lossy().replace('\\', "/");
         };
-        if let Some(toml::Value::Array(shapes)) = table.get_mut("shapes") {
-            for s in shapes.iter_mut() {
-                rebase(s.get_mut("file"));
+        for s in &mut scene.shapes {
+            if let ShapeFile::Mesh(m) = s {
+                rebase(&mut m.file);
             }
         }
-        if let Some(toml::Value::Table(materials)) = table.get_mut("materials") {
-            for (_, m) in materials.iter_mut() {
-                rebase(m.as_table_mut().and_then(|t| t.get_mut("texture")));
+        for m in scene.materials.values_mut() {
+            if let MaterialFile::Lambertian(LambertianFile {
+                texture: Some(t), ..
+            }) = m
+            {
+                rebase(t);
             }
         }
-        rebase(table.get_mut("environment").and_then(|e| e.get_mut("map")));
+        if let Some(e) = &mut scene.environment {
+            rebase(&mut e.map);
+        }
         let mut out = format!(
             "# Converted by heron {} from {}.\n",
             env!("CARGO_PKG_VERSION"),
@@ -152,6 +167,7 @@ impl Imported {
             }
         }
         out.push('\n');
+        let table = toml::Table::try_from(&scene).expect("a scene serialises to a TOML table");
         out.push_str(&toml::to_string(&table).expect("a TOML table serialises"));
         out
     }

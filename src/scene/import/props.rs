@@ -3,6 +3,7 @@
 //! not read can be named in a warning rather than dropped silently.
 use super::transform::{numbers, parse_transform, vector_attrs};
 use super::xml::{Diagnostic, Node};
+use crate::scene::file::{Colour, Emission, Reflectance};
 use glam::{DMat4, DVec3};
 use std::cell::Cell;
 
@@ -25,8 +26,9 @@ pub struct Props<'a> {
     used: Vec<Cell<bool>>,
 }
 
-/// A colour property as heron's scene files write colours: grey, RGB, a tabulated
-/// spectrum or a blackbody (see [`crate::scene::file::Colour`]).
+/// A colour property in the forms of heron's scene files: grey, RGB, a tabulated
+/// spectrum, a blackbody or a named illuminant, its numbers in f64 as the converters
+/// compute them (scaled, bounded) before the scene's [`Colour`] keeps them.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ColourValue {
     Grey(f64),
@@ -41,40 +43,48 @@ pub enum ColourValue {
         kelvin: f64,
         scale: f64,
     },
+    /// One of heron's named spectra (`crate::spectrum::uplift::NAMED_SPECTRA`) times
+    /// `scale`.
+    Named {
+        spectrum: &'static str,
+        scale: f64,
+    },
 }
 
 impl ColourValue {
-    pub fn to_toml(&self) -> toml::Value {
-        use toml::Value;
-        let table = |k: &str, v: Value, scale: f64| {
-            let mut t = toml::Table::new();
-            t.insert(k.into(), v);
-            if scale != 1.0 {
-                t.insert("scale".into(), Value::Float(scale));
-            }
-            Value::Table(t)
-        };
+    /// The scene file's colour.
+    pub fn colour(&self) -> Colour {
         match self {
-            ColourValue::Grey(g) => Value::Float(*g),
-            ColourValue::Rgb(c) => Value::Array(c.iter().map(|x| Value::Float(*x)).collect()),
-            ColourValue::Samples { samples, scale } => table(
-                "samples",
-                Value::Array(
-                    samples
-                        .iter()
-                        .map(|(l, v)| Value::Array(vec![Value::Float(*l), Value::Float(*v)]))
-                        .collect(),
-                ),
-                *scale,
-            ),
-            ColourValue::Blackbody { kelvin, scale } => {
-                table("blackbody", Value::Float(*kelvin), *scale)
-            }
+            ColourValue::Grey(g) => Colour::Grey(*g),
+            ColourValue::Rgb(c) => Colour::Rgb(*c),
+            ColourValue::Samples { samples, scale } => Colour::Samples {
+                samples: samples.clone(),
+                scale: *scale,
+            },
+            ColourValue::Blackbody { kelvin, scale } => Colour::Blackbody {
+                kelvin: *kelvin,
+                scale: *scale,
+            },
+            ColourValue::Named { spectrum, scale } => Colour::Named {
+                spectrum: spectrum.to_string(),
+                scale: *scale,
+            },
         }
     }
 
-    /// The largest value over channels or wavelengths (for a blackbody, its scale: the
-    /// unit blackbody's own peak is not needed where this is used, for reflectances).
+    /// The colour as a reflectance (its range is checked when the scene is read).
+    pub fn reflectance(&self) -> Reflectance {
+        Reflectance(self.colour())
+    }
+
+    /// The colour as an emission (its range is checked when the scene is read).
+    pub fn emission(&self) -> Emission {
+        Emission(self.colour())
+    }
+
+    /// The largest value over channels or wavelengths (for a blackbody or a named
+    /// illuminant, its scale: the unit spectrum's own peak is not needed where this is
+    /// used, for reflectances, which neither is).
     pub fn max(&self) -> f64 {
         match self {
             ColourValue::Grey(g) => *g,
@@ -82,7 +92,7 @@ impl ColourValue {
             ColourValue::Samples { samples, scale } => {
                 scale * samples.iter().fold(0.0f64, |a, (_, v)| a.max(*v))
             }
-            ColourValue::Blackbody { scale, .. } => *scale,
+            ColourValue::Blackbody { scale, .. } | ColourValue::Named { scale, .. } => *scale,
         }
     }
 
@@ -97,6 +107,10 @@ impl ColourValue {
             },
             ColourValue::Blackbody { kelvin, scale } => ColourValue::Blackbody {
                 kelvin: *kelvin,
+                scale: scale * k,
+            },
+            ColourValue::Named { spectrum, scale } => ColourValue::Named {
+                spectrum,
                 scale: scale * k,
             },
         }

@@ -17,11 +17,11 @@ pub(super) fn build_camera(
     base_dir: &Path,
     inputs: &mut Vec<String>,
 ) -> Result<Camera, String> {
-    if !(c.look_at.0 - c.eye.0).length().is_finite() {
+    if !(c.look_at.get() - c.eye.get()).length().is_finite() {
         return Err(format!(
             "camera: expected eye and look_at at a distance finite in f32, got eye = {} and look_at = {}",
-            fmt_points(&[c.eye.0]),
-            fmt_points(&[c.look_at.0])
+            fmt_points(&[c.eye.get()]),
+            fmt_points(&[c.look_at.get()])
         ));
     }
     let lens = match c.kind.as_deref() {
@@ -64,7 +64,7 @@ pub(super) fn build_camera(
             let f = paraxial::paraxial(&l.system, l.settings.focus_wavelength).efl;
             ((f / fh) as f32).clamp(D_MIN, D_MAX)
         }
-        (None, d) => d.map_or(1.0, |d| d.0),
+        (None, d) => d.map_or(1.0, |d| d.get()),
     };
     if !(D_MIN..=D_MAX).contains(&d) {
         return Err(format!(
@@ -73,8 +73,8 @@ pub(super) fn build_camera(
         ));
     }
     let cam = Camera::new(
-        c.eye.0,
-        c.look_at.0,
+        c.eye.get(),
+        c.look_at.get(),
         c.up.map_or(Vec3::Y, |u| u.unit()),
         d,
         c.resolution.width,
@@ -126,21 +126,21 @@ fn build_lens(
     };
     let focus_wavelength = c
         .focus_wavelength
-        .map_or(system.reference_wavelength, |w| w.0 as f64);
+        .map_or(system.reference_wavelength, |w| w.get() as f64);
     if !(360.0..=830.0).contains(&focus_wavelength) {
         return Err(format!(
             "camera.focus_wavelength: expected a wavelength in 360–830 nm, got {focus_wavelength}"
         ));
     }
-    let mm_per_unit = c.mm_per_unit.map_or(1000.0, |x| x.0 as f64);
+    let mm_per_unit = c.mm_per_unit.map_or(1000.0, |x| x.get() as f64);
     let focus = match (c.film_distance, c.focus_distance) {
         (Some(_), Some(_)) => {
             return Err(
                 "camera.focus_distance: give the focus once: film_distance (mm behind the last vertex) or focus_distance (scene units in front of the film), not both".into(),
             )
         }
-        (Some(d), None) => Focus::FilmDistance(d.0 as f64),
-        (None, Some(d)) => Focus::ObjectDistance(d.0 as f64 * mm_per_unit),
+        (Some(d), None) => Focus::FilmDistance(d.get() as f64),
+        (None, Some(d)) => Focus::ObjectDistance(d.get() as f64 * mm_per_unit),
         (None, None) => Focus::Prescription,
     };
     let pupil = match c.pupil.as_deref() {
@@ -155,19 +155,21 @@ fn build_lens(
     let system = match c.f_number {
         Some(n) => {
             let p = paraxial::paraxial(&system, focus_wavelength);
-            system.with_stop_scaled(p.f_number / n.0 as f64)
+            system.with_stop_scaled(p.f_number / n.get() as f64)
         }
         None => system,
     };
     let settings = LensSettings {
-        film_diagonal: c.film_diagonal.map_or(FILM_DIAGONAL_35MM, |x| x.0 as f64),
+        film_diagonal: c
+            .film_diagonal
+            .map_or(FILM_DIAGONAL_35MM, |x| x.get() as f64),
         focus,
         focus_wavelength,
         pupil,
         mm_per_unit,
         film_offset: c
             .film_offset
-            .map_or((0.0, 0.0), |p| (p.0[0] as f64, p.0[1] as f64)),
+            .map_or((0.0, 0.0), |p| (p.get()[0] as f64, p.get()[1] as f64)),
     };
     LensCamera::new(system, settings).map_err(|e| format!("camera.{e}"))
 }

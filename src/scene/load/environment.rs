@@ -39,7 +39,7 @@ pub(super) fn build_envmap(
         _ => {}
     }
     inputs.push(env.map.clone());
-    let scale = env.scale.map_or(1.0, |s| s.0);
+    let scale = env.scale.map_or(1.0, |s| s.get());
     Ok(Arc::new(EnvMap::new(
         mapping,
         img.width,

@@ -18,7 +18,7 @@ pub(super) fn build_lights(entries: &[LightFile]) -> Result<Vec<Light>, String> 
         .enumerate()
         .map(|(i, l)| match l {
             LightFile::Point(p) => Ok(Light::Point(PointLight {
-                position: p.position.0,
+                position: p.position.get(),
                 intensity: p.intensity.spectrum(),
             })),
             LightFile::Directional(d) => Ok(Light::Directional(DirectionalLight {
@@ -79,7 +79,7 @@ fn polarization(at: &str, p: &LightPolarizationFile) -> Result<LightPolarization
 fn sun(at: &str, s: &SunLightFile) -> Result<SunLight, String> {
     let deg = s
         .angular_radius
-        .map_or(crate::light::sun::SUN_ANGULAR_RADIUS_DEG, |a| a.0);
+        .map_or(crate::light::sun::SUN_ANGULAR_RADIUS_DEG, |a| a.get());
     if deg >= 90.0 {
         return Err(format!(
             "{at}.angular_radius: expected degrees in (0, 90), got {deg}"
@@ -98,7 +98,7 @@ fn sun(at: &str, s: &SunLightFile) -> Result<SunLight, String> {
         ));
     }
     if let Some(p) = &s.portal {
-        let (o, e1, e2) = (p.origin.0, p.edge1.0, p.edge2.0);
+        let (o, e1, e2) = (p.origin.get(), p.edge1.get(), p.edge2.get());
         if cross_overflows(o, o + e1, o + e2) || !(o + e1 + e2).is_finite() {
             return Err(format!(
                 "{at}.portal: expected a portal whose corners and edges' cross product are finite in f32 (coordinates within about ±1e19), got origin {} and edges {} and {}",
@@ -121,8 +121,8 @@ fn sun(at: &str, s: &SunLightFile) -> Result<SunLight, String> {
 
 /// A spot entry at key path `at`.
 fn spot(at: &str, s: &SpotLightFile) -> Result<SpotLight, String> {
-    let angle = s.cone_angle.map_or(30.0, |a| a.0);
-    let delta = s.cone_delta.map_or(5.0, |a| a.0);
+    let angle = s.cone_angle.map_or(30.0, |a| a.get());
+    let delta = s.cone_delta.map_or(5.0, |a| a.get());
     if angle > 90.0 {
         return Err(format!(
             "{at}.cone_angle: expected degrees in (0, 90], got {angle}"
@@ -134,7 +134,7 @@ fn spot(at: &str, s: &SpotLightFile) -> Result<SpotLight, String> {
         ));
     }
     Ok(SpotLight {
-        position: s.position.0,
+        position: s.position.get(),
         direction: s.direction.unit(),
         intensity: s.intensity.spectrum(),
         cos_falloff_start: (angle - delta).to_radians().cos(),

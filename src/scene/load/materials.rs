@@ -119,16 +119,19 @@ fn build_ior(
     inputs: &mut Vec<String>,
 ) -> std::result::Result<Ior, String> {
     let ior = match spec {
-        IorSpec::Constant(n) => Ior::Constant(*n),
+        IorSpec::Constant(n) => Ior::Constant(*n as f32),
         IorSpec::Named(name) => crate::spectrum::ior::named(name)
             .ok_or_else(|| format!("{at}: unknown refractive-index model {name:?}"))?,
-        IorSpec::Sellmeier { b, c } => Ior::sellmeier(b, c).map_err(|e| format!("{at}: {e}"))?,
+        IorSpec::Sellmeier { b, c } => {
+            let f32s = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+            Ior::sellmeier(&f32s(b), &f32s(c)).map_err(|e| format!("{at}: {e}"))?
+        }
         IorSpec::Cauchy([a, b, c]) => Ior::Cauchy {
-            a: *a,
-            b: *b,
-            c: *c,
+            a: *a as f32,
+            b: *b as f32,
+            c: *c as f32,
         },
-        IorSpec::Abbe { n_d, v_d } => Ior::abbe(*n_d, *v_d),
+        IorSpec::Abbe { n_d, v_d } => Ior::abbe(*n_d as f32, *v_d as f32),
         IorSpec::Table(file) => {
             let p = base_dir.join(file);
             let csv =
@@ -157,8 +160,8 @@ fn build_metal(
             crate::spectrum::metals::read_nk(&base_dir.join(file)).map_err(|e| format!("{at}: {e}"))
         }
         MetalSpec::Constant { n, k } => Ok(ComplexIor {
-            n: DenseSpectrum::constant(*n),
-            k: DenseSpectrum::constant(*k),
+            n: DenseSpectrum::constant(*n as f32),
+            k: DenseSpectrum::constant(*k as f32),
         }),
     }
 }
@@ -213,7 +216,7 @@ fn build_material(
             if let Some(o) = &d.outside_ior {
                 interface.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir, inputs)?;
             }
-            let alpha = d.roughness.map_or(0.0, |r| r.0);
+            let alpha = d.roughness.map_or(0.0, |r| r.get());
             if alpha < MIN_ALPHA {
                 Material::Dielectric(interface)
             } else {
@@ -230,7 +233,7 @@ fn build_material(
         }
         MaterialFile::Conductor(c) => {
             let ior = build_metal(at, &c.metal, base_dir, inputs)?;
-            let alpha = c.roughness.map_or(0.0, |r| r.0);
+            let alpha = c.roughness.map_or(0.0, |r| r.get());
             if alpha < MIN_ALPHA {
                 Material::Conductor(Conductor { ior })
             } else {
@@ -247,7 +250,7 @@ fn build_material(
                 ));
             }
             // Energy conservation, seed "Glossy materials": ρd + ρs ≤ 1.
-            let rho_s = g.rho_s.0;
+            let rho_s = g.rho_s.get();
             let sum_max = match g.rho_d.0.rgb() {
                 Some(rgb) => rgb.iter().fold(f32::MIN, |a, &c| a.max(c + rho_s)),
                 None => g.rho_d.0.max_value() + rho_s,
@@ -261,7 +264,7 @@ fn build_material(
             Material::Glossy(Glossy {
                 rho_d: g.rho_d.spectrum(),
                 rho_s,
-                shininess: g.shininess.0,
+                shininess: g.shininess.get(),
                 base: match &g.ior {
                     Some(spec) => Some(Dielectric::new(
                         build_ior(&format!("{at}.ior"), spec, base_dir, inputs)?,

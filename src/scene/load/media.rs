@@ -91,7 +91,7 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String>
     let (nodes, dist) = match (m.radius_mm, &m.drops) {
         (Some(r), None) => (
             vec![crate::drops::DropNode {
-                radius_mm: r.0 as f64,
+                radius_mm: r.get() as f64,
                 weight: 1.0,
             }],
             None,
@@ -140,9 +140,9 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String>
         .map(|n| n.weight * 4.0 / 3.0 * std::f64::consts::PI * (n.radius_mm * 1e-3).powi(3))
         .sum();
     let density = match (m.number_density, m.liquid_water_content) {
-        (Some(n), None) => n.0 as f64,
+        (Some(n), None) => n.get() as f64,
         // N = LWC / (ρ_water ⟨V⟩), ρ_water = 10⁶ g/m³.
-        (None, Some(w)) => w.0 as f64 / (1e6 * mean_volume),
+        (None, Some(w)) => w.get() as f64 / (1e6 * mean_volume),
         (Some(_), Some(_)) => {
             return Err(format!(
                 "{at}: expected one of number_density (drops per m³) or liquid_water_content (g/m³), got both"
@@ -158,13 +158,13 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String>
             }
         },
     };
-    let step = m.lambda_step.map_or(10.0, |s| s.0);
+    let step = m.lambda_step.map_or(10.0, |s| s.get());
     if !(1.0..=50.0).contains(&step) {
         return Err(format!(
             "{at}.lambda_step: expected nm between wavelength nodes in [1, 50], got {step}"
         ));
     }
-    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.0 as f64);
+    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.get() as f64);
     if cutoff > 10.0 {
         return Err(format!(
             "{at}.forward_cutoff: expected degrees in [0, 10] (the diffraction peak counted as unscattered), got {cutoff}"
@@ -207,8 +207,8 @@ fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> 
             "{at}.g: expected a mean cosine in (-1, 1), got {g}"
         ));
     }
-    let sigma_a = m.sigma_a.map_or(0.0, |x| x.0);
-    let sigma_s = m.sigma_s.map_or(0.0, |x| x.0);
+    let sigma_a = m.sigma_a.map_or(0.0, |x| x.get());
+    let sigma_s = m.sigma_s.map_or(0.0, |x| x.get());
     if !(sigma_a + sigma_s).is_finite() || sigma_a + sigma_s <= 0.0 {
         return Err(format!(
             "{at}: expected sigma_a + sigma_s finite and > 0, got {sigma_a} + {sigma_s}"

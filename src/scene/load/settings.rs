@@ -19,7 +19,7 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
         settings.max_depth = x.0;
     }
     if let Some(x) = r.epsilon {
-        settings.epsilon = x.0;
+        settings.epsilon = x.get();
     }
     if let Some(x) = r.seed {
         settings.seed = x;

@@ -95,24 +95,28 @@ fn sphere(at: &str, sp: &SphereFile) -> std::result::Result<ShapeKind, String> {
     // Below this a sphere spans a handful of f32 steps at its centre, less than the
     // error bound of its hit points (geometry::spawn): rays would pass through it (heron
     // stress finds leaks from 2e-7 down).
-    let reach = sp.center.0.abs().max_element();
-    if sp.radius.0 < MIN_RELATIVE_RADIUS * reach {
+    let reach = sp.center.get().abs().max_element();
+    if sp.radius.get() < MIN_RELATIVE_RADIUS * reach {
         return Err(format!(
             "{at}.radius: expected at least {MIN_RELATIVE_RADIUS:e} × the centre's largest coordinate ({}), i.e. {:e}, got {}: a smaller sphere is below float precision where it is",
             fmt_f32(reach),
             MIN_RELATIVE_RADIUS * reach,
-            fmt_f32(sp.radius.0)
+            fmt_f32(sp.radius.get())
         ));
     }
     Ok(ShapeKind::Sphere {
-        center: sp.center.0,
-        radius: sp.radius.0,
+        center: sp.center.get(),
+        radius: sp.radius.get(),
     })
 }
 
 /// A triangle entry at key path `at`: a mesh of one triangle.
 fn triangle(at: &str, t: &TriangleFile) -> std::result::Result<ShapeKind, String> {
-    let v = [t.vertices[0].0, t.vertices[1].0, t.vertices[2].0];
+    let v = [
+        t.vertices[0].get(),
+        t.vertices[1].get(),
+        t.vertices[2].get(),
+    ];
     if cross_overflows(v[0], v[1], v[2]) {
         return Err(format!(
             "{at}.vertices: expected a triangle whose edges' cross product is finite in f32 (coordinates within about ±1e19), got {}",
@@ -131,11 +135,11 @@ fn triangle(at: &str, t: &TriangleFile) -> std::result::Result<ShapeKind, String
 /// A plane entry at key path `at`: a square of two triangles.
 fn plane(at: &str, p: &PlaneFile) -> std::result::Result<ShapeKind, String> {
     let n = p.normal.unit();
-    let size = p.size.map_or(1000.0, |s| s.0);
+    let size = p.size.map_or(1000.0, |s| s.get());
     // Tangents with t × b = n, so (v1 − v0) × (v2 − v0) points along n.
     let t = n.any_orthogonal_vector().normalize();
     let b = n.cross(t);
-    let c = p.point.0;
+    let c = p.point.get();
     let v = vec![
         c - size * t - size * b,
         c + size * t - size * b,
@@ -159,7 +163,7 @@ fn plane(at: &str, p: &PlaneFile) -> std::result::Result<ShapeKind, String> {
 
 /// A quad entry at key path `at`: a parallelogram of two triangles.
 fn quad(at: &str, q: &QuadFile) -> std::result::Result<ShapeKind, String> {
-    let (o, e1, e2) = (q.origin.0, q.edge1.0, q.edge2.0);
+    let (o, e1, e2) = (q.origin.get(), q.edge1.get(), q.edge2.get());
     let v = vec![o, o + e1, o + e1 + e2, o + e2];
     if v.iter().any(|x| !x.is_finite()) {
         return Err(format!(
@@ -196,7 +200,7 @@ const MAX_WAVE_TRIANGLES: u64 = 1 << 25;
 /// A `waves` entry at key path `at`: the quad's grid of cells, displaced along its normal
 /// by the sum of the entry's sine waves (`WavesFile`).
 fn waves(at: &str, w: &WavesFile) -> std::result::Result<ShapeKind, String> {
-    let (o, e1, e2) = (w.origin.0, w.edge1.0, w.edge2.0);
+    let (o, e1, e2) = (w.origin.get(), w.edge1.get(), w.edge2.get());
     let [nu, nv] = w.resolution.map_or([128, 128], |r| [r[0].0, r[1].0]);
     if nu as u64 * nv as u64 * 2 > MAX_WAVE_TRIANGLES {
         return Err(format!(
@@ -232,7 +236,7 @@ fn waves(at: &str, w: &WavesFile) -> std::result::Result<ShapeKind, String> {
         if !wave.phase.is_finite() {
             return Err(format!("{wat}.phase: expected a finite angle in degrees"));
         }
-        let [a, b] = wave.direction.0;
+        let [a, b] = wave.direction.get();
         let d = a * u1 + b * u2;
         if !(d.length() > 0.0) || !d.is_finite() {
             return Err(format!(
@@ -241,7 +245,7 @@ fn waves(at: &str, w: &WavesFile) -> std::result::Result<ShapeKind, String> {
                 fmt_f32(b)
             ));
         }
-        let k = std::f64::consts::TAU / wave.wavelength.0 as f64;
+        let k = std::f64::consts::TAU / wave.wavelength.get() as f64;
         let d = d.normalize().as_dvec3() * k;
         terms.push((wave.amplitude as f64, d, (wave.phase as f64).to_radians()));
     }
@@ -522,8 +526,8 @@ pub(crate) fn shapes_of_groups(
     let transform = mesh_transform(at, &m.transform).map_err(|msg| scene_error(scene_path, msg))?;
     check_group_names(&groups, mesh_path, at, m)?;
     let placement = Placement {
-        scale: m.scale.map_or(1.0, |s| s.0),
-        translate: m.translate.map_or(Vec3::ZERO, |t| t.0),
+        scale: m.scale.map_or(1.0, |s| s.get()),
+        translate: m.translate.map_or(Vec3::ZERO, |t| t.get()),
         transform,
     };
     // Mitsuba 3's readers: an OBJ's v is flipped (its images start at the bottom row,

@@ -70,14 +70,14 @@ pub(super) fn plan_sky(
     };
     let deg = sun_file
         .angular_radius
-        .map_or(SUN_ANGULAR_RADIUS_DEG, |a| a.0);
+        .map_or(SUN_ANGULAR_RADIUS_DEG, |a| a.get());
     let spec = SkySpec {
         model: sf.model.clone(),
         // The degrees as the file writes them (f32's shortest form, not its binary
         // value's 17 digits), which the limit is checked on and messages print.
         sun_radius_deg: deg.to_string().parse().unwrap_or(deg as f64),
         sun_radius_rad: sun.angular_radius as f64,
-        droplet_radius_mm: sf.droplet_radius.map(|r| r.0 as f64),
+        droplet_radius_mm: sf.droplet_radius.map(|r| r.get() as f64),
         drops: sf.drops.clone(),
         orders: sf.orders.clone(),
         polarisation: sf.polarisation.clone(),
@@ -87,7 +87,7 @@ pub(super) fn plan_sky(
     let sky = spec.build(&|k| scene_key(k, i))?;
     // The spec has checked the model's name.
     let physical = SkyModel::from_name(&sf.model).is_some_and(SkyModel::is_physical);
-    let scale = sf.scale.map_or(1.0, |s| s.0);
+    let scale = sf.scale.map_or(1.0, |s| s.get());
     Ok(SkyPlan {
         model: sf.model.clone(),
         sky,

@@ -2,6 +2,9 @@
 //! the plastics (mapped to heron's glossy material) and the wrappers (`twosided`,
 //! `mask`, `bumpmap`, `normalmap`), with the indices and roughnesses they name.
 use super::*;
+use crate::scene::file::{
+    ConductorFile, DielectricFile, GlossyFile, IorSpec, LambertianFile, MetalSpec, MirrorFile,
+};
 
 impl<'a> Converter<'a> {
     /// The name of heron's material for BSDF element `n` (converted once).
@@ -13,9 +16,9 @@ impl<'a> Converter<'a> {
         if let Some(name) = self.material_of.get(&(n as *const Node)) {
             return Ok(name.clone());
         }
-        let table = self.bsdf_table(n)?;
-        let name = match table {
-            Some(t) => {
+        let material = self.bsdf_material(n)?;
+        let name = match material {
+            Some(m) => {
                 let base = n
                     .attr("id")
                     .map(str::to_string)
@@ -26,7 +29,7 @@ impl<'a> Converter<'a> {
                     name = format!("{base}-{k}");
                     k += 1;
                 }
-                self.materials.insert(name.clone(), Value::Table(t));
+                self.materials.insert(name.clone(), m);
                 name
             }
             None => self.default_material(),
@@ -41,24 +44,22 @@ impl<'a> Converter<'a> {
             return m.clone();
         }
         let name = "mitsuba-default-diffuse".to_string();
-        self.materials.insert(
-            name.clone(),
-            Value::Table(table(vec![
-                ("type", Value::String("lambertian".into())),
-                ("rho_d", float(0.5)),
-            ])),
-        );
+        self.materials
+            .insert(name.clone(), lambertian(ColourValue::Grey(0.5)));
         self.default_material = Some(name.clone());
         name
     }
 
-    /// heron's table for a BSDF, or None for Mitsuba's default (after a warning).
-    pub(super) fn bsdf_table(&mut self, n: &'a Node) -> Result<Option<Table>, Diagnostic> {
+    /// heron's material for a BSDF, or None for Mitsuba's default (after a warning).
+    pub(super) fn bsdf_material(
+        &mut self,
+        n: &'a Node,
+    ) -> Result<Option<MaterialFile>, Diagnostic> {
         let kind = Self::plugin(n)?;
         let p = Props::new(n);
         let t = match kind {
             "twosided" | "mask" | "bumpmap" | "normalmap" => return self.wrapper_bsdf(n, &p, kind),
-            "diffuse" => self.diffuse_table(&p)?,
+            "diffuse" => self.diffuse(&p)?,
             "thindielectric" => {
                 self.warn(n.diag(
                     "thindielectric (a sheet with no thickness) is not supported yet; Mitsuba's default BSDF is used",
@@ -74,9 +75,9 @@ impl<'a> Converter<'a> {
                 self.finish(&p)?;
                 return Ok(None);
             }
-            "dielectric" | "roughdielectric" => self.dielectric_table(n, &p, kind)?,
-            "conductor" | "roughconductor" => self.conductor_table(n, &p, kind)?,
-            "plastic" | "roughplastic" => self.plastic_table(n, &p, kind)?,
+            "dielectric" | "roughdielectric" => self.dielectric(n, &p, kind)?,
+            "conductor" | "roughconductor" => self.conductor(n, &p, kind)?,
+            "plastic" | "roughplastic" => self.plastic(n, &p, kind)?,
             other => {
                 self.warn(n.diag(format!(
                     "BSDF {other:?} is not supported (diffuse, dielectric, roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided are); Mitsuba's default BSDF (diffuse 0.5) is used"
@@ -89,13 +90,13 @@ impl<'a> Converter<'a> {
     }
 
     /// `twosided` (heron's surfaces are two-sided) and the modulating wrappers heron
-    /// renders without their modulation: the nested BSDF's table.
+    /// renders without their modulation: the nested BSDF's material.
     pub(super) fn wrapper_bsdf(
         &mut self,
         n: &'a Node,
         p: &Props<'a>,
         kind: &str,
-    ) -> Result<Option<Table>, Diagnostic> {
+    ) -> Result<Option<MaterialFile>, Diagnostic> {
         // heron's surfaces are two-sided: `twosided` adds nothing. The others
         // modulate their nested BSDF, which heron renders unmodulated.
         let inner = p.objects(&["bsdf"]);
@@ -120,52 +121,43 @@ impl<'a> Converter<'a> {
                     )?;
                 }
                 let name = self.bsdf(b)?;
-                Ok(self
-                    .materials
-                    .get(&name)
-                    .and_then(|v| v.as_table())
-                    .cloned())
+                Ok(self.materials.get(&name).cloned())
             }
         }
     }
 
-    pub(super) fn diffuse_table(&mut self, p: &Props<'a>) -> Result<Table, Diagnostic> {
-        Ok({
-            if let Some(file) = self.bitmap(p, "reflectance")? {
-                table(vec![
-                    ("type", Value::String("lambertian".into())),
-                    ("texture", Value::String(file)),
-                ])
-            } else {
-                let rho = self.colour(p, "reflectance", ColourValue::Grey(0.5))?;
-                table(vec![
-                    ("type", Value::String("lambertian".into())),
-                    ("rho_d", rho.to_toml()),
-                ])
-            }
-        })
+    pub(super) fn diffuse(&mut self, p: &Props<'a>) -> Result<MaterialFile, Diagnostic> {
+        if let Some(file) = self.bitmap(p, "reflectance")? {
+            return Ok(MaterialFile::Lambertian(LambertianFile {
+                rho_d: None,
+                texture: Some(file),
+            }));
+        }
+        let rho = self.colour(p, "reflectance", ColourValue::Grey(0.5))?;
+        Ok(lambertian(rho))
     }
 
-    pub(super) fn dielectric_table(
+    pub(super) fn dielectric(
         &mut self,
         n: &Node,
         p: &Props,
         kind: &str,
-    ) -> Result<Table, Diagnostic> {
+    ) -> Result<MaterialFile, Diagnostic> {
         Ok({
             let int = self.ior(p, "int_ior", "bk7")?;
             let ext = self.ior(p, "ext_ior", "air")?;
-            let mut t = table(vec![
-                ("type", Value::String("dielectric".into())),
-                ("ior", int),
-            ]);
-            // Air's 1.000277 is kept: it is Mitsuba's own default, and heron's
-            // relative index is then Mitsuba's.
-            t.insert("outside_ior".into(), ext);
-            if kind == "roughdielectric" {
-                let alpha = self.roughness(n, p)?;
-                t.insert("roughness".into(), float(alpha));
-            }
+            let roughness = match kind {
+                "roughdielectric" => Some(schema::unit(self.roughness(n, p)?)),
+                _ => None,
+            };
+            let t = MaterialFile::Dielectric(DielectricFile {
+                ior: int,
+                fresnel: None,
+                roughness,
+                // Air's 1.000277 is kept: it is Mitsuba's own default, and heron's
+                // relative index is then Mitsuba's.
+                outside_ior: Some(ext),
+            });
             for k in ["specular_reflectance", "specular_transmittance"] {
                 if let Some(c) = p.get(k) {
                     self.warn(c.diag(format!(
@@ -177,23 +169,23 @@ impl<'a> Converter<'a> {
         })
     }
 
-    pub(super) fn conductor_table(
+    pub(super) fn conductor(
         &mut self,
         n: &Node,
         p: &Props,
         kind: &str,
-    ) -> Result<Table, Diagnostic> {
+    ) -> Result<MaterialFile, Diagnostic> {
         Ok({
             let material = p.string("material")?;
             let eta = p.float("eta");
             let k = p.float("k");
             let (eta, k) = (eta?, k?);
             let metal = match (material, eta, k) {
-            (_, Some(n_), Some(k_)) => Some(Value::Table(table(vec![
-                ("n", float(n_)),
-                ("k", float(k_)),
-            ]))),
-            (Some(m), None, None) if METALS.contains(&m) => Some(Value::String(m.into())),
+            (_, Some(n_), Some(k_)) => Some(MetalSpec::Constant {
+                n: schema::tidy(n_),
+                k: schema::tidy(k_),
+            }),
+            (Some(m), None, None) if METALS.contains(&m) => Some(MetalSpec::Named(m.into())),
             (None | Some("none"), None, None) => None,
             (Some(m), None, None) => {
                 return Err(n.diag(format!(
@@ -212,42 +204,40 @@ impl<'a> Converter<'a> {
             }
             match metal {
             // Mitsuba's `none`: a perfect mirror.
-            None if kind == "conductor" => table(vec![
-                ("type", Value::String("mirror".into())),
-                ("rho_s", float(1.0)),
-            ]),
+            None if kind == "conductor" => MaterialFile::Mirror(MirrorFile {
+                rho_s: Some(ColourValue::Grey(1.0).reflectance()),
+            }),
             None => {
                 return Err(n.diag(
                     "material \"none\" on a roughconductor: heron has no rough perfect mirror; give a metal or eta and k",
                 ))
             }
-            Some(m) => {
-                let mut t = table(vec![("type", Value::String("conductor".into())), ("metal", m)]);
-                if kind == "roughconductor" {
-                    let alpha = self.roughness(n, p)?;
-                    t.insert("roughness".into(), float(alpha));
-                }
-                t
+            Some(metal) => {
+                let roughness = match kind {
+                    "roughconductor" => Some(schema::unit(self.roughness(n, p)?)),
+                    _ => None,
+                };
+                MaterialFile::Conductor(ConductorFile { metal, roughness })
             }
         }
         })
     }
 
-    pub(super) fn plastic_table(
+    pub(super) fn plastic(
         &mut self,
         n: &Node,
         p: &Props<'a>,
         kind: &str,
-    ) -> Result<Table, Diagnostic> {
+    ) -> Result<MaterialFile, Diagnostic> {
         Ok({
             let rho = self.colour(p, "diffuse_reflectance", ColourValue::Grey(0.5))?;
             let eta = match self.ior(p, "int_ior", "polypropylene")? {
-                Value::Float(x) => x,
-                Value::String(name) => mitsuba_ior(&name).unwrap_or(1.49),
+                IorSpec::Constant(x) => x,
+                IorSpec::Named(name) => mitsuba_ior(&name).unwrap_or(1.49),
                 _ => 1.49,
             };
             let ext = match self.ior(p, "ext_ior", "air")? {
-                Value::Float(x) => x,
+                IorSpec::Constant(x) => x,
                 _ => 1.000277,
             };
             let eta = eta / ext;
@@ -272,12 +262,13 @@ impl<'a> Converter<'a> {
             } else {
                 rho
             };
-            table(vec![
-                ("type", Value::String("glossy".into())),
-                ("rho_d", rho.to_toml()),
-                ("rho_s", float(f0)),
-                ("shininess", float(shininess)),
-            ])
+            MaterialFile::Glossy(GlossyFile {
+                rho_d: rho.reflectance(),
+                rho_s: schema::unit(f0),
+                shininess: schema::positive(shininess),
+                ior: None,
+                fresnel: None,
+            })
         })
     }
 
@@ -325,7 +316,7 @@ impl<'a> Converter<'a> {
         p: &Props,
         name: &str,
         default: &str,
-    ) -> Result<Value, Diagnostic> {
+    ) -> Result<IorSpec, Diagnostic> {
         let node = p.get(name);
         let text = match node {
             None => default.to_string(),
@@ -336,7 +327,7 @@ impl<'a> Converter<'a> {
                 let c = node.expect("a number came from the file");
                 return Err(c.diag(format!("value: expected an index > 0, got {text:?}")));
             }
-            return Ok(float(x));
+            return Ok(IorSpec::Constant(schema::tidy(x)));
         }
         if let Some((_, entry)) = CATALOGUE_IORS.iter().find(|(m, _)| *m == text) {
             if let Some(c) = node {
@@ -346,10 +337,10 @@ impl<'a> Converter<'a> {
                     mitsuba_ior(&text).unwrap_or(f64::NAN)
                 )))?;
             }
-            return Ok(Value::String((*entry).into()));
+            return Ok(IorSpec::Named((*entry).into()));
         }
         match mitsuba_ior(&text) {
-            Some(x) => Ok(float(x)),
+            Some(x) => Ok(IorSpec::Constant(schema::tidy(x))),
             None => {
                 let names: Vec<&str> = MITSUBA_IORS.iter().map(|(n, _)| *n).collect();
                 Err(node.unwrap_or(p.node).diag(format!(
@@ -369,4 +360,12 @@ pub(super) fn mitsuba_ior(name: &str) -> Option<f64> {
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, x)| *x)
+}
+
+/// A diffuse material of reflectance `rho`.
+fn lambertian(rho: ColourValue) -> MaterialFile {
+    MaterialFile::Lambertian(LambertianFile {
+        rho_d: Some(rho.reflectance()),
+        texture: None,
+    })
 }

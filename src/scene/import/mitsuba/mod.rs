@@ -1,15 +1,20 @@
-//! Mitsuba 3 scene objects to heron's scene tables (the TOML heron renders): sensor,
-//! film and sampler to `[camera]` and `[render]`, integrators, BSDFs to `[materials]`,
-//! shapes (with their area emitters) to `[[shapes]]`, emitters to `[[lights]]` and
-//! `background`. Mitsuba's defaults are those of its plugin documentation
-//! (mitsuba.readthedocs.io, "Plugin reference", 3.x); where heron has no equivalent the
-//! converter says what it did in a [`Diagnostic`] (a warning, an error under `strict`).
+//! Mitsuba 3 scene objects to heron's scene ([`SceneFile`], the schema of the TOML heron
+//! renders): sensor, film and sampler to `camera` and `render`, integrators, BSDFs to
+//! `materials`, shapes (with their area emitters) to `shapes`, emitters to `lights`,
+//! `background` and `environment`. Mitsuba's defaults are those of its plugin
+//! documentation (mitsuba.readthedocs.io, "Plugin reference", 3.x); where heron has no
+//! equivalent the converter says what it did in a [`Diagnostic`] (a warning, an error
+//! under `strict`).
 use super::props::{ColourError, ColourValue, Props};
+use super::schema;
 use super::xml::{Diagnostic, Node};
+use crate::scene::file::{
+    CameraFile, Emission, EnvironmentFile, LightFile, MaterialFile, RenderFile, SceneFile,
+    ShapeFile,
+};
 use glam::{DMat4, DVec3};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
-use toml::{Table, Value};
 
 mod bsdfs;
 mod shapes;
@@ -60,9 +65,9 @@ const CATALOGUE_IORS: &[(&str, &str)] = &[
 /// Mitsuba's conductor `material` names heron tabulates (spectrum/metals.rs).
 const METALS: &[&str] = &["Ag", "Al", "Au", "Cu"];
 
-/// What the conversion made: heron's scene table, and what it could not carry over.
+/// What the conversion made: heron's scene, and what it could not carry over.
 pub struct Converted {
-    pub table: Table,
+    pub scene: SceneFile,
     pub warnings: Vec<Diagnostic>,
 }
 
@@ -72,17 +77,18 @@ struct Converter<'a> {
     strict: bool,
     ids: HashMap<&'a str, &'a Node>,
     warnings: Vec<Diagnostic>,
-    materials: Table,
+    materials: BTreeMap<String, MaterialFile>,
     /// Material name of each converted BSDF element (shared through `ref`).
     material_of: HashMap<*const Node, String>,
     default_material: Option<String>,
-    shapes: Vec<Value>,
-    lights: Vec<Value>,
-    background: Option<Value>,
+    shapes: Vec<ShapeFile>,
+    lights: Vec<LightFile>,
+    background: Option<Emission>,
     /// `[environment]` from an `envmap` emitter.
-    environment: Option<Value>,
-    camera: Option<Table>,
-    render: Table,
+    environment: Option<EnvironmentFile>,
+    camera: Option<CameraFile>,
+    /// `[render]`, made by the first key set.
+    render: Option<RenderFile>,
 }
 
 /// Converts the document `root` (from [`super::xml::read_document`]) read from `path`.
@@ -94,7 +100,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         strict,
         ids,
         warnings: Vec::new(),
-        materials: Table::new(),
+        materials: BTreeMap::new(),
         material_of: HashMap::new(),
         default_material: None,
         shapes: Vec::new(),
@@ -102,7 +108,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         background: None,
         environment: None,
         camera: None,
-        render: Table::new(),
+        render: None,
     };
     for child in &root.children {
         match child.tag.as_str() {
@@ -131,49 +137,20 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
                 .into(),
         });
     };
-    let mut table = scene_table(
+    let scene = SceneFile {
+        background: c.background,
         camera,
-        std::mem::take(&mut c.render),
-        c.background.take(),
-        std::mem::take(&mut c.materials),
-        std::mem::take(&mut c.shapes),
-        std::mem::take(&mut c.lights),
-    );
-    if let Some(e) = c.environment.take() {
-        table.insert("environment".into(), e);
-    }
+        render: c.render,
+        materials: c.materials,
+        shapes: c.shapes,
+        lights: c.lights,
+        sky: None,
+        environment: c.environment,
+    };
     Ok(Converted {
-        table,
+        scene,
         warnings: c.warnings,
     })
-}
-
-/// heron's scene table from its parts, leaving out the empty optional ones (what both
-/// converters, this one and pbrt.rs, assemble).
-pub(super) fn scene_table(
-    camera: Table,
-    render: Table,
-    background: Option<Value>,
-    materials: Table,
-    shapes: Vec<Value>,
-    lights: Vec<Value>,
-) -> Table {
-    let mut t = Table::new();
-    t.insert("camera".into(), Value::Table(camera));
-    if !render.is_empty() {
-        t.insert("render".into(), Value::Table(render));
-    }
-    if let Some(b) = background {
-        t.insert("background".into(), b);
-    }
-    if !materials.is_empty() {
-        t.insert("materials".into(), Value::Table(materials));
-    }
-    t.insert("shapes".into(), Value::Array(shapes));
-    if !lights.is_empty() {
-        t.insert("lights".into(), Value::Array(lights));
-    }
-    t
 }
 
 fn collect_ids<'a>(n: &'a Node, ids: &mut HashMap<&'a str, &'a Node>) -> Result<(), Diagnostic> {
@@ -188,28 +165,12 @@ fn collect_ids<'a>(n: &'a Node, ids: &mut HashMap<&'a str, &'a Node>) -> Result<
     Ok(())
 }
 
-/// `v` to 12 significant digits (far beyond f32's 7), so that a rotation by 90° writes
-/// 0 and 1 rather than 6e-17 and 0.9999999999999999.
-pub(super) fn tidy(v: f64) -> f64 {
-    if v.abs() < 1e-12 {
-        return 0.0;
-    }
-    format!("{v:.11e}").parse().unwrap_or(v)
-}
-
-pub(super) fn float(v: f64) -> Value {
-    Value::Float(tidy(v))
-}
-
-pub(super) fn vec3(v: DVec3) -> Value {
-    Value::Array(v.to_array().iter().map(|x| float(*x)).collect())
-}
-
-pub(super) fn table(pairs: Vec<(&str, Value)>) -> Table {
-    pairs.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
-}
-
 impl<'a> Converter<'a> {
+    /// The `[render]` table, made on first use.
+    fn render(&mut self) -> &mut RenderFile {
+        self.render.get_or_insert_with(RenderFile::default)
+    }
+
     fn warn(&mut self, d: Diagnostic) -> Result<(), Diagnostic> {
         if self.strict {
             Err(d)
@@ -347,13 +308,12 @@ impl<'a> Converter<'a> {
                 "max_depth: expected -1 or at least 2 (heron renders at least one scattering event), got {depth}"
             )));
         }
-        self.render
-            .insert("integrator".into(), Value::String(integrator.into()));
-        self.render
-            .insert("max_depth".into(), Value::Integer(heron_depth));
+        let max_depth = schema::positive_count("max_depth", heron_depth).map_err(|m| n.diag(m))?;
+        self.render().integrator = Some(integrator.into());
+        self.render().max_depth = Some(max_depth);
         if let Some(rr) = p.integer("rr_depth")? {
-            self.render
-                .insert("rr_depth".into(), Value::Integer((rr - 1).max(0)));
+            let rr = schema::count("rr_depth", (rr - 1).max(0)).map_err(|m| n.diag(m))?;
+            self.render().rr_depth = Some(rr);
         }
         if kind == "direct" {
             for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {
@@ -404,7 +364,7 @@ impl<'a> Converter<'a> {
             }
         }
         // Film first: the field of view's axis needs the aspect ratio.
-        let (mut width, mut height) = (768_i64, 576_i64);
+        let (mut width, mut height) = (768, 576);
         for f in p.objects(&["film", "sampler"]) {
             let f = self.resolve(f)?;
             match f.tag.as_str() {
@@ -466,22 +426,14 @@ impl<'a> Converter<'a> {
         let eye = to_world.transform_point3(DVec3::ZERO);
         let look = to_world.transform_point3(DVec3::Z);
         let up = to_world.transform_vector3(DVec3::Y);
-        let mut cam = table(vec![
-            ("eye", vec3(eye)),
-            ("look_at", vec3(look)),
-            ("up", vec3(up)),
-            ("d", float(0.5 / tan_y)),
-            (
-                "resolution",
-                Value::Array(vec![Value::Integer(width), Value::Integer(height)]),
-            ),
-        ]);
-        cam.retain(|_, v| !matches!(v, Value::Float(x) if !x.is_finite()));
+        let mut cam = schema::pinhole(eye, look, up, 0.5 / tan_y, (width, height));
+        // A camera constant beyond f64 is left to heron's default.
+        cam.d = cam.d.filter(|d| d.0.is_finite());
         self.camera = Some(cam);
         self.finish(&p)
     }
 
-    fn film(&mut self, f: &'a Node) -> Result<(i64, i64), Diagnostic> {
+    fn film(&mut self, f: &'a Node) -> Result<(u32, u32), Diagnostic> {
         let kind = Self::plugin(f)?;
         if kind != "hdrfilm" && kind != "specfilm" {
             self.unsupported(f, "heron writes an OpenEXR film like hdrfilm; read as one")?;
@@ -493,6 +445,7 @@ impl<'a> Converter<'a> {
             if v < 1 {
                 return Err(f.diag(format!("{k}: expected at least 1 pixel, got {v}")));
             }
+            schema::count(k, v).map_err(|m| f.diag(m))?;
         }
         let filters = p.objects(&["rfilter"]);
         match filters.first() {
@@ -525,7 +478,7 @@ impl<'a> Converter<'a> {
             }
         }
         self.finish(&p)?;
-        Ok((width, height))
+        Ok((width as u32, height as u32))
     }
 
     fn sampler(&mut self, s: &'a Node) -> Result<(), Diagnostic> {
@@ -534,11 +487,11 @@ impl<'a> Converter<'a> {
             if spp < 1 {
                 return Err(s.diag(format!("sample_count: expected at least 1, got {spp}")));
             }
-            self.render.insert("spp".into(), Value::Integer(spp));
+            let spp = schema::positive_count("sample_count", spp).map_err(|m| s.diag(m))?;
+            self.render().spp = Some(spp);
         }
         if let Some(seed) = p.integer("seed")? {
-            self.render
-                .insert("seed".into(), Value::Integer(seed.max(0)));
+            self.render().seed = Some(seed.max(0) as u64);
         }
         // heron's sample sequence is its own (Sobol by default); the kind of sampler
         // changes noise, not the expected image.
@@ -547,10 +500,6 @@ impl<'a> Converter<'a> {
     }
 
     // ---- BSDFs ----------------------------------------------------------------------
-}
-
-pub(super) fn vec_row(r: [f64; 4]) -> Value {
-    Value::Array(r.iter().map(|x| float(*x)).collect())
 }
 
 /// `path` relative to the folder `base` when one contains the other's ancestors;

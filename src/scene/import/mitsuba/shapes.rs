@@ -1,6 +1,7 @@
 //! Mitsuba 3's shapes (with their area emitters) and emitters as heron's shapes and
 //! lights.
 use super::*;
+use crate::scene::file::{DirectionalLightFile, PointLightFile, SpotLightFile};
 
 impl<'a> Converter<'a> {
     pub(super) fn shape(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
@@ -26,14 +27,14 @@ impl<'a> Converter<'a> {
             Some(m) => m,
             None => self.default_material(),
         };
-        let mut entries: Vec<Table> = Vec::new();
+        let mut entries: Vec<ShapeFile> = Vec::new();
         match kind {
             "rectangle" => {
                 let mut q = quad(&to_world, [-1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
                 if flip {
                     q.reverse_edges();
                 }
-                entries.push(q.table());
+                entries.push(q.shape());
             }
             "cube" => {
                 // The six faces of [-1, 1]³, each (origin, edge1, edge2) with edge1 × edge2
@@ -51,7 +52,7 @@ impl<'a> Converter<'a> {
                     if flip {
                         q.reverse_edges();
                     }
-                    entries.push(q.table());
+                    entries.push(q.shape());
                 }
             }
             "disk" => {
@@ -64,10 +65,7 @@ impl<'a> Converter<'a> {
                     // Counter-clockwise about the transformed +z, as `quad` keeps it.
                     let swap = flip ^ (to_world.determinant() < 0.0);
                     let verts = if swap { [c, v1, v0] } else { [c, v0, v1] };
-                    entries.push(table(vec![
-                        ("type", Value::String("triangle".into())),
-                        ("vertices", Value::Array(verts.into_iter().map(vec3).collect())),
-                    ]));
+                    entries.push(schema::triangle(verts));
                 }
             }
             "sphere" => {
@@ -84,11 +82,10 @@ impl<'a> Converter<'a> {
                 if flip {
                     self.warn(n.diag("flip_normals on a sphere is not supported, ignored"))?;
                 }
-                entries.push(table(vec![
-                    ("type", Value::String("sphere".into())),
-                    ("center", vec3(to_world.transform_point3(center))),
-                    ("radius", float(radius * s[0])),
-                ]));
+                entries.push(schema::sphere(
+                    to_world.transform_point3(center),
+                    radius * s[0],
+                ));
             }
             "obj" | "ply" => {
                 let Some(file) = p.string("filename")? else {
@@ -102,22 +99,10 @@ impl<'a> Converter<'a> {
                 }
                 // heron shades every mesh by its face normals (README, "Mitsuba 3 scenes").
                 p.get("face_normals");
-                let flip_uv = p.boolean("flip_tex_coords")?;
-                let mut t = table(vec![
-                    ("type", Value::String("mesh".into())),
-                    ("file", Value::String(rel.to_string_lossy().replace('\\', "/"))),
-                ]);
-                if to_world != DMat4::IDENTITY {
-                    let rows: Vec<Value> = (0..4)
-                        .map(|r| vec_row(to_world.row(r).to_array()))
-                        .collect();
-                    t.insert("transform".into(), Value::Array(rows));
-                }
                 // heron's defaults are Mitsuba's (true for OBJ, false for PLY).
-                if let Some(f) = flip_uv {
-                    t.insert("flip_tex_coords".into(), Value::Boolean(f));
-                }
-                entries.push(t);
+                let flip_uv = p.boolean("flip_tex_coords")?;
+                let file = rel.to_string_lossy().replace('\\', "/");
+                entries.push(schema::mesh(file, to_world, flip_uv));
             }
             "serialized" => {
                 return Err(n.diag(
@@ -132,11 +117,10 @@ impl<'a> Converter<'a> {
             }
         }
         for mut e in entries {
-            e.insert("material".into(), Value::String(material.clone()));
-            if let Some(em) = &emission {
-                e.insert("emission".into(), em.clone());
-            }
-            self.shapes.push(Value::Table(e));
+            let (m, em, _) = e.surface_mut();
+            *m = Some(material.clone());
+            *em = emission.clone();
+            self.shapes.push(e);
         }
         self.finish(&p)
     }
@@ -149,13 +133,13 @@ impl<'a> Converter<'a> {
         &mut self,
         n: &'a Node,
         shape: Option<&Node>,
-    ) -> Result<Option<Value>, Diagnostic> {
+    ) -> Result<Option<Emission>, Diagnostic> {
         let kind = Self::plugin(n)?;
         let p = Props::new(n);
         let out = match (kind, shape) {
             ("area", Some(_)) => {
                 let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
-                Some(l.to_toml())
+                Some(l.emission())
             }
             ("area", None) => return Err(n.diag("an area emitter must be inside a <shape>")),
             (_, Some(s)) => {
@@ -171,11 +155,11 @@ impl<'a> Converter<'a> {
                     (None, None) => DVec3::ZERO,
                 };
                 let i = self.colour(&p, "intensity", ColourValue::Grey(1.0))?;
-                self.lights.push(Value::Table(table(vec![
-                    ("type", Value::String("point".into())),
-                    ("position", vec3(pos)),
-                    ("intensity", i.to_toml()),
-                ])));
+                self.lights.push(LightFile::Point(PointLightFile {
+                    position: schema::point(pos),
+                    intensity: i.emission(),
+                    polarization: None,
+                }));
                 None
             }
             ("spot", None) => {
@@ -191,14 +175,14 @@ impl<'a> Converter<'a> {
                 self.warn(n.diag(
                     "spot: heron's falloff between beam_width and cutoff_angle is pbrt's smoothstep, Mitsuba's is linear in angle",
                 ))?;
-                self.lights.push(Value::Table(table(vec![
-                    ("type", Value::String("spot".into())),
-                    ("position", vec3(m.transform_point3(DVec3::ZERO))),
-                    ("direction", vec3(m.transform_vector3(DVec3::Z))),
-                    ("intensity", i.to_toml()),
-                    ("cone_angle", float(cutoff)),
-                    ("cone_delta", float(cutoff - beam)),
-                ])));
+                self.lights.push(LightFile::Spot(SpotLightFile {
+                    position: schema::point(m.transform_point3(DVec3::ZERO)),
+                    direction: schema::direction(m.transform_vector3(DVec3::Z)),
+                    intensity: i.emission(),
+                    cone_angle: Some(schema::positive(cutoff)),
+                    cone_delta: Some(schema::non_negative(cutoff - beam)),
+                    polarization: None,
+                }));
                 None
             }
             ("directional", None) => {
@@ -211,11 +195,12 @@ impl<'a> Converter<'a> {
                     return Err(n.diag("direction: expected a non-zero vector"));
                 }
                 let e = self.colour(&p, "irradiance", ColourValue::Grey(1.0))?;
-                self.lights.push(Value::Table(table(vec![
-                    ("type", Value::String("directional".into())),
-                    ("direction", vec3(dir)),
-                    ("radiance", e.to_toml()),
-                ])));
+                self.lights
+                    .push(LightFile::Directional(DirectionalLightFile {
+                        direction: schema::direction(dir),
+                        radiance: e.emission(),
+                        polarization: None,
+                    }));
                 None
             }
             ("constant", None) => {
@@ -225,7 +210,7 @@ impl<'a> Converter<'a> {
                         "a second environment emitter (constant or envmap); heron's environment is the first, ignored",
                     ))?;
                 } else {
-                    self.background = Some(l.to_toml());
+                    self.background = Some(l.emission());
                 }
                 None
             }
@@ -242,26 +227,24 @@ impl<'a> Converter<'a> {
                 let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
                 // Only how the map is sampled, not what it shows: heron's own sampling.
                 p.get("mis_compensation");
-                let mut t = table(vec![
-                    (
-                        "map",
-                        Value::String(rel.to_string_lossy().replace('\\', "/")),
-                    ),
-                    ("scale", float(scale)),
-                ]);
-                if to_world != DMat4::IDENTITY {
+                let transform = (to_world != DMat4::IDENTITY).then(|| {
                     // The map is at infinity: its translation does not matter.
                     let mut m = to_world;
                     m.w_axis = glam::DVec4::W;
-                    let rows: Vec<Value> = (0..4).map(|r| vec_row(m.row(r).to_array())).collect();
-                    t.insert("transform".into(), Value::Array(rows));
-                }
+                    schema::rows(m)
+                });
+                let t = EnvironmentFile {
+                    map: rel.to_string_lossy().replace('\\', "/"),
+                    mapping: None,
+                    scale: Some(schema::non_negative(scale)),
+                    transform,
+                };
                 if self.environment.is_some() || self.background.is_some() {
                     self.warn(n.diag(
                         "a second environment emitter (envmap or constant); heron's environment is the first, ignored",
                     ))?;
                 } else {
-                    self.environment = Some(Value::Table(t));
+                    self.environment = Some(t);
                 }
                 None
             }
@@ -289,13 +272,8 @@ impl Quad {
         std::mem::swap(&mut self.edge1, &mut self.edge2);
     }
 
-    fn table(&self) -> Table {
-        table(vec![
-            ("type", Value::String("quad".into())),
-            ("origin", vec3(self.origin)),
-            ("edge1", vec3(self.edge1)),
-            ("edge2", vec3(self.edge2)),
-        ])
+    fn shape(&self) -> ShapeFile {
+        schema::quad(self.origin, self.edge1, self.edge2)
     }
 }
 

@@ -111,12 +111,12 @@ impl Conv {
             "Sampler" => {
                 let p = d.params();
                 if let Some(n) = p.float("pixelsamples") {
-                    self.render
-                        .insert("spp".into(), Value::Integer((n as i64).max(1)));
+                    let spp = schema::positive_count("Sampler: pixelsamples", (n as i64).max(1))
+                        .map_err(|m| self.diag(path, line, m))?;
+                    self.render().spp = Some(spp);
                 }
                 if let Some(seed) = p.float("seed") {
-                    self.render
-                        .insert("seed".into(), Value::Integer(seed.max(0.0) as i64));
+                    self.render().seed = Some(seed.max(0.0) as i64 as u64);
                 }
                 Ok(())
             }
@@ -271,7 +271,10 @@ impl Conv {
                 "Film: expected xresolution and yresolution of at least 1",
             ));
         }
-        self.resolution = (w as i64, h as i64);
+        let size = |k: &str, v: f64| {
+            schema::count(&format!("Film: {k}"), v as i64).map_err(|m| self.diag(path, line, m))
+        };
+        self.resolution = (size("xresolution", w)?, size("yresolution", h)?);
         if d.name() == "spectral" {
             // pbrt-v4's SpectralFilm: nbuckets equal buckets over [lambdamin, lambdamax]
             // (16 over 360–830 nm by default); heron's bins span 360–830 nm.
@@ -286,8 +289,7 @@ impl Conv {
             if (lo, hi) != (360.0, 830.0) {
                 self.warn(self.diag(path, line, format!("Film \"spectral\": heron's spectral bins span 360–830 nm, not {lo}–{hi} nm; {n} bins over 360–830 nm are used")))?;
             }
-            self.render
-                .insert("spectral_bins".into(), Value::Integer(n as i64));
+            self.render().spectral_bins = Some(n as i64);
         }
         Ok(())
     }
@@ -303,7 +305,7 @@ impl Conv {
                 return self.warn(self.diag(path, line, format!("Integrator {other:?} is not supported (path, volpath, bdpt, sppm, lightpath are), heron's default is used")));
             }
         };
-        self.render.insert("integrator".into(), s(kind));
+        self.render().integrator = Some(kind.into());
         let depth = p.float("maxdepth").unwrap_or(5.0) as i64;
         if depth < 1 {
             return Err(self.diag(
@@ -312,8 +314,9 @@ impl Conv {
                 format!("Integrator: maxdepth: expected at least 1, got {depth}"),
             ));
         }
-        self.render
-            .insert("max_depth".into(), Value::Integer(depth));
+        let depth = schema::positive_count("Integrator: maxdepth", depth)
+            .map_err(|m| self.diag(path, line, m))?;
+        self.render().max_depth = Some(depth);
         p.get("regularize");
         p.get("lightsampler");
         Ok(())
@@ -393,7 +396,7 @@ impl Conv {
                 let l = self.emission(path, p, "L", 1.0)?;
                 let scale = p.float("scale").unwrap_or(1.0);
                 let two = p.string("twosided") == Some("true");
-                self.g.area = Some((scaled(l, scale), two));
+                self.g.area = Some((scaled(l, scale).emission(), two));
             }
         }
         Ok(())

@@ -1,5 +1,5 @@
 //! pbrt-v4 scene files (pbrt-v4 User's Guide, "Scene Description Format") to heron's
-//! scene table: the tokens and directives with their line, the current transformation
+//! scene ([`SceneFile`]): the tokens and directives with their line, the current transformation
 //! matrix with `AttributeBegin`/`End`, materials (named and current), area lights, and
 //! the shapes heron has. Conventions: pbrt's `Transform`/`ConcatTransform` matrices are
 //! given column by column (pbrt transposes them), its camera looks along local +z with
@@ -18,12 +18,17 @@
 //! matrix is CTM(instance) · CTM(shape). Everything else a copy has (material, reverse
 //! orientation) is the definition's; instances may come before their definition (pbrt-v4
 //! resolves them after parsing), and area lights in a definition do not emit.
-use super::mitsuba::{float, relative_to, scene_table, table, vec3, Converted};
+use super::mitsuba::{relative_to, Converted};
+use super::props::ColourValue;
+use super::schema::{self, tidy};
 use super::xml::Diagnostic;
+use crate::scene::file::{
+    CameraFile, Emission, EnvironmentFile, LightFile, MaterialFile, RenderFile, SceneFile,
+    ShapeFile,
+};
 use glam::{DMat4, DVec3};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
-use toml::{Table, Value};
 
 mod directives;
 mod tokens;
@@ -33,7 +38,8 @@ mod translate;
 struct Graphics {
     ctm: DMat4,
     material: Option<String>,
-    area: Option<(Value, bool)>,
+    /// The area light's radiance and two-sidedness.
+    area: Option<(Emission, bool)>,
     reverse: bool,
 }
 
@@ -65,7 +71,7 @@ struct ShapeDef {
     ctm: DMat4,
     reverse: bool,
     material: String,
-    area: Option<(Value, bool)>,
+    area: Option<(Emission, bool)>,
     file: PathBuf,
     line: u32,
 }
@@ -88,7 +94,8 @@ struct ObjectDef {
 /// may come first), each in file order.
 #[derive(Clone, Debug)]
 enum Slot {
-    Shape(Value),
+    /// Boxed: a shape entry is several times an instance's size.
+    Shape(Box<ShapeFile>),
     Instance {
         name: String,
         ctm: DMat4,
@@ -111,17 +118,18 @@ struct Conv {
     base: PathBuf,
     strict: bool,
     warnings: Vec<Diagnostic>,
-    materials: Table,
+    materials: BTreeMap<String, MaterialFile>,
     named: HashMap<String, String>,
     shapes: Vec<Slot>,
-    lights: Vec<Value>,
-    background: Option<Value>,
+    lights: Vec<LightFile>,
+    background: Option<Emission>,
     /// `[environment]` from an image `infinite` light.
-    environment: Option<Value>,
-    camera: Option<Table>,
+    environment: Option<EnvironmentFile>,
+    camera: Option<CameraFile>,
     camera_from_world: Option<(DMat4, u32, PathBuf, f64)>,
-    resolution: (i64, i64),
-    render: Table,
+    resolution: (u32, u32),
+    /// `[render]`, made by the first key set.
+    render: Option<RenderFile>,
     g: Graphics,
     stack: Vec<Pushed>,
     n_material: usize,
@@ -153,7 +161,7 @@ impl Conv {
             base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
             strict,
             warnings: Vec::new(),
-            materials: Table::new(),
+            materials: BTreeMap::new(),
             named: HashMap::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
@@ -162,7 +170,7 @@ impl Conv {
             camera: None,
             camera_from_world: None,
             resolution: (1280, 720),
-            render: Table::new(),
+            render: None,
             g: Graphics {
                 ctm: DMat4::IDENTITY,
                 material: None,
@@ -179,7 +187,7 @@ impl Conv {
     }
 
     /// After the last file: the open definition is an error, the instances become
-    /// shapes, and the camera and tables are put together.
+    /// shapes, and the camera and the scene are put together.
     fn finish(mut self, path: &Path) -> Result<Converted, Diagnostic> {
         if let Some(o) = &self.object {
             return Err(self.diag(
@@ -193,19 +201,18 @@ impl Conv {
         }
         let shapes = self.instantiate()?;
         self.finish_camera(path)?;
-        let mut t = scene_table(
-            self.camera.take().expect("finish_camera sets it"),
-            std::mem::take(&mut self.render),
-            self.background.take(),
-            std::mem::take(&mut self.materials),
+        let scene = SceneFile {
+            background: self.background.take(),
+            camera: self.camera.take().expect("finish_camera sets it"),
+            render: self.render.take(),
+            materials: std::mem::take(&mut self.materials),
             shapes,
-            std::mem::take(&mut self.lights),
-        );
-        if let Some(e) = self.environment.take() {
-            t.insert("environment".into(), e);
-        }
+            lights: std::mem::take(&mut self.lights),
+            sky: None,
+            environment: self.environment.take(),
+        };
         Ok(Converted {
-            table: t,
+            scene,
             warnings: self.warnings,
         })
     }
@@ -216,13 +223,13 @@ impl Conv {
     /// shapes' own `renderFromObject`). An unknown name is an error at the instance, as
     /// in pbrt-v4's `CreateAggregate` ("object instance not defined"); an empty object
     /// gives nothing.
-    fn instantiate(&mut self) -> Result<Vec<Value>, Diagnostic> {
+    fn instantiate(&mut self) -> Result<Vec<ShapeFile>, Diagnostic> {
         let slots = std::mem::take(&mut self.shapes);
         let objects = std::mem::take(&mut self.objects);
         let mut out = Vec::with_capacity(slots.len());
         for slot in slots {
             match slot {
-                Slot::Shape(v) => out.push(v),
+                Slot::Shape(v) => out.push(*v),
                 Slot::Instance {
                     name,
                     ctm,
@@ -246,11 +253,12 @@ impl Conv {
     }
 }
 
-fn s(v: &str) -> Value {
-    Value::String(v.to_string())
-}
-
 impl Conv {
+    /// The `[render]` table, made on first use.
+    fn render(&mut self) -> &mut RenderFile {
+        self.render.get_or_insert_with(RenderFile::default)
+    }
+
     fn diag(&self, file: &Path, line: u32, m: impl Into<String>) -> Diagnostic {
         Diagnostic {
             file: file.to_path_buf(),
@@ -285,22 +293,25 @@ fn v3(n: &[f64]) -> DVec3 {
     }
 }
 
-fn scaled(v: Value, k: f64) -> Value {
+/// A light's colour times its `scale` parameter, the products tidied ([`tidy`]).
+fn scaled(c: ColourValue, k: f64) -> ColourValue {
     if k == 1.0 {
-        return v;
+        return c;
     }
-    match v {
-        Value::Table(mut t) => {
-            let s0 = t.get("scale").and_then(Value::as_float).unwrap_or(1.0);
-            t.insert("scale".into(), float(s0 * k));
-            Value::Table(t)
-        }
-        Value::Float(x) => float(x * k),
-        Value::Array(a) => Value::Array(
-            a.into_iter()
-                .map(|x| float(x.as_float().unwrap_or(0.0) * k))
-                .collect(),
-        ),
-        v => v,
+    match c {
+        ColourValue::Grey(x) => ColourValue::Grey(tidy(x * k)),
+        ColourValue::Rgb(rgb) => ColourValue::Rgb(rgb.map(|x| tidy(x * k))),
+        ColourValue::Samples { samples, scale } => ColourValue::Samples {
+            samples,
+            scale: tidy(scale * k),
+        },
+        ColourValue::Blackbody { kelvin, scale } => ColourValue::Blackbody {
+            kelvin,
+            scale: tidy(scale * k),
+        },
+        ColourValue::Named { spectrum, scale } => ColourValue::Named {
+            spectrum,
+            scale: tidy(scale * k),
+        },
     }
 }

@@ -3,6 +3,10 @@
 //! with its matrix.
 use super::tokens::Params;
 use super::*;
+use crate::scene::file::{
+    ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec, LambertianFile,
+    MetalSpec, PointLightFile, SpotLightFile, UnitNumber,
+};
 
 impl Conv {
     /// A reflectance parameter ([`Self::colour_as`] for a reflectance).
@@ -12,7 +16,7 @@ impl Conv {
         p: &Params,
         name: &str,
         default: f64,
-    ) -> Result<Value, Diagnostic> {
+    ) -> Result<ColourValue, Diagnostic> {
         self.colour_as(path, p, name, default, false)
     }
 
@@ -23,7 +27,7 @@ impl Conv {
         p: &Params,
         name: &str,
         default: f64,
-    ) -> Result<Value, Diagnostic> {
+    ) -> Result<ColourValue, Diagnostic> {
         self.colour_as(path, p, name, default, true)
     }
 
@@ -41,10 +45,10 @@ impl Conv {
         name: &str,
         default: f64,
         emission: bool,
-    ) -> Result<Value, Diagnostic> {
-        use crate::scene::import::props::{mitsuba_samples, read_spd, ColourValue};
+    ) -> Result<ColourValue, Diagnostic> {
+        use crate::scene::import::props::{mitsuba_samples, read_spd};
         let Some(q) = p.get(name) else {
-            return Ok(float(default));
+            return Ok(ColourValue::Grey(tidy(default)));
         };
         let bad =
             |this: &Self, m: String| this.diag(path, q.line, format!("\"{} {name}\": {m}", q.ty));
@@ -66,11 +70,11 @@ impl Conv {
             } else {
                 1.0
             };
-            ColourValue::Samples { samples, scale }.to_toml()
+            ColourValue::Samples { samples, scale }
         };
         match (q.ty.as_str(), q.nums.as_slice(), q.strs.as_slice()) {
-            ("rgb", [r, g, b], _) => Ok(Value::Array(vec![float(*r), float(*g), float(*b)])),
-            ("spectrum" | "float", [v], []) => Ok(float(*v)),
+            ("rgb", [r, g, b], _) => Ok(ColourValue::Rgb([tidy(*r), tidy(*g), tidy(*b)])),
+            ("spectrum" | "float", [v], []) => Ok(ColourValue::Grey(tidy(*v))),
             ("blackbody", [k], _) => {
                 if !emission {
                     return Err(bad(self, "a blackbody is an emission spectrum".into()));
@@ -79,7 +83,7 @@ impl Conv {
                 if !(lo..=hi).contains(k) {
                     return Err(bad(self, format!("expected kelvin within [{lo}, {hi}], got {k}")));
                 }
-                Ok(ColourValue::Blackbody { kelvin: *k, scale: 1.0 }.to_toml())
+                Ok(ColourValue::Blackbody { kelvin: *k, scale: 1.0 })
             }
             ("spectrum", nums, []) if nums.len() >= 4 && nums.len() % 2 == 0 => {
                 let pairs: Vec<(f64, f64)> = nums.chunks(2).map(|c| (c[0], c[1])).collect();
@@ -89,15 +93,13 @@ impl Conv {
                 Ok(table_colour(pairs))
             }
             ("spectrum", [], [n]) if n == "stdillum-D65" || n == "stdillum-A" => {
-                let name = if n == "stdillum-A" { "A" } else { "D65" };
-                let mut t = Table::new();
-                t.insert("spectrum".into(), Value::String(name.into()));
+                let spectrum = if n == "stdillum-A" { "A" } else { "D65" };
                 if !emission {
                     // A reflectance must stay within [0, 1]: the named illuminants are
                     // scaled to luminance 1, so only as lights.
                     return Err(bad(self, "a named illuminant is an emission spectrum".into()));
                 }
-                Ok(Value::Table(t))
+                Ok(ColourValue::Named { spectrum, scale: 1.0 })
             }
             ("spectrum", [], [f]) if !f.starts_with("metal-") && !f.starts_with("glass-") && !f.contains("illum") && !f.starts_with("canon") && !f.starts_with("nikon") && !f.starts_with("sony") => {
                 let full = self.base_of(path).join(f);
@@ -106,7 +108,7 @@ impl Conv {
             }
             ("spectrum", _, _) | ("texture", _, _) => {
                 self.warn(self.diag(path, q.line, format!("\"{} {name}\": this named spectrum or texture is not supported yet (rgb, blackbody, λ value pairs, .spd files, stdillum-D65 and stdillum-A are); {default} is used", q.ty)))?;
-                Ok(float(default))
+                Ok(ColourValue::Grey(tidy(default)))
             }
             _ => Err(self.diag(
                 path,
@@ -117,6 +119,13 @@ impl Conv {
                 ),
             )),
         }
+    }
+
+    /// A microfacet material's roughness: [`Self::alpha`] when above 0, at most 1.
+    fn roughness(&mut self, p: &Params) -> Option<UnitNumber> {
+        self.alpha(p)
+            .filter(|a| *a > 0.0)
+            .map(|a| schema::unit(a.min(1.0)))
     }
 
     pub(super) fn alpha(&mut self, p: &Params) -> Option<f64> {
@@ -141,10 +150,7 @@ impl Conv {
         name: Option<&str>,
     ) -> Result<String, Diagnostic> {
         let t = match ty {
-            "diffuse" => table(vec![
-                ("type", s("lambertian")),
-                ("rho_d", self.colour(path, p, "reflectance", 0.5)?),
-            ]),
+            "diffuse" => lambertian(self.colour(path, p, "reflectance", 0.5)?),
             "dielectric" | "thindielectric" => {
                 if ty == "thindielectric" {
                     self.warn(self.diag(
@@ -153,38 +159,39 @@ impl Conv {
                         "thindielectric is not supported yet; rendered as a solid dielectric",
                     ))?;
                 }
+                let named = |n: &str| IorSpec::Named(n.into());
                 let ior = match p.get("eta") {
-                    None => float(1.5),
+                    None => IorSpec::Constant(tidy(1.5)),
                     Some(q) => match (q.ty.as_str(), q.nums.first(), q.strs.first()) {
-                        (_, Some(v), _) => float(*v),
+                        (_, Some(v), _) => IorSpec::Constant(tidy(*v)),
                         ("spectrum", None, Some(n)) => match n.as_str() {
-                            "glass-BK7" => s("N-BK7"),
-                            "glass-F11" | "glass-SF11" => s("N-SF11"),
-                            "fused silica" | "glass-fused-silica" => s("fused-silica"),
+                            "glass-BK7" => named("N-BK7"),
+                            "glass-F11" | "glass-SF11" => named("N-SF11"),
+                            "fused silica" | "glass-fused-silica" => named("fused-silica"),
                             other => return Err(self.diag(path, q.line, format!("\"spectrum eta\": expected a number or one of glass-BK7, glass-F11 (heron's N-SF11), got {other:?}"))),
                         },
                         _ => return Err(self.diag(path, q.line, "\"eta\": expected a number or a named spectrum")),
                     },
                 };
-                let mut t = table(vec![("type", s("dielectric")), ("ior", ior)]);
-                if let Some(a) = self.alpha(p) {
-                    if a > 0.0 {
-                        t.insert("roughness".into(), float(a.min(1.0)));
-                    }
-                }
+                let roughness = self.roughness(p);
                 p.get("remaproughness");
-                t
+                MaterialFile::Dielectric(DielectricFile {
+                    ior,
+                    fresnel: None,
+                    roughness,
+                    outside_ior: None,
+                })
             }
             "conductor" => {
                 let metal = match (p.get("eta"), p.get("k"), p.get("reflectance")) {
-                    (None, None, None) => s("Cu"),
+                    (None, None, None) => MetalSpec::Named("Cu".into()),
                     (Some(e), Some(k), _) => match (e.nums.first(), k.nums.first(), e.strs.first(), k.strs.first()) {
-                        (Some(n), Some(kk), _, _) => Value::Table(table(vec![("n", float(*n)), ("k", float(*kk))])),
+                        (Some(n), Some(kk), _, _) => MetalSpec::Constant { n: tidy(*n), k: tidy(*kk) },
                         (_, _, Some(a), Some(b)) => {
                             let m = a.strip_prefix("metal-").and_then(|x| x.strip_suffix("-eta"));
                             let m2 = b.strip_prefix("metal-").and_then(|x| x.strip_suffix("-k"));
                             match (m, m2) {
-                                (Some(m), Some(m2)) if m == m2 && ["Ag", "Al", "Au", "Cu"].contains(&m) => s(m),
+                                (Some(m), Some(m2)) if m == m2 && ["Ag", "Al", "Au", "Cu"].contains(&m) => MetalSpec::Named(m.into()),
                                 _ => return Err(self.diag(path, e.line, format!("conductor: expected metal-Ag/Al/Au/Cu-eta and -k spectra or numbers, got {a:?} and {b:?}"))),
                             }
                         }
@@ -193,14 +200,9 @@ impl Conv {
                     (_, _, Some(q)) => return Err(self.diag(path, q.line, "conductor: \"reflectance\" (an artist's colour) is not supported; give eta and k")),
                     (Some(q), None, _) | (None, Some(q), _) => return Err(self.diag(path, q.line, "conductor: expected both eta and k")),
                 };
-                let mut t = table(vec![("type", s("conductor")), ("metal", metal)]);
-                if let Some(a) = self.alpha(p) {
-                    if a > 0.0 {
-                        t.insert("roughness".into(), float(a.min(1.0)));
-                    }
-                }
+                let roughness = self.roughness(p);
                 p.get("remaproughness");
-                t
+                MaterialFile::Conductor(ConductorFile { metal, roughness })
             }
             "coateddiffuse" => {
                 let rho = self.colour(path, p, "reflectance", 0.5)?;
@@ -211,12 +213,13 @@ impl Conv {
                 p.get("remaproughness");
                 p.get("thickness");
                 self.warn(self.diag(path, line, format!("coateddiffuse is mapped to heron's glossy (modified Phong): ρd = reflectance, ρs = {f0:.4} (Fresnel at normal incidence), shininess {shininess:.0}")))?;
-                table(vec![
-                    ("type", s("glossy")),
-                    ("rho_d", rho),
-                    ("rho_s", float(f0)),
-                    ("shininess", float(shininess)),
-                ])
+                MaterialFile::Glossy(GlossyFile {
+                    rho_d: rho.reflectance(),
+                    rho_s: schema::unit(f0),
+                    shininess: schema::positive(shininess),
+                    ior: None,
+                    fresnel: None,
+                })
             }
             other => {
                 for q in &p.0 {
@@ -233,7 +236,7 @@ impl Conv {
             Some(n) => n.to_string(),
             None => format!("{ty}-{}", self.n_material),
         };
-        self.materials.insert(key.clone(), Value::Table(t));
+        self.materials.insert(key.clone(), t);
         Ok(key)
     }
 
@@ -242,13 +245,8 @@ impl Conv {
             return m.clone();
         }
         let k = "pbrt-default-diffuse".to_string();
-        self.materials.insert(
-            k.clone(),
-            Value::Table(table(vec![
-                ("type", s("lambertian")),
-                ("rho_d", float(0.5)),
-            ])),
-        );
+        self.materials
+            .insert(k.clone(), lambertian(ColourValue::Grey(tidy(0.5))));
         self.default_material = Some(k.clone());
         k
     }
@@ -266,11 +264,11 @@ impl Conv {
             "point" => {
                 let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
                 let i = self.emission(path, p, "I", 1.0)?;
-                self.lights.push(Value::Table(table(vec![
-                    ("type", s("point")),
-                    ("position", vec3(m.transform_point3(from))),
-                    ("intensity", scaled(i, scale)),
-                ])));
+                self.lights.push(LightFile::Point(PointLightFile {
+                    position: schema::point(m.transform_point3(from)),
+                    intensity: scaled(i, scale).emission(),
+                    polarization: None,
+                }));
             }
             "spot" => {
                 let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
@@ -278,28 +276,29 @@ impl Conv {
                 let i = self.emission(path, p, "I", 1.0)?;
                 let cone = p.float("coneangle").unwrap_or(30.0);
                 let delta = p.float("conedelta").unwrap_or(5.0);
-                self.lights.push(Value::Table(table(vec![
-                    ("type", s("spot")),
-                    ("position", vec3(m.transform_point3(from))),
-                    ("direction", vec3(m.transform_vector3(to - from))),
-                    ("intensity", scaled(i, scale)),
-                    ("cone_angle", float(cone)),
-                    ("cone_delta", float(delta)),
-                ])));
+                self.lights.push(LightFile::Spot(SpotLightFile {
+                    position: schema::point(m.transform_point3(from)),
+                    direction: schema::direction(m.transform_vector3(to - from)),
+                    intensity: scaled(i, scale).emission(),
+                    cone_angle: Some(schema::positive(cone)),
+                    cone_delta: Some(schema::non_negative(delta)),
+                    polarization: None,
+                }));
             }
             "distant" => {
                 let from = p.get("from").map_or(DVec3::ZERO, |q| v3(&q.nums));
                 let to = p.get("to").map_or(DVec3::Z, |q| v3(&q.nums));
                 let l = self.emission(path, p, "L", 1.0)?;
-                self.lights.push(Value::Table(table(vec![
-                    ("type", s("directional")),
-                    ("direction", vec3(m.transform_vector3(to - from))),
-                    ("radiance", scaled(l, scale)),
-                ])));
+                self.lights
+                    .push(LightFile::Directional(DirectionalLightFile {
+                        direction: schema::direction(m.transform_vector3(to - from)),
+                        radiance: scaled(l, scale).emission(),
+                        polarization: None,
+                    }));
             }
             "infinite" if p.get("filename").is_none() => {
                 let l = self.emission(path, p, "L", 1.0)?;
-                self.background = Some(scaled(l, scale));
+                self.background = Some(scaled(l, scale).emission());
             }
             "infinite" => {
                 // pbrt-v4's ImageInfiniteLight: a square image on the equal-area
@@ -327,22 +326,13 @@ impl Conv {
                 let lin = glam::DMat3::from_mat4(m);
                 let s3 = lin.determinant().abs().cbrt();
                 let lin = if s3 > 0.0 { lin * (1.0 / s3) } else { lin };
-                let mut rows = Vec::new();
-                for r in 0..3 {
-                    let row = lin.row(r);
-                    rows.push(crate::scene::import::mitsuba::vec_row([
-                        row.x, row.y, row.z, 0.0,
-                    ]));
-                }
-                rows.push(crate::scene::import::mitsuba::vec_row([0.0, 0.0, 0.0, 1.0]));
-                let mut t = table(vec![
-                    ("map", s(&rel.to_string_lossy().replace('\\', "/"))),
-                    ("mapping", s("equal-area")),
-                    ("scale", float(scale)),
-                ]);
-                if lin != glam::DMat3::IDENTITY {
-                    t.insert("transform".into(), Value::Array(rows));
-                }
+                let t = EnvironmentFile {
+                    map: rel.to_string_lossy().replace('\\', "/"),
+                    mapping: Some("equal-area".into()),
+                    scale: Some(schema::non_negative(scale)),
+                    transform: (lin != glam::DMat3::IDENTITY)
+                        .then(|| schema::rows(DMat4::from_mat3(lin))),
+                };
                 if self.environment.is_some() || self.background.is_some() {
                     self.warn(self.diag(
                         path,
@@ -350,7 +340,7 @@ impl Conv {
                         "a second infinite light; heron's environment is the first, ignored",
                     ))?;
                 } else {
-                    self.environment = Some(Value::Table(t));
+                    self.environment = Some(t);
                 }
             }
             other => {
@@ -405,7 +395,7 @@ impl Conv {
             Some(o) => o.shapes.push(sd),
             None => {
                 for v in self.emit(&sd, None)? {
-                    self.shapes.push(Slot::Shape(v));
+                    self.shapes.push(Slot::Shape(Box::new(v)));
                 }
             }
         }
@@ -534,7 +524,7 @@ impl Conv {
         &mut self,
         sd: &ShapeDef,
         inst: Option<(&str, DMat4, &Path, u32)>,
-    ) -> Result<Vec<Value>, Diagnostic> {
+    ) -> Result<Vec<ShapeFile>, Diagnostic> {
         let m = match inst {
             Some((_, ctm, _, _)) => ctm * sd.ctm,
             None => sd.ctm,
@@ -553,7 +543,7 @@ impl Conv {
             None => (sd.file.clone(), sd.line, String::new()),
         };
         let flip = sd.reverse ^ (m.determinant() < 0.0);
-        let mut entries: Vec<Table> = Vec::new();
+        let mut entries: Vec<ShapeFile> = Vec::new();
         match &sd.geom {
             Geom::Sphere { radius } => {
                 let m3 = glam::DMat3::from_mat4(m);
@@ -565,11 +555,10 @@ impl Conv {
                         format!("{ctx}Shape \"sphere\": heron's spheres take a uniform scale only"),
                     ));
                 }
-                entries.push(table(vec![
-                    ("type", s("sphere")),
-                    ("center", vec3(m.transform_point3(DVec3::ZERO))),
-                    ("radius", float(radius * sc[0])),
-                ]));
+                entries.push(schema::sphere(
+                    m.transform_point3(DVec3::ZERO),
+                    radius * sc[0],
+                ));
             }
             Geom::Mesh {
                 kind,
@@ -585,12 +574,7 @@ impl Conv {
                         let scale = (a - o).length().max((b - o).length());
                         if (c - (a + b - o)).length() <= 1e-9 * scale {
                             let (e1, e2) = if flip { (b - o, a - o) } else { (a - o, b - o) };
-                            entries.push(table(vec![
-                                ("type", s("quad")),
-                                ("origin", vec3(o)),
-                                ("edge1", vec3(e1)),
-                                ("edge2", vec3(e2)),
-                            ]));
+                            entries.push(schema::quad(o, e1, e2));
                             continue;
                         }
                     }
@@ -602,13 +586,7 @@ impl Conv {
                     };
                     for t in tris {
                         let t = if flip { [t[0], t[2], t[1]] } else { t };
-                        entries.push(table(vec![
-                            ("type", s("triangle")),
-                            (
-                                "vertices",
-                                Value::Array(t.iter().map(|&k| vec3(verts[k])).collect()),
-                            ),
-                        ]));
+                        entries.push(schema::triangle(t.map(|k| verts[k])));
                     }
                 }
             }
@@ -616,35 +594,19 @@ impl Conv {
                 if flip {
                     self.warn(self.diag(&file, line, format!("{ctx}Shape \"plymesh\": ReverseOrientation or a mirroring transform on a mesh is not supported, ignored")))?;
                 }
-                let mut t = table(vec![("type", s("mesh")), ("file", s(f))]);
-                if m != DMat4::IDENTITY {
-                    t.insert(
-                        "transform".into(),
-                        Value::Array(
-                            (0..4)
-                                .map(|r| {
-                                    Value::Array(
-                                        m.row(r).to_array().iter().map(|x| float(*x)).collect(),
-                                    )
-                                })
-                                .collect(),
-                        ),
-                    );
-                }
-                entries.push(t);
+                entries.push(schema::mesh(f.clone(), m, None));
             }
         }
         Ok(entries
             .into_iter()
             .map(|mut e| {
-                e.insert("material".into(), s(&sd.material));
+                let (material, emission, two_sided) = e.surface_mut();
+                *material = Some(sd.material.clone());
                 if let Some((l, two)) = &sd.area {
-                    e.insert("emission".into(), l.clone());
-                    if *two {
-                        e.insert("two_sided".into(), Value::Boolean(true));
-                    }
+                    *emission = Some(l.clone());
+                    *two_sided = two.then_some(true);
                 }
-                Value::Table(e)
+                e
             })
             .collect())
     }
@@ -667,16 +629,15 @@ impl Conv {
         // pbrt's fov spans the shorter image axis.
         let t = (0.5 * fov.to_radians()).tan();
         let tan_y = if aspect >= 1.0 { t } else { t / aspect };
-        self.camera = Some(table(vec![
-            ("eye", vec3(eye)),
-            ("look_at", vec3(look)),
-            ("up", vec3(up)),
-            ("d", float(0.5 / tan_y)),
-            (
-                "resolution",
-                Value::Array(vec![Value::Integer(w), Value::Integer(h)]),
-            ),
-        ]));
+        self.camera = Some(schema::pinhole(eye, look, up, 0.5 / tan_y, (w, h)));
         Ok(())
     }
+}
+
+/// A diffuse material of reflectance `rho`.
+fn lambertian(rho: ColourValue) -> MaterialFile {
+    MaterialFile::Lambertian(LambertianFile {
+        rho_d: Some(rho.reflectance()),
+        texture: None,
+    })
 }

@@ -1,0 +1,140 @@
+//! The scene schema's values ([`crate::scene::file`]) as both converters build them from
+//! their f64 arithmetic: numbers tidied to 12 significant digits ([`tidy`]), the shapes
+//! and the pinhole camera the two formats share. The schema's leaves keep these f64
+//! numbers as they are (and heron reads them in f32), so `heron convert` writes the
+//! digits computed here; the ranges are checked when the scene is read, as a file's.
+use crate::scene::file::{
+    CameraFile, Direction3, MeshFile, NonNegativeNumber, Point3, PositiveCount, PositiveNumber,
+    QuadFile, Resolution, ShapeFile, SphereFile, TriangleFile, UnitNumber,
+};
+use glam::{DMat4, DVec3};
+use std::collections::BTreeMap;
+
+/// `v` to 12 significant digits (far beyond f32's 7), so that a rotation by 90° writes
+/// 0 and 1 rather than 6e-17 and 0.9999999999999999.
+pub fn tidy(v: f64) -> f64 {
+    if v.abs() < 1e-12 {
+        return 0.0;
+    }
+    format!("{v:.11e}").parse().unwrap_or(v)
+}
+
+pub fn point(v: DVec3) -> Point3 {
+    Point3(v.to_array().map(tidy).into())
+}
+
+pub fn direction(v: DVec3) -> Direction3 {
+    Direction3(v.to_array().map(tidy).into())
+}
+
+pub fn positive(x: f64) -> PositiveNumber {
+    PositiveNumber(tidy(x))
+}
+
+pub fn unit(x: f64) -> UnitNumber {
+    UnitNumber(tidy(x))
+}
+
+pub fn non_negative(x: f64) -> NonNegativeNumber {
+    NonNegativeNumber(tidy(x))
+}
+
+/// An affine matrix as the schema's `transform` (rows).
+pub fn rows(m: DMat4) -> Vec<Vec<f64>> {
+    (0..4)
+        .map(|r| m.row(r).to_array().map(tidy).to_vec())
+        .collect()
+}
+
+/// A count x ≥ 0 as the schema's u32 (image sizes, samples, depths), or the message for
+/// one beyond it (a scene file's TOML integer could say it, the schema cannot).
+pub fn count(what: &str, x: i64) -> Result<u32, String> {
+    u32::try_from(x).map_err(|_| format!("{what}: expected at most {}, got {x}", u32::MAX))
+}
+
+/// A count ≥ 1 as the schema's [`PositiveCount`] (see [`count`]).
+pub fn positive_count(what: &str, x: i64) -> Result<PositiveCount, String> {
+    count(what, x).map(PositiveCount)
+}
+
+/// The pinhole camera both formats convert to: heron's image plane of height 1 at `d`.
+pub fn pinhole(
+    eye: DVec3,
+    look_at: DVec3,
+    up: DVec3,
+    d: f64,
+    (width, height): (u32, u32),
+) -> CameraFile {
+    CameraFile {
+        eye: point(eye),
+        look_at: point(look_at),
+        up: Some(direction(up)),
+        d: Some(positive(d)),
+        resolution: Resolution { width, height },
+        kind: None,
+        lens: None,
+        surface: None,
+        film_diagonal: None,
+        film_distance: None,
+        focus_distance: None,
+        focus_wavelength: None,
+        mm_per_unit: None,
+        f_number: None,
+        polarizer: None,
+        pupil: None,
+        film_offset: None,
+    }
+}
+
+// The shapes with no surface yet: the converters give each the surface of the element
+// it came from (`ShapeFile::surface_mut`).
+
+pub fn sphere(center: DVec3, radius: f64) -> ShapeFile {
+    ShapeFile::Sphere(SphereFile {
+        center: point(center),
+        radius: positive(radius),
+        material: None,
+        emission: None,
+        two_sided: None,
+        medium: None,
+    })
+}
+
+pub fn triangle(vertices: [DVec3; 3]) -> ShapeFile {
+    ShapeFile::Triangle(TriangleFile {
+        vertices: vertices.map(point),
+        material: None,
+        emission: None,
+        two_sided: None,
+        medium: None,
+    })
+}
+
+pub fn quad(origin: DVec3, edge1: DVec3, edge2: DVec3) -> ShapeFile {
+    ShapeFile::Quad(QuadFile {
+        origin: point(origin),
+        edge1: direction(edge1),
+        edge2: direction(edge2),
+        material: None,
+        emission: None,
+        two_sided: None,
+        medium: None,
+    })
+}
+
+/// A mesh file (relative to the scene's folder), placed by `transform` unless it is the
+/// identity.
+pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> ShapeFile {
+    ShapeFile::Mesh(MeshFile {
+        file,
+        material: None,
+        groups: BTreeMap::new(),
+        scale: None,
+        translate: None,
+        transform: (transform != DMat4::IDENTITY).then(|| rows(transform)),
+        flip_tex_coords,
+        emission: None,
+        two_sided: None,
+        medium: None,
+    })
+}
