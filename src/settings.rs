@@ -380,8 +380,8 @@ pub enum Packets {
     /// Packets of paths: the 8 paths of a packet advance together, their closest-hit
     /// rays go to Embree as 8-wide packets (camera rays in one, later rays in another)
     /// and their shadow rays as `rtcOccluded8` rounds, and a path that ends is replaced
-    /// by the tile's next sample (`whitted` and `path`). Light tracing and BDPT run one
-    /// path at a time and send each pixel sample's connection shadow rays 8 at a time.
+    /// by the tile's next sample (`whitted` and `path`; the others, and polarised
+    /// renders, run camera packets instead, or none under light tracing).
     Paths,
 }
 

@@ -42,8 +42,8 @@ pub(crate) struct RenderArgs {
     /// (camera rays in packets, every later ray alone: the one-path-at-a-time engine) or
     /// off (every ray alone). They agree up to the last bits of Embree's hits. Default
     /// auto: paths under whitted, camera otherwise (off under lighttrace, which traces
-    /// no camera rays): the faster here (BENCHMARKS.md). Under lighttrace and bdpt,
-    /// paths sends each sample's connection shadow rays 8 at a time.
+    /// no camera rays): the faster here (BENCHMARKS.md). Under lighttrace, bdpt and sppm
+    /// (and polarised renders), paths runs camera packets (none under lighttrace).
     #[arg(long, value_name = "HOW")]
     packets: Option<String>,
     /// Every ray alone: the same as --packets off.

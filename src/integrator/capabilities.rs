@@ -34,8 +34,8 @@ pub struct Capabilities {
     /// Whether it starts from the pixel sample's camera ray (so camera packets help).
     pub camera_rays: bool,
     /// Whether the packet engine can advance its paths step by step
-    /// ([`super::StepIntegrator`]); `--packets paths` otherwise batches what it can
-    /// (light tracing's and BDPT's connection shadow rays).
+    /// ([`super::StepIntegrator`]); without, `--packets paths` runs camera packets (or
+    /// none, without camera rays).
     pub steps: bool,
     /// Whether it adds to other pixels than the one it samples (splat planes and
     /// buffers; the pass size).
@@ -130,9 +130,9 @@ pub fn check_variance(kind: IntegratorKind, variance: bool) -> Result<(), String
 
 /// The packets a render with integrator `kind` runs for the setting `p`: `auto`
 /// resolved to the integrator's choice, camera packets only for an integrator that
-/// traces camera rays, none for one without packets. Polarised transport (`polarized`)
-/// runs no packet-engine steps, whose throughputs are scalar: camera packets instead
-/// (light tracing's and BDPT's connections carry Stokes vectors in their packets).
+/// traces camera rays, none for one without packets; packets of paths only for an
+/// integrator with steps, and not for polarised transport (`polarized`), since the
+/// packet engine's throughputs are scalar: camera packets instead (or none).
 pub fn packets(kind: IntegratorKind, p: Packets, polarized: bool) -> Packets {
     let caps = capabilities(kind);
     let p = match p {
@@ -142,7 +142,13 @@ pub fn packets(kind: IntegratorKind, p: Packets, polarized: bool) -> Packets {
     };
     match p {
         Packets::Camera if !caps.camera_rays => Packets::Off,
-        Packets::Paths if polarized && caps.steps => Packets::Camera,
+        Packets::Paths if polarized || !caps.steps => {
+            if caps.camera_rays {
+                Packets::Camera
+            } else {
+                Packets::Off
+            }
+        }
         p => p,
     }
 }

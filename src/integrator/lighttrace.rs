@@ -20,7 +20,7 @@
 //! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
 //! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
 use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE};
-use super::toolkit::{next_hit, pixel_of, roulette, Connection, Connections, LightPathStart};
+use super::toolkit::{next_hit, pixel_of, roulette, unoccluded, Connection, LightPathStart};
 use super::transport::{LightEvent, Transport};
 use super::{Context, Integrator, PixelIntegrator, TraceCounters};
 use crate::accel::embree::Hit;
@@ -33,143 +33,6 @@ use crate::sampler::Sampler;
 use crate::settings::{KernelFlags, Packets};
 use crate::spectrum::SampledWavelengths;
 
-/// Traces one light path and splats its connections to the camera; returns nothing for
-/// the pixel sample's own pixel. What the light path carries besides its scalar
-/// throughput is the transport `T`'s: nothing ([`Unpolarized`](super::transport::Unpolarized)),
-/// or its Stokes vector (`integrator::polarized`), whose connections splat Stokes
-/// radiance. Both trace the same paths with the same random numbers.
-pub(crate) fn radiance<const N: usize, T: Transport<N>>(
-    ctx: &Context,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> T::Value {
-    let scene = ctx.scene;
-    let cam = &scene.camera;
-    let settings = ctx.settings;
-    let Some(start) = LightPathStart::sample(ctx, wl, sampler) else {
-        return T::Value::zero();
-    };
-    let (le, pmf) = (&start.le, start.pmf);
-    // Rays leave a light's surface as they leave any surface; other lights' origins are
-    // in free space.
-    let light_point = le.spawn_point();
-    let eye = SpawnPoint::free(cam.eye);
-
-    // The connections to the camera, their shadow rays traced one by one or, with
-    // `--packets paths`, 8 at a time.
-    let mut conns = Connections::<N, T::Value>::new(settings.packets == Packets::Paths);
-    let mut own = T::Value::zero();
-    // The splat of a connection from `from` along `cs`, unless its shadow ray is blocked.
-    let connect = |conns: &Connections<N, T::Value>,
-                   from: &SpawnPoint,
-                   cs: &CameraWiSample,
-                   c: T::Value,
-                   counters: &mut TraceCounters| {
-        let q = ctx.offset.shadow(from, cs.wi, cs.dist, &eye);
-        let shadow = match conns.visible(ctx, q, counters) {
-            Some(false) => return None,
-            Some(true) => None,
-            None => q,
-        };
-        Some(Connection {
-            c,
-            splat: Some(pixel_of(cam, cs.raster)),
-            shadow,
-        })
-    };
-
-    // An emitting surface seen by the camera: the light's own vertex.
-    if let Some(n) = le.normal {
-        if let Some(cs) = cam.sample_wi(le.origin) {
-            let emitted = scene.lights[start.index].l(n, cs.wi, wl);
-            if !emitted.is_zero() {
-                let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
-                let beam = T::emitted(ctx, start.index, cs.wi, wl);
-                let c = T::seen(&beam, ctx, None, cs.wi, emitted * k, wl);
-                if let Some(c) = connect(&conns, &light_point, &cs, c, counters) {
-                    conns.push(ctx, c, (&mut own, splats), wl, counters);
-                }
-            }
-        }
-    }
-
-    let mut beta = start.beta();
-    let mut carried = T::emitted(ctx, start.index, le.dir, wl);
-    // The light path's throughput carries the light's flux, whose size depends on the
-    // scene's units (an area light's flux scales with its area); the roulette compares
-    // the throughput with where it started, so that a scene scaled by 1e-4 is not
-    // cut short (tests/stability.rs).
-    let beta_start = beta.max_value();
-    let mut ray = ctx.offset.spawn(&light_point, le.dir);
-    let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(TransportMode::Importance);
-    let mut depth = 0u32;
-    while let Some(hit) = next_hit(ctx, &ray, &mut None, counters) {
-        let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
-        bsdf_ctx.uv = it.uv;
-        // The path has scattered `depth` times before this vertex; scattering here
-        // toward the camera is one more.
-        if depth == settings.max_depth {
-            break;
-        }
-        depth += 1;
-        let u_lobe = sampler.get_1d();
-        let u_bsdf = sampler.get_2d();
-        let u_rr = sampler.get_1d();
-        let frame = it.frame();
-        let wo = frame.to_local(-ray.dir);
-        let flags = material.flags();
-        if flags.has_non_specular() {
-            if let Some(cs) = cam.sample_wi(it.position) {
-                let wi = frame.to_local(cs.wi);
-                let f = material.eval(wo, wi, wl, &bsdf_ctx).f;
-                if !f.is_zero() {
-                    let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
-                    let at = LightEvent {
-                        material,
-                        frame: &frame,
-                        to_local: wi,
-                        from_local: wo,
-                    };
-                    let c = T::seen(&carried, ctx, Some(&at), cs.wi, c, wl);
-                    if let Some(c) = connect(&conns, &it.spawn_point(), &cs, c, counters) {
-                        conns.push(ctx, c, (&mut own, splats), wl, counters);
-                    }
-                }
-            }
-        }
-        if depth == settings.max_depth {
-            break;
-        }
-        let Some(bs) = material.sample(wo, u_lobe, u_bsdf, wl, &bsdf_ctx) else {
-            break;
-        };
-        beta *= bs.weight();
-        let at = LightEvent {
-            material,
-            frame: &frame,
-            to_local: bs.wi,
-            from_local: wo,
-        };
-        T::light_scattered(&mut carried, &at, bs.flags, wl);
-        if bs.ended_companions {
-            bsdf_ctx.companions_alive = false;
-        }
-        if beta.is_zero() {
-            break;
-        }
-        ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
-        // Russian roulette on the importance throughput, relative to the light's.
-        let rr = beta.max_value() / beta_start;
-        if !roulette(&mut beta, rr, depth, settings.rr_depth, u_rr) {
-            break;
-        }
-    }
-    conns.flush(ctx, (&mut own, splats), wl, counters);
-    T::Value::zero()
-}
-
 /// Light tracing.
 pub struct LightTracer;
 
@@ -180,7 +43,7 @@ impl Integrator for LightTracer {
         polarization: Support::Yes,
         variance: Support::Yes,
         packets: true,
-        // It traces no camera rays; `paths` batches its connections' shadow rays.
+        // It traces no camera rays, and has no steps for packets of paths.
         auto_packets: Packets::Off,
         camera_rays: false,
         steps: false,
@@ -190,6 +53,11 @@ impl Integrator for LightTracer {
 }
 
 impl PixelIntegrator for LightTracer {
+    /// Traces one light path and splats its connections to the camera; returns nothing for
+    /// the pixel sample's own pixel. What the light path carries besides its scalar
+    /// throughput is the transport `T`'s: nothing ([`Unpolarized`](super::transport::Unpolarized)),
+    /// or its Stokes vector (`integrator::polarized`), whose connections splat Stokes
+    /// radiance. Both trace the same paths with the same random numbers.
     fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
         ctx: &Context,
         _: CameraRay,
@@ -199,6 +67,116 @@ impl PixelIntegrator for LightTracer {
         counters: &mut TraceCounters,
         splats: &mut Splats,
     ) -> T::Value {
-        radiance::<N, T>(ctx, wl, sampler, counters, splats)
+        let scene = ctx.scene;
+        let cam = &scene.camera;
+        let settings = ctx.settings;
+        let Some(start) = LightPathStart::sample(ctx, wl, sampler) else {
+            return T::Value::zero();
+        };
+        let (le, pmf) = (&start.le, start.pmf);
+        // Rays leave a light's surface as they leave any surface; other lights' origins are
+        // in free space.
+        let light_point = le.spawn_point();
+        let eye = SpawnPoint::free(cam.eye);
+
+        // What the connections to the camera add to the pixel sample's own pixel: nothing.
+        let mut own = T::Value::zero();
+        // The splat of a connection from `from` along `cs`, unless its shadow ray is blocked.
+        let connect =
+            |from: &SpawnPoint, cs: &CameraWiSample, c: T::Value, counters: &mut TraceCounters| {
+                let q = ctx.offset.shadow(from, cs.wi, cs.dist, &eye);
+                unoccluded(ctx, q, counters).then(|| Connection {
+                    c,
+                    splat: Some(pixel_of(cam, cs.raster)),
+                })
+            };
+
+        // An emitting surface seen by the camera: the light's own vertex.
+        if let Some(n) = le.normal {
+            if let Some(cs) = cam.sample_wi(le.origin) {
+                let emitted = scene.lights[start.index].l(n, cs.wi, wl);
+                if !emitted.is_zero() {
+                    let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
+                    let beam = T::emitted(ctx, start.index, cs.wi, wl);
+                    let c = T::seen(&beam, ctx, None, cs.wi, emitted * k, wl);
+                    if let Some(c) = connect(&light_point, &cs, c, counters) {
+                        c.add(&mut own, splats, wl);
+                    }
+                }
+            }
+        }
+
+        let mut beta = start.beta();
+        let mut carried = T::emitted(ctx, start.index, le.dir, wl);
+        // The light path's throughput carries the light's flux, whose size depends on the
+        // scene's units (an area light's flux scales with its area); the roulette compares
+        // the throughput with where it started, so that a scene scaled by 1e-4 is not
+        // cut short (tests/stability.rs).
+        let beta_start = beta.max_value();
+        let mut ray = ctx.offset.spawn(&light_point, le.dir);
+        let mut bsdf_ctx = BsdfContext::radiance::<N>().with_mode(TransportMode::Importance);
+        let mut depth = 0u32;
+        while let Some(hit) = next_hit(ctx, &ray, &mut None, counters) {
+            let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
+            bsdf_ctx.uv = it.uv;
+            // The path has scattered `depth` times before this vertex; scattering here
+            // toward the camera is one more.
+            if depth == settings.max_depth {
+                break;
+            }
+            depth += 1;
+            let u_lobe = sampler.get_1d();
+            let u_bsdf = sampler.get_2d();
+            let u_rr = sampler.get_1d();
+            let frame = it.frame();
+            let wo = frame.to_local(-ray.dir);
+            let flags = material.flags();
+            if flags.has_non_specular() {
+                if let Some(cs) = cam.sample_wi(it.position) {
+                    let wi = frame.to_local(cs.wi);
+                    let f = material.eval(wo, wi, wl, &bsdf_ctx).f;
+                    if !f.is_zero() {
+                        let c = beta * f * (wi.z.abs() * cs.we / cs.pdf);
+                        let at = LightEvent {
+                            material,
+                            frame: &frame,
+                            to_local: wi,
+                            from_local: wo,
+                        };
+                        let c = T::seen(&carried, ctx, Some(&at), cs.wi, c, wl);
+                        if let Some(c) = connect(&it.spawn_point(), &cs, c, counters) {
+                            c.add(&mut own, splats, wl);
+                        }
+                    }
+                }
+            }
+            if depth == settings.max_depth {
+                break;
+            }
+            let Some(bs) = material.sample(wo, u_lobe, u_bsdf, wl, &bsdf_ctx) else {
+                break;
+            };
+            beta *= bs.weight();
+            let at = LightEvent {
+                material,
+                frame: &frame,
+                to_local: bs.wi,
+                from_local: wo,
+            };
+            T::light_scattered(&mut carried, &at, bs.flags, wl);
+            if bs.ended_companions {
+                bsdf_ctx.companions_alive = false;
+            }
+            if beta.is_zero() {
+                break;
+            }
+            ray = ctx.offset.spawn(&it.spawn_point(), frame.to_world(bs.wi));
+            // Russian roulette on the importance throughput, relative to the light's.
+            let rr = beta.max_value() / beta_start;
+            if !roulette(&mut beta, rr, depth, settings.rr_depth, u_rr) {
+                break;
+            }
+        }
+        T::Value::zero()
     }
 }

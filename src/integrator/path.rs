@@ -96,112 +96,142 @@ use crate::settings::{on, KernelFlags, MediumNee, Packets, EMITTERS, ESCAPE, MED
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
 
-/// Radiance arriving along the camera ray `ray` at the wavelengths `wl`; for polarised
-/// transport `T`, the Stokes radiance in the camera's frame (`integrator::polarized`).
-///
-/// `K` is the kernel ([`KernelFlags`]): without `SHADOWS` there is no next-event
-/// estimation (the scene has no light to sample, or no surface to light), without
-/// `EMITTERS` no emission lookup at hits, without `ESCAPE` nothing along escaping rays.
-/// The random numbers read per bounce are the same in every kernel.
-pub(crate) fn radiance<const N: usize, const K: KernelFlags, T: Transport<N>>(
-    ctx: &Context,
-    cam: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-) -> T::Value {
-    let mut carry = T::at_camera(ctx, &cam);
-    let mut s = PathState::<N>::at_camera(&cam);
-    let mut t = Tracer {
-        ctx,
-        wl,
-        sampler,
-        counters,
-        shadows: &mut Immediate,
-        carry: &mut carry,
+/// The path tracer.
+pub struct PathTracer;
+
+impl Integrator for PathTracer {
+    const CAPABILITIES: Capabilities = Capabilities {
+        lens: Support::Yes,
+        media: true,
+        polarization: Support::Yes,
+        variance: Support::Yes,
+        packets: true,
+        auto_packets: Packets::Camera,
+        camera_rays: true,
+        steps: true,
+        splats: false,
+        kernel: Some(kernel_flags),
     };
-    follow(
-        &mut t,
-        cam.ray,
-        &mut s,
-        first_hit,
-        step::<N, K, Immediate, T>,
-    );
-    T::delivered(carry, s.l)
 }
 
-/// The path's state at the camera: what [`step`] starts from.
-#[inline]
-pub fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
-    PathState::at_camera(cam)
+/// The kernel flags the path tracer is specialised on: next-event estimation, emitters,
+/// escaping rays and media (`scene::features`).
+fn kernel_flags(f: &Features) -> KernelFlags {
+    let bit = |on: bool, flag: KernelFlags| if on { flag } else { 0 };
+    bit(f.nee, SHADOWS) | bit(f.emitters, EMITTERS) | bit(f.escape, ESCAPE) | bit(f.media, MEDIA)
 }
 
-/// One step of the path whose ray `ray` has the closest hit `hit`: the segment through a
-/// medium, a boundary crossed, the light found along an escaping ray, or a surface
-/// vertex; `ray` becomes the next ray. Returns false when the path has ended. Shadow
-/// rays go to the tracer's sink (the packet engine traces them after the step, before
-/// the next); every contribution and every scattering event goes to its transport
-/// (nothing more for unpolarised transport, the Mueller product for
-/// `integrator::polarized`).
-#[inline(always)]
-pub(crate) fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
-    t: &mut Tracer<N, S, T>,
-    s: &mut PathState<N>,
-    ray: &mut Ray,
-    hit: Option<Hit>,
-) -> bool {
-    let (ctx, wl) = (t.ctx, t.wl);
-    let scene = ctx.scene;
-    if on(K, MEDIA) && s.medium != NO_MEDIUM {
-        // A closed boundary always stops a ray inside; a ray that escapes it leaked.
-        let Some(h) = &hit else { return false };
-        match medium_segment::<N, K, S, T>(t, s, ray, h) {
-            Segment::Scattered => return true,
-            Segment::Ended => return false,
-            Segment::Crossed => {}
-        }
+impl PixelIntegrator for PathTracer {
+    /// Radiance arriving along the camera ray `ray` at the wavelengths `wl`; for polarised
+    /// transport `T`, the Stokes radiance in the camera's frame (`integrator::polarized`).
+    ///
+    /// `K` is the kernel ([`KernelFlags`]): without `SHADOWS` there is no next-event
+    /// estimation (the scene has no light to sample, or no surface to light), without
+    /// `EMITTERS` no emission lookup at hits, without `ESCAPE` nothing along escaping rays.
+    /// The random numbers read per bounce are the same in every kernel.
+    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        cam: CameraRay,
+        first_hit: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+        _: &mut Splats,
+    ) -> T::Value {
+        let mut carry = T::at_camera(ctx, &cam);
+        let mut s = PathState::<N>::at_camera(&cam);
+        let mut t = Tracer {
+            ctx,
+            wl,
+            sampler,
+            counters,
+            shadows: &mut Immediate,
+            carry: &mut carry,
+        };
+        follow(
+            &mut t,
+            cam.ray,
+            &mut s,
+            first_hit,
+            Self::step::<N, K, Immediate, T>,
+        );
+        T::delivered(carry, s.l)
     }
-    if on(K, MEDIA) {
-        if let Some(h) = &hit {
-            if scene.shapes[h.geom_id as usize].interface {
-                // An index-matched boundary: cross it, switching media, no bounce.
-                let (it, _) = scene.interaction(ray, h, ctx.offset.is_robust());
-                s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
-                    scene.shapes[h.geom_id as usize].medium
-                } else {
-                    NO_MEDIUM
-                };
-                s.crossings += 1;
-                if s.crossings > MAX_CROSSINGS {
-                    return false;
-                }
-                *ray = ctx.offset.spawn(&it.spawn_point(), ray.dir);
-                return true;
+}
+
+impl StepIntegrator for PathTracer {
+    /// The path's state at the camera: what [`StepIntegrator::step`] starts from.
+    #[inline]
+    fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
+        PathState::at_camera(cam)
+    }
+
+    /// One step of the path whose ray `ray` has the closest hit `hit`: the segment through a
+    /// medium, a boundary crossed, the light found along an escaping ray, or a surface
+    /// vertex; `ray` becomes the next ray. Returns false when the path has ended. Shadow
+    /// rays go to the tracer's sink (the packet engine traces them after the step, before
+    /// the next); every contribution and every scattering event goes to its transport
+    /// (nothing more for unpolarised transport, the Mueller product for
+    /// `integrator::polarized`).
+    #[inline(always)]
+    fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+        t: &mut Tracer<N, S, T>,
+        s: &mut PathState<N>,
+        ray: &mut Ray,
+        hit: Option<Hit>,
+    ) -> bool {
+        let (ctx, wl) = (t.ctx, t.wl);
+        let scene = ctx.scene;
+        if on(K, MEDIA) && s.medium != NO_MEDIUM {
+            // A closed boundary always stops a ray inside; a ray that escapes it leaked.
+            let Some(h) = &hit else { return false };
+            match medium_segment::<N, K, S, T>(t, s, ray, h) {
+                Segment::Scattered => return true,
+                Segment::Ended => return false,
+                Segment::Crossed => {}
             }
         }
-    }
-    // The lanes' mean of r_u (1 without media) divides every contribution found.
-    let mis = if on(K, MEDIA) {
-        lane_mean(s.r_u, s.bsdf_ctx.companions_alive)
-    } else {
-        1.0
-    };
-    let Some(hit) = hit else {
-        if on(K, ESCAPE) {
-            for &i in &scene.infinite_lights {
-                let le = scene.lights[i as usize].le(ray.dir, wl);
-                if !le.is_zero() {
-                    let (prev_p, dir) = (s.prev_p, ray.dir);
-                    s.add_found_light::<K, S, T>(t, (i as usize, dir), le, mis, || {
-                        light_pdf(ctx, i as usize, prev_p, dir, None)
-                    });
+        if on(K, MEDIA) {
+            if let Some(h) = &hit {
+                if scene.shapes[h.geom_id as usize].interface {
+                    // An index-matched boundary: cross it, switching media, no bounce.
+                    let (it, _) = scene.interaction(ray, h, ctx.offset.is_robust());
+                    s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
+                        scene.shapes[h.geom_id as usize].medium
+                    } else {
+                        NO_MEDIUM
+                    };
+                    s.crossings += 1;
+                    if s.crossings > MAX_CROSSINGS {
+                        return false;
+                    }
+                    *ray = ctx.offset.spawn(&it.spawn_point(), ray.dir);
+                    return true;
                 }
             }
         }
-        return false;
-    };
-    surface_vertex::<N, K, S, T>(t, s, ray, &hit, mis)
+        // The lanes' mean of r_u (1 without media) divides every contribution found.
+        let mis = if on(K, MEDIA) {
+            lane_mean(s.r_u, s.bsdf_ctx.companions_alive)
+        } else {
+            1.0
+        };
+        let Some(hit) = hit else {
+            if on(K, ESCAPE) {
+                for &i in &scene.infinite_lights {
+                    let le = scene.lights[i as usize].le(ray.dir, wl);
+                    if !le.is_zero() {
+                        let (prev_p, dir) = (s.prev_p, ray.dir);
+                        s.add_found_light::<K, S, T>(t, (i as usize, dir), le, mis, || {
+                            light_pdf(ctx, i as usize, prev_p, dir, None)
+                        });
+                    }
+                }
+            }
+            return false;
+        };
+        surface_vertex::<N, K, S, T>(t, s, ray, &hit, mis)
+    }
 }
 
 impl<const N: usize> PathState<N> {
@@ -799,60 +829,5 @@ fn medium_outside(current: u32, scene: &Scene, geom: u32) -> u32 {
         NO_MEDIUM
     } else {
         current
-    }
-}
-
-/// The path tracer.
-pub struct PathTracer;
-
-impl Integrator for PathTracer {
-    const CAPABILITIES: Capabilities = Capabilities {
-        lens: Support::Yes,
-        media: true,
-        polarization: Support::Yes,
-        variance: Support::Yes,
-        packets: true,
-        auto_packets: Packets::Camera,
-        camera_rays: true,
-        steps: true,
-        splats: false,
-        kernel: Some(kernel_flags),
-    };
-}
-
-/// The kernel flags the path tracer is specialised on: next-event estimation, emitters,
-/// escaping rays and media (`scene::features`).
-fn kernel_flags(f: &Features) -> KernelFlags {
-    let bit = |on: bool, flag: KernelFlags| if on { flag } else { 0 };
-    bit(f.nee, SHADOWS) | bit(f.emitters, EMITTERS) | bit(f.escape, ESCAPE) | bit(f.media, MEDIA)
-}
-
-impl PixelIntegrator for PathTracer {
-    fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
-        ctx: &Context,
-        ray: CameraRay,
-        first_hit: Option<Option<Hit>>,
-        wl: &SampledWavelengths<N>,
-        sampler: &mut Sampler,
-        counters: &mut TraceCounters,
-        _: &mut Splats,
-    ) -> T::Value {
-        radiance::<N, K, T>(ctx, ray, first_hit, wl, sampler, counters)
-    }
-}
-
-impl StepIntegrator for PathTracer {
-    fn start<const N: usize>(cam: &CameraRay) -> PathState<N> {
-        start(cam)
-    }
-
-    #[inline(always)]
-    fn step<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
-        t: &mut Tracer<N, S, T>,
-        s: &mut PathState<N>,
-        ray: &mut Ray,
-        hit: Option<Hit>,
-    ) -> bool {
-        step::<N, K, S, T>(t, s, ray, hit)
     }
 }

@@ -662,132 +662,37 @@ impl<const N: usize> ShadowSink<N> for Deferred<N> {
     }
 }
 
-/// What a connection adds once its shadow ray (if any) is known to be clear: to the
-/// pixel sample's own radiance (BDPT's s ≥ 0, t ≥ 2 strategies), or splatted into a
-/// pixel (a light path's vertex seen by the camera).
+/// What a connection adds once its shadow ray is known to be clear: to the pixel
+/// sample's own value (BDPT's s ≥ 0, t ≥ 2 strategies), or splatted into a pixel (a
+/// light path's vertex seen by the camera).
 #[derive(Clone, Copy)]
-pub(crate) struct Connection<const N: usize, V = SampledSpectrum<N>> {
+pub(crate) struct Connection<V> {
     pub c: V,
     pub splat: Option<u32>,
-    /// The shadow ray still to trace (`None`: none, or already traced and clear).
-    pub shadow: Option<RayQuery>,
 }
 
-/// The connections of one pixel sample (light tracing's to the camera, BDPT's
-/// strategies), added in the order they were made. With `--packets paths` their shadow
-/// rays are deferred and go to Embree 8 at a time (`rtcOccluded8`) before the
-/// connections are added; otherwise each is traced when made (`rtcOccluded1`), and a
-/// connection found blocked costs nothing more.
-pub(crate) struct Connections<const N: usize, V = SampledSpectrum<N>> {
-    batched: bool,
-    pending: [Option<Connection<N, V>>; CONNECTIONS_CAP],
-    len: usize,
-    queries: usize,
+impl<V> Connection<V> {
+    /// Adds the connection: to `own` when it is finite, or into its pixel's splats.
+    #[inline]
+    pub fn add<const N: usize>(&self, own: &mut V, splats: &mut Splats, wl: &SampledWavelengths<N>)
+    where
+        V: SampleValue<N>,
+    {
+        match self.splat {
+            Some(p) => self.c.splat(splats, p, wl),
+            None => self.c.add_to(own),
+        }
+    }
 }
 
-/// Connections kept before they are added (up to 8 of them with shadow rays: a packet).
-const CONNECTIONS_CAP: usize = 16;
-
-impl<const N: usize, V: SampleValue<N>> Connections<N, V> {
-    pub fn new(batched: bool) -> Self {
-        Connections {
-            batched,
-            pending: [None; CONNECTIONS_CAP],
-            len: 0,
-            queries: 0,
-        }
-    }
-
-    /// Whether the shadow ray `q` (`None`: blocked without one) is clear: known now when
-    /// rays are traced one by one, `None` when it is deferred (the connection then
-    /// carries `q` in [`Connection::shadow`]).
-    #[inline]
-    pub fn visible(
-        &self,
-        ctx: &Context,
-        q: Option<RayQuery>,
-        counters: &mut TraceCounters,
-    ) -> Option<bool> {
-        let Some(q) = q else { return Some(false) };
-        if self.batched {
-            return None;
-        }
-        counters.shadow_rays += 1;
-        Some(!ctx.accel.occluded1(&q))
-    }
-
-    /// Adds `c` now (one by one) or once its packet has been traced.
-    #[inline]
-    pub fn push(
-        &mut self,
-        ctx: &Context,
-        c: Connection<N, V>,
-        out: (&mut V, &mut Splats),
-        wl: &SampledWavelengths<N>,
-        counters: &mut TraceCounters,
-    ) {
-        if !self.batched {
-            Self::add(&c, out, wl);
-            return;
-        }
-        self.pending[self.len] = Some(c);
-        self.len += 1;
-        self.queries += c.shadow.is_some() as usize;
-        if self.queries == 8 || self.len == CONNECTIONS_CAP {
-            self.flush(ctx, out, wl, counters);
-        }
-    }
-
-    /// Traces the deferred shadow rays as one packet and adds the clear connections, in
-    /// order.
-    pub fn flush(
-        &mut self,
-        ctx: &Context,
-        (l, splats): (&mut V, &mut Splats),
-        wl: &SampledWavelengths<N>,
-        counters: &mut TraceCounters,
-    ) {
-        let mut rays = [RayQuery {
-            origin: Vec3::ZERO,
-            dir: Vec3::Z,
-            tnear: 0.0,
-            tfar: 0.0,
-        }; 8];
-        let mut lane = [usize::MAX; CONNECTIONS_CAP];
-        let mut mask = 0u8;
-        let mut k = 0;
-        for (i, c) in self.pending[..self.len].iter().enumerate() {
-            if let Some(q) = c.and_then(|c| c.shadow) {
-                rays[k] = q;
-                lane[i] = k;
-                mask |= 1 << k;
-                k += 1;
-            }
-        }
-        let blocked = if mask != 0 {
-            counters.shadow_rays += k as u64;
-            ctx.accel
-                .occluded8_with(&rays, mask, crate::accel::embree::RayCoherence::Incoherent)
-        } else {
-            0
-        };
-        for (p, &k) in self.pending[..self.len].iter_mut().zip(&lane) {
-            let Some(c) = p.take() else {
-                continue;
-            };
-            if k == usize::MAX || blocked & (1 << k) == 0 {
-                Self::add(&c, (&mut *l, &mut *splats), wl);
-            }
-        }
-        self.len = 0;
-        self.queries = 0;
-    }
-
-    #[inline]
-    fn add(c: &Connection<N, V>, (l, splats): (&mut V, &mut Splats), wl: &SampledWavelengths<N>) {
-        match c.splat {
-            Some(p) => c.c.splat(splats, p, wl),
-            None => c.c.add_to(l),
-        }
-    }
+/// Whether a connection's shadow ray `q` is clear (`None`: blocked without one, the
+/// points too close to tell apart), traced now (`rtcOccluded1`), so that a connection
+/// found blocked costs nothing more. Light tracing's and BDPT's connections once went 8
+/// at a time under `--packets paths`: that gained nothing for light tracing and cost
+/// BDPT 4–5% (BENCHMARKS.md, "Packets of paths"), so it is gone.
+#[inline]
+pub(crate) fn unoccluded(ctx: &Context, q: Option<RayQuery>, counters: &mut TraceCounters) -> bool {
+    let Some(q) = q else { return false };
+    counters.shadow_rays += 1;
+    !ctx.accel.occluded1(&q)
 }

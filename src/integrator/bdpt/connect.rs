@@ -5,19 +5,12 @@ use super::*;
 
 impl<'a, const N: usize> Bdpt<'a, N> {
     /// Geometry term between two vertices with their visibility: 0 when blocked (or
-    /// degenerate), else the term and the shadow ray still to trace (deferred by
-    /// `conns`).
-    pub(super) fn g<V: SampleValue<N>>(
-        &self,
-        a: &Vertex<N>,
-        b: &Vertex<N>,
-        conns: &Connections<N, V>,
-        counters: &mut TraceCounters,
-    ) -> (f32, Option<RayQuery>) {
+    /// degenerate).
+    pub(super) fn g(&self, a: &Vertex<N>, b: &Vertex<N>, counters: &mut TraceCounters) -> f32 {
         let w = b.p - a.p;
         let d2 = w.length_squared();
         if d2 == 0.0 {
-            return (0.0, None);
+            return 0.0;
         }
         let d = d2.sqrt();
         let w = w / d;
@@ -29,32 +22,30 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             g *= b.n.dot(w).abs();
         }
         if g == 0.0 {
-            return (0.0, None);
+            return 0.0;
         }
-        match self.shadow(&a.spawn_point(), w, d, &b.spawn_point(), conns, counters) {
-            Err(()) => (0.0, None),
-            Ok(q) => (g, q),
+        if self.shadow(&a.spawn_point(), w, d, &b.spawn_point(), counters) {
+            g
+        } else {
+            0.0
         }
     }
 
-    /// The shadow ray between two points, with the render's `RayOffset` cutoffs (points
-    /// too close to tell apart count as blocked): `Err` when it is known to be blocked,
-    /// else the query still to trace (`None`: traced and clear).
-    pub(super) fn shadow<V: SampleValue<N>>(
+    /// Whether the shadow ray between two points is clear, with the render's
+    /// `RayOffset` cutoffs (points too close to tell apart count as blocked).
+    pub(super) fn shadow(
         &self,
         from: &SpawnPoint,
         w: Vec3,
         dist: f32,
         to: &SpawnPoint,
-        conns: &Connections<N, V>,
         counters: &mut TraceCounters,
-    ) -> Result<Option<RayQuery>, ()> {
-        let q = self.ctx.offset.shadow(from, w, dist, to);
-        match conns.visible(self.ctx, q, counters) {
-            Some(true) => Ok(None),
-            Some(false) => Err(()),
-            None => Ok(q),
-        }
+    ) -> bool {
+        unoccluded(
+            self.ctx,
+            self.ctx.offset.shadow(from, w, dist, to),
+            counters,
+        )
     }
 
     /// The power-heuristic weight of strategy (s, t); `sampled` replaces the
@@ -159,17 +150,15 @@ impl<'a, const N: usize> Bdpt<'a, N> {
     }
 
     /// Strategy (s, t): its MIS-weighted contribution to the camera's pixel, or (for
-    /// t = 1) a splat; None when it adds nothing. Its shadow ray is traced now or
-    /// deferred, as `conns` does.
+    /// t = 1) a splat; None when it adds nothing or its shadow ray is blocked.
     pub(super) fn connect<T: Transport<N>>(
         &self,
         carry: &T::Bdpt,
         paths: &mut Subpaths<N>,
         (s, t): (usize, usize),
         sampler: &mut Sampler,
-        conns: &Connections<N, T::Value>,
         counters: &mut TraceCounters,
-    ) -> Option<Connection<N, T::Value>> {
+    ) -> Option<Connection<T::Value>> {
         let scene = self.scene();
         let (light, camera) = (&mut paths.light[..], &mut paths.camera[..]);
         // A camera path that reached a light is only used as such (s = 0).
@@ -177,12 +166,12 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             return None;
         }
         let mut sampled = None;
-        let (l, shadow) = if s == 0 {
+        let l = if s == 0 {
             let pt = camera[t - 1];
             if !pt.is_light() {
                 return None;
             }
-            (self.le(&pt, &camera[t - 2]) * pt.beta, None)
+            self.le(&pt, &camera[t - 2]) * pt.beta
         } else if t == 1 {
             let qs = light[s - 1];
             if !qs.connectible(scene) || qs.infinite {
@@ -205,15 +194,14 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if c.is_zero() {
                 return None;
             }
-            let shadow = self
-                .shadow(&qs.spawn_point(), cs.wi, cs.dist, &eye, conns, counters)
-                .ok()?;
+            if !self.shadow(&qs.spawn_point(), cs.wi, cs.dist, &eye, counters) {
+                return None;
+            }
             sampled = Some(cv);
             let w = self.mis_weight(light, camera, sampled, s, t);
             return Some(Connection {
                 c: T::strategy(carry, self, paths, (s, t), sampled.as_ref(), c * w),
                 splat: Some(pixel_of(cam, cs.raster)),
-                shadow,
             });
         } else if s == 1 {
             let pt = camera[t - 1];
@@ -249,18 +237,11 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if c.is_zero() {
                 return None;
             }
-            let shadow = self
-                .shadow(
-                    &pt.spawn_point(),
-                    ls.wi,
-                    ls.dist,
-                    &ls.target(),
-                    conns,
-                    counters,
-                )
-                .ok()?;
+            if !self.shadow(&pt.spawn_point(), ls.wi, ls.dist, &ls.target(), counters) {
+                return None;
+            }
             sampled = Some(lv);
-            (c, shadow)
+            c
         } else {
             let (qs, pt) = (light[s - 1], camera[t - 1]);
             if !qs.connectible(scene) || !pt.connectible(scene) || qs.infinite {
@@ -277,8 +258,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             if c.is_zero() {
                 return None;
             }
-            let (g, shadow) = self.g(&qs, &pt, conns, counters);
-            (c * g, shadow)
+            c * self.g(&qs, &pt, counters)
         };
         if l.is_zero() {
             return None;
@@ -287,7 +267,6 @@ impl<'a, const N: usize> Bdpt<'a, N> {
         Some(Connection {
             c: T::strategy(carry, self, paths, (s, t), sampled.as_ref(), c),
             splat: None,
-            shadow,
         })
     }
 }

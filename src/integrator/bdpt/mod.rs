@@ -32,12 +32,10 @@
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
 use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE};
 use super::polarized::{non_delta, Beam, Chain};
-use super::toolkit::{
-    next_hit, pixel_of, Connection, Connections, LightPathStart, Vertex as Event,
-};
+use super::toolkit::{next_hit, pixel_of, unoccluded, Connection, LightPathStart, Vertex as Event};
 use super::transport::Transport;
 use super::{Context, Integrator, PixelIntegrator, TraceCounters};
-use crate::accel::embree::{Hit, RayQuery};
+use crate::accel::embree::Hit;
 use crate::bsdf::{BsdfContext, LobeFlags, TransportMode};
 use crate::camera::CameraRay;
 use crate::film::tile::SampleValue;
@@ -330,58 +328,6 @@ fn direction<const N: usize>(a: &Vertex<N>, b: &Vertex<N>) -> Vec3 {
     (b.p - a.p).normalize_or_zero()
 }
 
-/// The MIS-weighted sum of every strategy for one pixel sample; t = 1 strategies go to
-/// `splats`. What the subpaths carry besides their scalar throughputs is the transport
-/// `T`'s: nothing, or their Mueller matrices and Stokes vectors (polarised BDPT, whose
-/// value is the Stokes radiance in the camera's frame and whose t = 1 strategies splat
-/// Stokes radiance). Both trace the same subpaths and strategies with the same random
-/// numbers.
-pub(crate) fn radiance<const N: usize, T: Transport<N>>(
-    ctx: &Context,
-    cam: CameraRay,
-    first_hit: Option<Option<Hit>>,
-    wl: &SampledWavelengths<N>,
-    sampler: &mut Sampler,
-    counters: &mut TraceCounters,
-    splats: &mut Splats,
-) -> T::Value {
-    // The pinhole's ray (render.rs refuses BDPT with a lens camera).
-    let ray = cam.ray;
-    let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
-    let b = Bdpt { ctx, wl };
-    let mut paths = Subpaths {
-        light: [Vertex::<N>::EMPTY; MAX_VERTICES],
-        camera: [Vertex::<N>::EMPTY; MAX_VERTICES],
-        n_light: 0,
-        n_camera: 0,
-    };
-    paths.n_light = b.light_subpath(&mut paths.light, max_depth + 1, sampler, counters);
-    paths.n_camera = b.camera_subpath(
-        ray,
-        first_hit,
-        &mut paths.camera,
-        max_depth + 2,
-        sampler,
-        counters,
-    );
-    let carry = T::subpaths(&b, &paths, ray.dir);
-    let mut l = T::Value::zero();
-    let mut conns = Connections::<N, T::Value>::new(ctx.settings.packets == Packets::Paths);
-    for t in 1..=paths.n_camera {
-        for s in 0..=paths.n_light {
-            let depth = s as isize + t as isize - 2;
-            if (s == 1 && t == 1) || depth < 0 || depth > max_depth as isize {
-                continue;
-            }
-            if let Some(c) = b.connect::<T>(&carry, &mut paths, (s, t), sampler, &conns, counters) {
-                conns.push(ctx, c, (&mut l, splats), wl, counters);
-            }
-        }
-    }
-    conns.flush(ctx, (&mut l, splats), wl, counters);
-    l
-}
-
 /// Bidirectional path tracing.
 pub struct Bidirectional;
 
@@ -401,15 +347,53 @@ impl Integrator for Bidirectional {
 }
 
 impl PixelIntegrator for Bidirectional {
+    /// The MIS-weighted sum of every strategy for one pixel sample; t = 1 strategies go to
+    /// `splats`. What the subpaths carry besides their scalar throughputs is the transport
+    /// `T`'s: nothing, or their Mueller matrices and Stokes vectors (polarised BDPT, whose
+    /// value is the Stokes radiance in the camera's frame and whose t = 1 strategies splat
+    /// Stokes radiance). Both trace the same subpaths and strategies with the same random
+    /// numbers.
     fn sample<const N: usize, const K: KernelFlags, T: Transport<N>>(
         ctx: &Context,
-        ray: CameraRay,
+        cam: CameraRay,
         first_hit: Option<Option<Hit>>,
         wl: &SampledWavelengths<N>,
         sampler: &mut Sampler,
         counters: &mut TraceCounters,
         splats: &mut Splats,
     ) -> T::Value {
-        radiance::<N, T>(ctx, ray, first_hit, wl, sampler, counters, splats)
+        // The pinhole's ray (render.rs refuses BDPT with a lens camera).
+        let ray = cam.ray;
+        let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
+        let b = Bdpt { ctx, wl };
+        let mut paths = Subpaths {
+            light: [Vertex::<N>::EMPTY; MAX_VERTICES],
+            camera: [Vertex::<N>::EMPTY; MAX_VERTICES],
+            n_light: 0,
+            n_camera: 0,
+        };
+        paths.n_light = b.light_subpath(&mut paths.light, max_depth + 1, sampler, counters);
+        paths.n_camera = b.camera_subpath(
+            ray,
+            first_hit,
+            &mut paths.camera,
+            max_depth + 2,
+            sampler,
+            counters,
+        );
+        let carry = T::subpaths(&b, &paths, ray.dir);
+        let mut l = T::Value::zero();
+        for t in 1..=paths.n_camera {
+            for s in 0..=paths.n_light {
+                let depth = s as isize + t as isize - 2;
+                if (s == 1 && t == 1) || depth < 0 || depth > max_depth as isize {
+                    continue;
+                }
+                if let Some(c) = b.connect::<T>(&carry, &mut paths, (s, t), sampler, counters) {
+                    c.add(&mut l, splats, wl);
+                }
+            }
+        }
+        l
     }
 }
