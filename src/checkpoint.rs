@@ -3,7 +3,7 @@
 //! --shard K/N -o part.heronfilm`, `heron merge`); the checks that a checkpoint fits the
 //! render that resumes it, and that parts fit each other.
 //!
-//! A render runs in passes of samples (`render.rs`); after a pass the film's sums are
+//! A render runs in passes of samples (`render/passes.rs`); after a pass the film's sums are
 //! complete for the samples so far. The file holds those sums (the film's planes, fixed
 //! point, so that they do not depend on how the samples were grouped: `film/fixed.rs`),
 //! the passes done and the settings that determine the image. A render killed at any
@@ -520,7 +520,7 @@ pub fn merge(parts: &[(std::path::PathBuf, Checkpoint)]) -> Result<Checkpoint> {
             if missing.len() > 1 { "them" } else { "it" }
         )));
     }
-    // Shards of photon mapping are independent chains (see `render.rs`): their own
+    // Shards of photon mapping are independent chains (see `render/progressive.rs`): their own
     // per-pixel states do not continue as one, so the merged film has none.
     let mut film = FilmState::new(first.film.layout);
     for (_, c) in parts {

@@ -149,7 +149,7 @@ pub fn add_stokes_to_bins<const N: usize>(
 
 /// Contributions an integrator makes to pixels other than the one it samples (light
 /// tracing, bidirectional connections to the camera): kept in the order they are made,
-/// per tile and pass, and added to the film in tile order by `render.rs`, so splatting
+/// per tile and pass, and added to the film in tile order by `render/`, so splatting
 /// keeps the image independent of the thread count. A splat is an estimate of the
 /// image's value per pixel sample: the film adds Σ splats / spp. With spectral output,
 /// each splat also keeps its lanes' bin contributions. A polarised render's splats

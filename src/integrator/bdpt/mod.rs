@@ -362,7 +362,7 @@ impl PixelIntegrator for Bidirectional {
         counters: &mut TraceCounters,
         splats: &mut Splats,
     ) -> T::Value {
-        // The pinhole's ray (render.rs refuses BDPT with a lens camera).
+        // The pinhole's ray (BDPT declares no lens camera support: `LENS_NEEDS_WE`).
         let ray = cam.ray;
         let max_depth = (ctx.settings.max_depth as usize).min(MAX_VERTICES - 2);
         let b = Bdpt { ctx, wl };
