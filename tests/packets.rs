@@ -1,4 +1,4 @@
-//! Packets of paths (`--packets paths`: render.rs `render_tile_paths` under `whitted`
+//! Packets of paths (`--packets paths`: the tile engine's `Steps` program under `whitted`
 //! and `path`; camera packets under `bdpt`, none under `lighttrace`) against one path at
 //! a time (`--packets camera`), on every scene in `scenes/` under every integrator.
 //!

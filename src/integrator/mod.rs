@@ -50,11 +50,11 @@ use lighttrace::LightTracer;
 use path::PathTracer;
 use polarized::Polarized;
 use sppm::PhotonMapping;
-use toolkit::ShadowSink;
 pub(crate) use toolkit::WALKS;
 pub use toolkit::{Deferred, PathState};
+use toolkit::{Immediate, ShadowSink};
 pub(crate) use transport::Tracer;
-use transport::{Transport, Unpolarized};
+use transport::{follow, Transport, Unpolarized};
 use whitted::Whitted;
 
 /// What an integrator needs to trace: the scene, its committed Embree scene and the
@@ -140,6 +140,37 @@ pub(crate) trait StepIntegrator: PixelIntegrator {
         ray: &mut Ray,
         hit: Option<Hit>,
     ) -> bool;
+
+    /// A whole pixel sample taken step by step, one path at a time with each shadow ray
+    /// traced as it is made: [`PixelIntegrator::sample`] of a step integrator.
+    #[inline(always)]
+    fn sample_by_steps<const N: usize, const K: KernelFlags, T: Transport<N>>(
+        ctx: &Context,
+        cam: CameraRay,
+        first_hit: Option<Option<Hit>>,
+        wl: &SampledWavelengths<N>,
+        sampler: &mut Sampler,
+        counters: &mut TraceCounters,
+    ) -> T::Value {
+        let mut carry = T::at_camera(ctx, &cam);
+        let mut s = Self::start::<N>(&cam);
+        let mut t = Tracer {
+            ctx,
+            wl,
+            sampler,
+            counters,
+            shadows: &mut Immediate,
+            carry: &mut carry,
+        };
+        follow(
+            &mut t,
+            cam.ray,
+            &mut s,
+            first_hit,
+            Self::step::<N, K, Immediate, T>,
+        );
+        T::delivered(carry, s.l)
+    }
 }
 
 /// A progressive integrator, run as passes whose per-pixel state carries over from one

@@ -76,10 +76,10 @@
 //! media, has nothing to add here.
 use super::capabilities::{Capabilities, Support};
 use super::toolkit::{
-    lane_mean, light_pdf, roulette, sample_light, Finish, Immediate, PathState, ShadowSink,
-    TransmittanceWalk, Vertex, MAX_CROSSINGS,
+    lane_mean, light_pdf, roulette, sample_light, Finish, PathState, ShadowSink, TransmittanceWalk,
+    Vertex, MAX_CROSSINGS,
 };
-use super::transport::{follow, Scatter, Tracer, Transport};
+use super::transport::{Scatter, Tracer, Transport};
 use super::{Context, Integrator, PixelIntegrator, StepIntegrator, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::{LobeFlags, Material};
@@ -138,24 +138,7 @@ impl PixelIntegrator for PathTracer {
         counters: &mut TraceCounters,
         _: &mut Splats,
     ) -> T::Value {
-        let mut carry = T::at_camera(ctx, &cam);
-        let mut s = PathState::<N>::at_camera(&cam);
-        let mut t = Tracer {
-            ctx,
-            wl,
-            sampler,
-            counters,
-            shadows: &mut Immediate,
-            carry: &mut carry,
-        };
-        follow(
-            &mut t,
-            cam.ray,
-            &mut s,
-            first_hit,
-            Self::step::<N, K, Immediate, T>,
-        );
-        T::delivered(carry, s.l)
+        Self::sample_by_steps::<N, K, T>(ctx, cam, first_hit, wl, sampler, counters)
     }
 }
 

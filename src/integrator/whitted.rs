@@ -15,8 +15,8 @@
 //! Light reaching a diffuse surface through glass or off other diffuse surfaces is
 //! missing: that is the `path` integrator's job.
 use super::capabilities::{Capabilities, Support};
-use super::toolkit::{Immediate, PathState, ShadowSink, Vertex};
-use super::transport::{follow, Scatter, Tracer, Transport};
+use super::toolkit::{PathState, ShadowSink, Vertex};
+use super::transport::{Scatter, Tracer, Transport};
 use super::{Context, Integrator, PixelIntegrator, StepIntegrator, TraceCounters};
 use crate::accel::embree::Hit;
 use crate::bsdf::LobeFlags;
@@ -87,24 +87,7 @@ impl PixelIntegrator for Whitted {
         counters: &mut TraceCounters,
         _: &mut Splats,
     ) -> T::Value {
-        let mut carry = T::at_camera(ctx, &cam);
-        let mut s = Self::start::<N>(&cam);
-        let mut t = Tracer {
-            ctx,
-            wl,
-            sampler,
-            counters,
-            shadows: &mut Immediate,
-            carry: &mut carry,
-        };
-        follow(
-            &mut t,
-            cam.ray,
-            &mut s,
-            first_hit,
-            Self::step::<N, K, Immediate, T>,
-        );
-        T::delivered(carry, s.l)
+        Self::sample_by_steps::<N, K, T>(ctx, cam, first_hit, wl, sampler, counters)
     }
 }
 

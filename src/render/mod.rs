@@ -11,6 +11,7 @@
 use crate::accel::embree::{self, RayCoherence, RayQuery};
 use crate::camera::CameraRay;
 use crate::checkpoint::{Checkpoint, FilmKey, Shard};
+use crate::film::fixed::SquareSum;
 use crate::film::planes::Layout;
 use crate::film::state::FilmState;
 use crate::film::state::IntegratorPlane;
@@ -29,7 +30,7 @@ use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
 mod passes;
-mod paths;
+mod programs;
 mod progressive;
 mod tile;
 
@@ -279,38 +280,10 @@ fn render_with(
     }
     let paths = opts.settings.packets == Packets::Paths && caps.steps;
     let polarized = opts.settings.polarization;
-    let integrate = move |n: Lanes| -> SampleFn {
-        if polarized {
-            // Checked above (`check_camera`): the integrator has a polarised kernel.
-            const WHY: &str = "a polarised kernel";
-            return match n {
-                Lanes::One => {
-                    SampleFn::StokesOne(integrator::stokes_kernel::<1>(kind, k).expect(WHY))
-                }
-                Lanes::Four => {
-                    SampleFn::StokesFour(integrator::stokes_kernel::<4>(kind, k).expect(WHY))
-                }
-                Lanes::Eight => {
-                    SampleFn::StokesEight(integrator::stokes_kernel::<8>(kind, k).expect(WHY))
-                }
-            };
-        }
-        let p = |f1, f4, f8| match n {
-            Lanes::One => f1,
-            Lanes::Four => f4,
-            Lanes::Eight => f8,
-        };
-        match (paths, n) {
-            (true, _) => p(
-                integrator::path_fns::<1>(kind, k).map(SampleFn::PathsOne),
-                integrator::path_fns::<4>(kind, k).map(SampleFn::PathsFour),
-                integrator::path_fns::<8>(kind, k).map(SampleFn::PathsEight),
-            )
-            .expect("an integrator with a step"),
-            (false, Lanes::One) => SampleFn::One(integrator::kernel::<1>(kind, k)),
-            (false, Lanes::Four) => SampleFn::Four(integrator::kernel::<4>(kind, k)),
-            (false, Lanes::Eight) => SampleFn::Eight(integrator::kernel::<8>(kind, k)),
-        }
+    let integrate = move |n: Lanes| match n {
+        Lanes::One => SampleFn::One(tile_fn(kind, k, polarized, paths)),
+        Lanes::Four => SampleFn::Four(tile_fn(kind, k, polarized, paths)),
+        Lanes::Eight => SampleFn::Eight(tile_fn(kind, k, polarized, paths)),
     };
     // Every render can stop, checkpoint or resume at a pass boundary. A splatting
     // integrator keeps its splats per tile for one pass: passes of about 2²⁰ pixel
@@ -366,18 +339,42 @@ fn kind_splats(opts: &RenderOptions) -> bool {
 /// [`integrator::kernel`]): one indirect call per pixel sample.
 pub(crate) type SampleFnN<const N: usize> = integrator::RadianceFn<N>;
 
+/// What a render's tiles run at `N` lanes: one of the integrator's monomorphised
+/// functions, chosen once per render.
+pub(crate) enum TileFn<const N: usize> {
+    /// Whole pixel samples of radiance (`integrator::kernel`).
+    Radiance(SampleFnN<N>),
+    /// Whole pixel samples of Stokes radiance, for polarised transport
+    /// (`integrator::stokes_kernel`).
+    Stokes(integrator::StokesFn<N>),
+    /// The steps of packets of paths (`integrator::path_fns`, `--packets paths`).
+    Steps(integrator::PathFns<N>),
+}
+
+/// The render's [`TileFn`] at its lane count.
 pub(crate) enum SampleFn {
-    One(SampleFnN<1>),
-    Four(SampleFnN<4>),
-    Eight(SampleFnN<8>),
-    /// The packet engine's (`Packets::Paths`).
-    PathsOne(integrator::PathFns<1>),
-    PathsFour(integrator::PathFns<4>),
-    PathsEight(integrator::PathFns<8>),
-    /// Polarised transport's (`integrator::polarized`).
-    StokesOne(integrator::StokesFn<1>),
-    StokesFour(integrator::StokesFn<4>),
-    StokesEight(integrator::StokesFn<8>),
+    One(TileFn<1>),
+    Four(TileFn<4>),
+    Eight(TileFn<8>),
+}
+
+/// The tile function of `kind` at `N` lanes for the kernel flags `k`: polarised
+/// transport's (checked by `check_camera`: the integrator has one), else the steps of
+/// packets of paths when `paths` (the integrator has steps: `packets`), else whole
+/// samples.
+fn tile_fn<const N: usize>(
+    kind: IntegratorKind,
+    k: KernelFlags,
+    polarized: bool,
+    paths: bool,
+) -> TileFn<N> {
+    if polarized {
+        TileFn::Stokes(integrator::stokes_kernel::<N>(kind, k).expect("a polarised kernel"))
+    } else if paths {
+        TileFn::Steps(integrator::path_fns::<N>(kind, k).expect("an integrator with a step"))
+    } else {
+        TileFn::Radiance(integrator::kernel::<N>(kind, k))
+    }
 }
 
 /// Whether the render was abandoned (`RenderOptions::cancel`).
@@ -431,7 +428,7 @@ mod tests {
         }
         let integrate = |n: Lanes| -> SampleFn {
             assert_eq!(n, Lanes::Four);
-            SampleFn::Four(splat_one)
+            SampleFn::Four(TileFn::Radiance(splat_one))
         };
         let run = |threads: usize, pass: u32| {
             let pool = embree::worker_pool(threads).unwrap();
@@ -505,7 +502,7 @@ mod tests {
         }
         let pool = embree::worker_pool(2).unwrap();
         for (name, f) in [("own", own as SampleFnN<4>), ("splat", splat)] {
-            let integrate = move |_: Lanes| SampleFn::Four(f);
+            let integrate = move |_: Lanes| SampleFn::Four(TileFn::Radiance(f));
             let mut o = RenderOptions::from_scene(&scene);
             o.settings.spp = 64;
             o.settings.lanes = Lanes::Four;

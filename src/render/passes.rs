@@ -1,15 +1,49 @@
-//! The pass loop: every tile of the image on rayon, pass by pass, each tile by the
-//! engine the render runs (one path at a time, `tile.rs`, or packets of paths,
-//! `paths.rs`); the film's state a render starts from and when it checkpoints, previews
-//! or stops.
-use super::paths::render_tile_paths;
+//! The pass loop: every tile of the image on rayon, pass by pass, each tile by the tile
+//! engine (`tile.rs`) running the render's program (`programs.rs`: whole pixel samples,
+//! or the steps of packets of paths); the film's state a render starts from and when it
+//! checkpoints, previews or stops.
+use super::programs::{Steps, Whole};
 use super::tile::render_tile;
 use super::*;
+
+/// One tile's samples of one pass by the tile engine, with the program `f` names. Two
+/// instances of the engine per program, so that a render without the variance runs the
+/// loop it ran before the variance existed.
+fn run_tile<const N: usize>(
+    ctx: &Context,
+    opts: &RenderOptions,
+    xy: (u32, u32),
+    samples: std::ops::Range<u32>,
+    f: &TileFn<N>,
+) -> TileResult {
+    match (f, opts.variance) {
+        (TileFn::Radiance(f), false) => {
+            render_tile::<N, false, _>(ctx, opts, xy, samples, Whole::new(ctx, opts, f))
+        }
+        (TileFn::Radiance(f), true) => {
+            render_tile::<N, true, _>(ctx, opts, xy, samples, Whole::new(ctx, opts, f))
+        }
+        (TileFn::Stokes(f), false) => {
+            render_tile::<N, false, _>(ctx, opts, xy, samples, Whole::new(ctx, opts, f))
+        }
+        (TileFn::Stokes(f), true) => {
+            render_tile::<N, true, _>(ctx, opts, xy, samples, Whole::new(ctx, opts, f))
+        }
+        (TileFn::Steps(f), false) => {
+            render_tile::<N, false, _>(ctx, opts, xy, samples, Steps::new(f))
+        }
+        (TileFn::Steps(f), true) => {
+            render_tile::<N, true, _>(ctx, opts, xy, samples, Steps::new(f))
+        }
+    }
+}
 
 /// Renders `spp` samples per pixel (or the shard's share of them) in passes of
 /// `pass_spp` samples; returns the film's unnormalised state. Pass boundaries are where
 /// a render may checkpoint or stop, and they bound the splat lists kept per tile; the
 /// sums are exact (`film/fixed.rs`), so passes, shards and threads do not change them.
+// Never inlined: scripts/callgrind_loop.sh counts the instructions inside it by name.
+#[inline(never)]
 pub(super) fn render_passes(
     ctx: &Context,
     pool: &rayon::ThreadPool,
@@ -59,63 +93,10 @@ pub(super) fn render_passes(
             tiles
                 .par_iter()
                 .map(|&(x0, y0)| {
-                    // Two instances of the tile loop, so that a render without the
-                    // variance runs the loop it ran before the variance existed.
-                    let r = match (&sample, opts.variance) {
-                        (SampleFn::One(f), false) => {
-                            render_tile::<1, false, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::Four(f), false) => {
-                            render_tile::<4, false, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::Eight(f), false) => {
-                            render_tile::<8, false, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::One(f), true) => {
-                            render_tile::<1, true, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::Four(f), true) => {
-                            render_tile::<4, true, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::Eight(f), true) => {
-                            render_tile::<8, true, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::PathsOne(f), false) => {
-                            render_tile_paths::<1, false>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::PathsFour(f), false) => {
-                            render_tile_paths::<4, false>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::PathsEight(f), false) => {
-                            render_tile_paths::<8, false>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::PathsOne(f), true) => {
-                            render_tile_paths::<1, true>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::PathsFour(f), true) => {
-                            render_tile_paths::<4, true>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::PathsEight(f), true) => {
-                            render_tile_paths::<8, true>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::StokesOne(f), false) => {
-                            render_tile::<1, false, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::StokesFour(f), false) => {
-                            render_tile::<4, false, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::StokesEight(f), false) => {
-                            render_tile::<8, false, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::StokesOne(f), true) => {
-                            render_tile::<1, true, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::StokesFour(f), true) => {
-                            render_tile::<4, true, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
-                        (SampleFn::StokesEight(f), true) => {
-                            render_tile::<8, true, _>(ctx, opts, x0, y0, s0..s1, f)
-                        }
+                    let r = match &sample {
+                        SampleFn::One(f) => run_tile(ctx, opts, (x0, y0), s0..s1, f),
+                        SampleFn::Four(f) => run_tile(ctx, opts, (x0, y0), s0..s1, f),
+                        SampleFn::Eight(f) => run_tile(ctx, opts, (x0, y0), s0..s1, f),
                     };
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     if let Some(p) = &opts.progress {
