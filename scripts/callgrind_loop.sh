@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# Instruction counts of the render loop (callgrind, collecting inside render_passes only),
-# which do not drift with the machine's load: the default scene under whitted and the
-# Cornell box under path, on one thread. For refactors of the hot path: compare a
-# binary before and after.
+# Instruction counts of the render loop, which do not drift with the machine's load: the
+# default scene under whitted and the Cornell box under path, on one thread. For refactors
+# of the hot path: compare a binary before and after. Callgrind toggles collection per
+# thread: on the calling thread in the pass loop (render_passes: the tiles added to the
+# film), on the worker in each tile (render_tile, never inlined; before the one tile
+# engine, the pass loop's closure render_passes::{{closure}}, into which the tile loops
+# were inlined). The patterns never nest in one binary, so an older binary counts what it
+# counted before.
 #
 #   scripts/callgrind_loop.sh [HERON_BINARY...]     (default: target/release/heron)
 #   SPP=64 SIZE=128 scripts/callgrind_loop.sh ...   (per-sample cost at a real sample count)
@@ -34,7 +38,7 @@ done
 for bin in "${bins[@]}"; do
   for scene in default cornell-box; do
     valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --collect-atstart=no \
-      --toggle-collect='*render_passes*' \
+      --toggle-collect='*render_passes*' --toggle-collect='*::render_tile' \
       "$bin" render "$tmp/$scene.toml" -o "$tmp/cg.exr" --spp "$spp" --threads 1 --quiet \
       --no-png ${FLAGS:-} >"$tmp/out" 2>"$tmp/log"
     ir=$(grep -E '^(summary|totals):' "$tmp/cg.out" | head -n 1 | awk '{print $2}')

@@ -123,6 +123,9 @@ impl Order {
 /// every lane advances, the program settles what it deferred, and a lane whose path has
 /// ended gives its pixel its sample. The film's sums are exact, so the order in which
 /// samples end does not change them.
+// Never inlined: scripts/callgrind_loop.sh counts the instructions inside it by name on
+// the worker threads.
+#[inline(never)]
 pub(super) fn render_tile<const N: usize, const VARIANCE: bool, P: Program<N>>(
     ctx: &Context,
     opts: &RenderOptions,
