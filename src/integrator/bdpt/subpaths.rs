@@ -94,9 +94,20 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             pdf_fwd = bs.pdf;
             let mut pdf_rev = material.pdf(bs.wi, wo_l, self.wl, &bsdf_ctx);
             if bs.is_specular() {
+                // A delta lobe has no density to compare, but the MIS ratios through a
+                // specular chain still need the chain's Jacobian: a delta counted as
+                // density one per projected solid angle (|cos| per solid angle, then
+                // converted to area at the next vertex as any direction) makes the
+                // ratio between the strategies at the chain's two ends that of the
+                // beam's étendue, which refraction and reflection conserve. Zeros here
+                // (pbrt's convention) dropped the chain's cos/d² factors, so a lens
+                // focusing the sun weighted light tracing's caustic down by 1/d² and
+                // left the rest to camera paths that find the sun's disk by chance.
+                // Each value is a function of the vertex and the direction alone, so
+                // both subpaths compute the same one and the weights still sum to one.
                 path[bounces].delta = true;
-                pdf_rev = 0.0;
-                pdf_fwd = 0.0;
+                pdf_fwd = bs.wi.z.abs();
+                pdf_rev = wo_l.z.abs();
             }
             let cur = path[bounces];
             path[bounces - 1].pdf_rev = convert_density(pdf_rev, &cur, &path[bounces - 1]);
