@@ -28,7 +28,10 @@
 //!
 //! Every tested (region, channel) is one test, and the whole image is one more per
 //! channel; a region where both images are equal and the standard error is zero (a
-//! black background in both) is not a test. The family of m tests is held at level α
+//! black background in both) is not a test. A standard error is never taken below the
+//! images' resolution, f32's ε times the channel's mean magnitude over the compared
+//! pixels: a difference smaller than that is rounding (a black region's fixed-point
+//! residue, ±10⁻¹⁹, with zero variance), not a difference. The family of m tests is held at level α
 //! by Šidák's correction (each test at 1 − (1 − α)^(1/m)) or Bonferroni's (α/m); a test
 //! fails when its two-sided p-value is below that. The images are the same up to noise
 //! when no test fails.
@@ -459,8 +462,16 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
         (Some(_), Some(_)) => VarianceSource::Channels,
         _ => VarianceSource::Spread,
     };
+    let all: Vec<usize> = (0..npix).filter(|&i| inside(i)).collect();
+    let floor: [f64; 3] = std::array::from_fn(|c| {
+        let magnitude: f64 = all
+            .iter()
+            .map(|&i| (a.values[i][c].abs() + b.values[i][c].abs()) as f64)
+            .sum();
+        f32::EPSILON as f64 * magnitude / (2 * all.len().max(1)) as f64
+    });
     let test = |pixels: &[usize], c: usize, x: u32, y: u32, tw: u32, th: u32| {
-        region_test(a, b, source, pixels, c, (x, y, tw, th))
+        region_test(a, b, source, pixels, (c, floor[c]), (x, y, tw, th))
     };
     let mut regions = Vec::new();
     let mut identical = 0;
@@ -487,7 +498,6 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
             }
         }
     }
-    let all: Vec<usize> = (0..npix).filter(|&i| inside(i)).collect();
     let mut whole: Vec<RegionTest> = (0..3)
         .filter_map(|c| test(&all, c, 0, 0, w, h))
         .map(|t| RegionTest {
@@ -522,14 +532,15 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
     })
 }
 
-/// The test of one region and channel; None when there is nothing to test (no pixels,
-/// one pixel with the spread estimator, or both images equal with zero standard error).
+/// The test of one region and channel `c`, whose standard error is at least `floor`
+/// (the images' resolution); None when there is nothing to test (no pixels, one pixel
+/// with the spread estimator, or both images equal with zero standard error).
 fn region_test(
     a: &Image,
     b: &Image,
     source: VarianceSource,
     pixels: &[usize],
-    c: usize,
+    (c, floor): (usize, f64),
     (x, y, width, height): (u32, u32, u32, u32),
 ) -> Option<RegionTest> {
     let n = pixels.len();
@@ -568,6 +579,7 @@ fn region_test(
     if se == 0.0 && d == 0.0 {
         return None;
     }
+    let se = se.max(floor);
     let z = if se == 0.0 {
         d.signum() * f64::INFINITY
     } else {
@@ -712,6 +724,36 @@ mod tests {
             // per region, 11 on the whole image.
             assert!(c.whole.iter().all(|t| t.fails && t.z > 8.0));
         }
+    }
+
+    /// A black region whose values are fixed-point residue (±10⁻¹⁹, what a render's
+    /// XYZ → RGB leaves of sums that are zero) with zero variance: below the images'
+    /// resolution, not a difference (it was z = ∞). A real difference there still fails.
+    #[test]
+    fn rounding_residue_in_a_black_region_is_not_a_difference() {
+        let lit = noisy(6, 32, 16, 0.1, 0.0, true);
+        let with_black = |img: &Image, black: f32| {
+            let mut values = img.values.clone();
+            let mut var = img.variance.clone().unwrap();
+            for i in 0..values.len() {
+                if i % 32 >= 16 {
+                    let sign = if i % 2 == 0 { 1.0 } else { -0.3 };
+                    values[i] = [black * sign; 3];
+                    var[i] = [0.0; 3];
+                }
+            }
+            Image::new("test", 32, 16, ["R", "G", "B"], values, Some(var)).unwrap()
+        };
+        let other = noisy(7, 32, 16, 0.1, 0.0, true);
+        let b = with_black(&other, 0.0);
+        let c = compare(&with_black(&lit, 1.2e-19), &b, &Options::default()).unwrap();
+        assert!(
+            c.same() && c.regions.len() == 6,
+            "{}",
+            c.report("a", "b", 5)
+        );
+        let c = compare(&with_black(&lit, 1e-3), &b, &Options::default()).unwrap();
+        assert!(!c.same(), "{}", c.report("a", "b", 5));
     }
 
     #[test]
