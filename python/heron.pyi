@@ -270,6 +270,7 @@ class Comparison(TypedDict):
     region: int
     alpha: float
     correction: Literal["sidak", "bonferroni"]
+    tolerance: float
     variance_from: Literal["channels", "spread"]
     per_test_alpha: float
     critical_z: float
@@ -292,13 +293,16 @@ def compare(
     alpha: float = 0.01,
     correction: Literal["sidak", "bonferroni"] = "sidak",
     mask: Optional[npt.ArrayLike] = None,
+    tolerance: float = 0.0,
     heatmap: Optional[_Path] = None,
 ) -> Comparison:
     """Are two renders the same image up to noise? ``heron compare``'s region z-test.
 
     a, b: an EXR path, a RenderResult, an H x W x 3 array, or (array, variance array);
     b is the reference of the relative errors. Standard errors come from both images'
-    variance, else from the spread within each region (Student t). "same" is the
+    variance, else from the spread within each region (Student t); tolerance is a
+    relative margin within which mean differences are allowed (sppm's radius bias).
+    "same" is the
     verdict and "status" the CLI's exit status (0 same, 1 different); errors raise
     HeronError (the CLI's status 2).
     """

@@ -154,6 +154,36 @@ fn renders_agree_and_a_three_percent_change_is_found() {
         out,
         "the CLI prints the library's report"
     );
+    // An equivalence margin: a 5% tolerance allows the 3% darker walls, a 1% one
+    // leaves 2% for the noise to explain, which it cannot.
+    let (code, out, err) = cmp(&[
+        s(&p("a.exr")),
+        s(&p("c.exr")),
+        "--region",
+        "8",
+        "--tolerance",
+        "0.05",
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(
+        out.contains("tolerance 0.05: differences within 5% of the means"),
+        "{out}"
+    );
+    let (code, out, err) = cmp(&[
+        s(&p("a.exr")),
+        s(&p("c.exr")),
+        "--region",
+        "8",
+        "--tolerance",
+        "0.01",
+    ]);
+    assert_eq!(code, 1, "{out}{err}");
+    let (code, _, err) = cmp(&[s(&p("a.exr")), s(&p("c.exr")), "--tolerance", "1.5"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--tolerance: expected a relative margin in [0, 1)"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -304,6 +334,7 @@ fn pure_noise_is_called_different_at_the_rate_alpha() {
             alpha: 0.05,
             correction,
             mask: None,
+            tolerance: 0.0,
         };
         let mut false_positives = 0;
         for _ in 0..runs {

@@ -603,6 +603,7 @@ fn compare_stokes(a: &Film, b: &Film, k: usize) -> heron::compare::Comparison {
             alpha: 0.005,
             correction: heron::compare::Correction::Sidak,
             mask: None,
+            tolerance: 0.0,
         },
     )
     .unwrap()

@@ -13,6 +13,7 @@ const RENAMES: &[(&str, &str)] = &[
     ("--region", "region"),
     ("--alpha", "alpha"),
     ("--correction", "correction"),
+    ("--tolerance", "tolerance"),
     ("--heatmap", "heatmap"),
 ];
 
@@ -92,7 +93,9 @@ fn image_arg(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Image
 /// heron.RenderResult (its rgb and variance), an H×W×3 array (no variance) or a tuple
 /// (array, variance array). b is the reference of the relative errors. region: edge in
 /// pixels (16); alpha: family-wise significance level (0.01); correction: "sidak" or
-/// "bonferroni"; mask: optional H×W booleans, the pixels to compare; heatmap: optional
+/// "bonferroni"; mask: optional H×W booleans, the pixels to compare; tolerance: a
+/// relative margin, mean differences within it allowed (0; e.g. 0.03 for sppm's radius
+/// bias); heatmap: optional
 /// path of a PNG heat map of the z-scores (written atomically).
 ///
 /// Returns a dict: "same" (the verdict), "status" (0 same, 1 different: the CLI's exit
@@ -104,7 +107,7 @@ fn image_arg(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Image
 /// of the regions' z, NaN where not tested). Errors (different sizes, unreadable files,
 /// bad options) raise HeronError, where the CLI exits with status 2.
 #[pyfunction]
-#[pyo3(signature = (a, b, *, region=16, alpha=0.01, correction="sidak", mask=None, heatmap=None))]
+#[pyo3(signature = (a, b, *, region=16, alpha=0.01, correction="sidak", mask=None, tolerance=0.0, heatmap=None))]
 pub fn compare<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
@@ -113,6 +116,7 @@ pub fn compare<'py>(
     alpha: f64,
     correction: &str,
     mask: Option<&Bound<'py, PyAny>>,
+    tolerance: f64,
     heatmap: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
@@ -149,6 +153,7 @@ pub fn compare<'py>(
             alpha,
             correction,
             mask,
+            tolerance,
         };
         let c = py
             .detach(|| compare_images(&ia, &ib, &opts))

@@ -20,6 +20,11 @@ pub(crate) struct CompareArgs {
     /// (alpha/m).
     #[arg(long, default_value = "sidak", value_parser = clap::builder::PossibleValuesParser::new(heron::compare::Correction::NAMES))]
     correction: String,
+    /// An equivalence margin: mean differences within this fraction of the two images'
+    /// means are allowed and only the excess is held to the noise (0: the plain
+    /// z-test). For an estimator biased by a stated bound, e.g. 0.03 for sppm.
+    #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
+    tolerance: f64,
     /// Write a PNG heat map of the regions' z-scores (red: A brighter, blue: B brighter;
     /// failing regions outlined).
     #[arg(long, value_name = "PNG")]
@@ -38,6 +43,7 @@ pub(crate) fn run(a: CompareArgs) -> Result<()> {
         alpha: a.alpha,
         correction: Correction::parse(&a.correction).map_err(anyhow::Error::msg)?,
         mask: None,
+        tolerance: a.tolerance,
     };
     opts.check().map_err(anyhow::Error::msg)?;
     if let Some(h) = &a.heatmap {

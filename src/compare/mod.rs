@@ -134,6 +134,13 @@ pub struct Options {
     /// Pixels to compare (row-major; None: all). A region with fewer than half its
     /// pixels in the mask is not tested.
     pub mask: Option<Vec<bool>>,
+    /// An equivalence margin, relative: a mean difference within `tolerance` times the
+    /// mean of the two images' magnitudes is not counted, only what lies beyond it is
+    /// held to the noise (0: the plain z-test). For an estimator that is consistent but
+    /// biased at any finite sample count, by a bound stated beforehand (photon
+    /// mapping's radius bias), or a reference whose known small differences are not
+    /// the question.
+    pub tolerance: f64,
 }
 
 impl Default for Options {
@@ -143,6 +150,7 @@ impl Default for Options {
             alpha: 0.01,
             correction: Correction::Sidak,
             mask: None,
+            tolerance: 0.0,
         }
     }
 }
@@ -157,6 +165,12 @@ impl Options {
             return Err(format!(
                 "--alpha: expected a significance level between 0 and 1 (e.g. 0.01), got {}",
                 self.alpha
+            ));
+        }
+        if !(self.tolerance >= 0.0 && self.tolerance < 1.0) {
+            return Err(format!(
+                "--tolerance: expected a relative margin in [0, 1) (e.g. 0.02), got {}",
+                self.tolerance
             ));
         }
         Ok(())
@@ -200,6 +214,8 @@ pub struct Comparison {
     pub region: u32,
     pub alpha: f64,
     pub correction: Correction,
+    /// The relative margin ([`Options::tolerance`]).
+    pub tolerance: f64,
     pub variance_from: VarianceSource,
     /// The level of each test (α split among the tests by the correction).
     pub per_test_alpha: f64,
@@ -310,6 +326,14 @@ impl Comparison {
             },
             self.per_test_alpha,
         );
+        if self.tolerance > 0.0 {
+            let _ = writeln!(
+                s,
+                "tolerance {}: differences within {}% of the means are allowed, z counts the rest",
+                self.tolerance,
+                100.0 * self.tolerance
+            );
+        }
         let _ = write!(s, "mean difference A − B:");
         for t in &self.whole {
             let _ = write!(
@@ -471,7 +495,14 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
         f32::EPSILON as f64 * magnitude / (2 * all.len().max(1)) as f64
     });
     let test = |pixels: &[usize], c: usize, x: u32, y: u32, tw: u32, th: u32| {
-        region_test(a, b, source, pixels, (c, floor[c]), (x, y, tw, th))
+        region_test(
+            a,
+            b,
+            source,
+            pixels,
+            (c, floor[c], o.tolerance),
+            (x, y, tw, th),
+        )
     };
     let mut regions = Vec::new();
     let mut identical = 0;
@@ -519,6 +550,7 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
         region: o.region,
         alpha: o.alpha,
         correction: o.correction,
+        tolerance: o.tolerance,
         variance_from: source,
         per_test_alpha: per_test,
         critical_z: normal_critical(per_test),
@@ -533,14 +565,15 @@ pub fn compare(a: &Image, b: &Image, o: &Options) -> Result<Comparison> {
 }
 
 /// The test of one region and channel `c`, whose standard error is at least `floor`
-/// (the images' resolution); None when there is nothing to test (no pixels, one pixel
+/// (the images' resolution) and whose difference counts only beyond `tolerance` times
+/// the two means' magnitude; None when there is nothing to test (no pixels, one pixel
 /// with the spread estimator, or both images equal with zero standard error).
 fn region_test(
     a: &Image,
     b: &Image,
     source: VarianceSource,
     pixels: &[usize],
-    (c, floor): (usize, f64),
+    (c, floor, tolerance): (usize, f64, f64),
     (x, y, width, height): (u32, u32, u32, u32),
 ) -> Option<RegionTest> {
     let n = pixels.len();
@@ -580,10 +613,17 @@ fn region_test(
         return None;
     }
     let se = se.max(floor);
-    let z = if se == 0.0 {
-        d.signum() * f64::INFINITY
+    // The margin is taken off the difference before it meets the noise: the test of
+    // |D| ≤ margin + z·SE (the spread estimator's s comes from the differences about
+    // their own mean, so the margin does not enter it).
+    let margin = tolerance * 0.5 * (mean_a.abs() + mean_b.abs());
+    let excess = d.signum() * (d.abs() - margin).max(0.0);
+    let z = if excess == 0.0 {
+        0.0
+    } else if se == 0.0 {
+        excess.signum() * f64::INFINITY
     } else {
-        d / se
+        excess / se
     };
     let p = match dof {
         _ if !z.is_finite() => 0.0,

@@ -84,6 +84,7 @@ pub fn compare_xyz(
             alpha,
             correction: Correction::Sidak,
             mask,
+            tolerance: 0.0,
         },
     )
     .unwrap()
