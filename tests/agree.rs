@@ -38,13 +38,15 @@
 //! - scenes with participating media have one integrator (`path`); their estimators
 //!   and engines are held to each other in [`media_estimators_and_packet_engines_agree`].
 //!
-//! Size: `HERON_AGREE=full` (`scripts/agree.sh`) renders at 160 pixels on the longer
-//! side with the sample counts of [`Budget::full`], where every pair's whole-image test
+//! Size: `HERON_AGREE=full` (`scripts/agree.sh`) renders at 96 pixels on the longer
+//! side with the sample counts of [`Budget::full`], where most pairs' whole-image test
 //! resolves a 1% difference; the default, run by the test command, at 64 pixels with a
-//! sixteenth of the samples (about two minutes on two cores), which resolves 3–4%.
+//! quarter of those samples (about two minutes on two cores), where most resolve 4%.
 //! Both print one line per pair: the regions tested, the largest |z|, and the
-//! smallest whole-image difference the test would catch. BENCHMARKS.md, "Integrators
-//! agree", records both runs and the known errors each catches when put back.
+//! smallest whole-image difference the test would catch; and per render the time to a
+//! relMSE of 10⁻³ estimated from its variance channels (the README's table of which
+//! integrator converges fastest). BENCHMARKS.md, "Integrators agree", records both runs
+//! and the known error the test catches when put back.
 mod common;
 
 use heron::bsdf::LobeFlags;
@@ -187,29 +189,7 @@ fn all_specular(flags: LobeFlags) -> bool {
 /// what light tracing, which reaches the camera only from a diffuse or glossy vertex,
 /// renders (not glass, mirrors or the sky seen directly).
 fn seen_by_light_tracing(r: &Renderer, scene: &Scene) -> Vec<bool> {
-    let cam = &scene.camera;
-    let mut mask = Vec::with_capacity((cam.width * cam.height) as usize);
-    for y in 0..cam.height {
-        for x in 0..cam.width {
-            mask.push(
-                [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
-                    .iter()
-                    .all(|&(dx, dy)| {
-                        let q = heron::accel::embree::RayQuery {
-                            origin: cam.eye,
-                            dir: cam.direction(x as f32 + dx, y as f32 + dy),
-                            tnear: 0.0,
-                            tfar: f32::INFINITY,
-                        };
-                        r.accel().intersect1(&q).is_some_and(|h| {
-                            let m = scene.shapes[h.geom_id as usize].material as usize;
-                            !scene.materials[m].flags().intersects(LobeFlags::SPECULAR)
-                        })
-                    }),
-            );
-        }
-    }
-    mask
+    common::render::first_hit_mask(r, scene, |m| !m.flags().intersects(LobeFlags::SPECULAR))
 }
 
 /// What a scene holds that decides which pairs are comparable.

@@ -199,29 +199,9 @@ fn light_tracing_and_bdpt_agree_with_the_path_tracer_on_caustic_glass() {
 /// connects only at diffuse vertices, can render (not the glass, not the sky).
 fn diffuse_mask(scene: &Scene) -> Vec<bool> {
     let r = Renderer::new(scene).unwrap();
-    let cam = &scene.camera;
-    let mut mask = Vec::new();
-    for y in 0..cam.height {
-        for x in 0..cam.width {
-            let diffuse =
-                [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
-                    .iter()
-                    .all(|&(dx, dy)| {
-                        let q = heron::accel::embree::RayQuery {
-                            origin: cam.eye,
-                            dir: cam.direction(x as f32 + dx, y as f32 + dy),
-                            tnear: 0.0,
-                            tfar: f32::INFINITY,
-                        };
-                        r.accel().intersect1(&q).is_some_and(|h| {
-                            let m = scene.shapes[h.geom_id as usize].material as usize;
-                            matches!(scene.materials[m], heron::bsdf::Material::Lambertian(_))
-                        })
-                    });
-            mask.push(diffuse);
-        }
-    }
-    mask
+    common::render::first_hit_mask(&r, scene, |m| {
+        matches!(m, heron::bsdf::Material::Lambertian(_))
+    })
 }
 
 /// A ball lens focusing the sun onto a floor (caustic-dispersion): the caustic's paths

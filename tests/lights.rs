@@ -676,13 +676,27 @@ fn light_sampler_by_power_and_uniform() {
     let lights = sampler_lights();
     let b = bounds();
     let phi: Vec<f64> = lights.iter().map(|l| l.phi(&b) as f64).collect();
-    let total: f64 = phi.iter().sum();
-    let by_power: Vec<f64> = phi.iter().map(|p| p / total).collect();
+    // Finite lights (two points and a sphere) and lights at infinity (the sun and the
+    // sky) both emit: each group gets half the choices, split by power within it.
+    let group = |infinite: bool| -> f64 {
+        phi.iter()
+            .zip(&lights)
+            .filter(|(_, l)| l.is_infinite() == infinite)
+            .map(|(p, _)| p)
+            .sum()
+    };
+    let (far, near) = (group(true), group(false));
+    assert!(far > 0.0 && near > 0.0);
+    let by_power: Vec<f64> = phi
+        .iter()
+        .zip(&lights)
+        .map(|(p, l)| 0.5 * p / if l.is_infinite() { far } else { near })
+        .collect();
     let power = LightSampler::new(LightSamplerKind::Power, &lights, &b);
     for (i, &p) in by_power.iter().enumerate() {
         assert!(
             (power.pmf(i) as f64 - p).abs() <= 1e-5 * p + 1e-7,
-            "pmf({i}) = {} vs Φ_i/ΣΦ = {p}",
+            "pmf({i}) = {} vs Φ_i/(2 ΣΦ of its group) = {p}",
             power.pmf(i)
         );
     }

@@ -8,7 +8,7 @@
 //! integrator is broken.
 use heron::compare::{compare, Comparison, Correction, Image, Options};
 use heron::film::Film;
-use heron::render::{render, RenderOptions};
+use heron::render::{render, RenderOptions, Renderer};
 use heron::scene::Scene;
 use heron::settings::IntegratorKind;
 
@@ -88,4 +88,39 @@ pub fn compare_xyz(
         },
     )
     .unwrap()
+}
+
+/// Pixels whose camera ray (pinhole) meets, at all four corners, a surface whose
+/// material `keep` accepts: what light tracing, which reaches the camera only from
+/// diffuse or glossy vertices, can render (`tests/bidir.rs`, `tests/agree.rs`).
+pub fn first_hit_mask(
+    r: &Renderer,
+    scene: &Scene,
+    keep: impl Fn(&heron::bsdf::Material) -> bool,
+) -> Vec<bool> {
+    let cam = &scene.camera;
+    let mut mask = Vec::with_capacity((cam.width * cam.height) as usize);
+    for y in 0..cam.height {
+        for x in 0..cam.width {
+            mask.push(
+                [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                    .iter()
+                    .all(|&(dx, dy)| {
+                        let q = heron::accel::embree::RayQuery {
+                            origin: cam.eye,
+                            dir: cam.direction(x as f32 + dx, y as f32 + dy),
+                            tnear: 0.0,
+                            tfar: f32::INFINITY,
+                        };
+                        r.accel().intersect1(&q).is_some_and(|h| {
+                            keep(
+                                &scene.materials
+                                    [scene.shapes[h.geom_id as usize].material as usize],
+                            )
+                        })
+                    }),
+            );
+        }
+    }
+    mask
 }
