@@ -368,6 +368,63 @@ fn run_jobs(jobs: Vec<Job>, region: u32, resolves: f64) -> Vec<String> {
     failures
 }
 
+/// Whether `mask` leaves any of the test's regions (edge `region`) at least half
+/// covered.
+fn any_region_half_covered(mask: &[bool], scene: &Scene, region: u32) -> bool {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let e = region as usize;
+    (0..h / e).any(|ry| {
+        (0..w / e).any(|rx| {
+            let n = (ry * e..(ry + 1) * e)
+                .flat_map(|y| (rx * e..(rx + 1) * e).map(move |x| y * w + x))
+                .filter(|&i| mask[i])
+                .count();
+            2 * n >= e * e
+        })
+    })
+}
+
+/// Which integrator converges fastest on a scene: each unbiased render's relMSE
+/// estimated from its variance channels, times its time, scaled to relMSE 10⁻³, over
+/// the pixels light tracing sees (all pixels where it sees none).
+fn convergence_costs(
+    stem: &str,
+    renders: &[Option<Result<Rendered, String>>],
+    lt_mask: &[bool],
+) -> Vec<String> {
+    let pixels: Vec<usize> = (0..lt_mask.len())
+        .filter(|&i| lt_mask[i] || !lt_mask.contains(&true))
+        .collect();
+    let mut costs = Vec::new();
+    for (k, x) in KINDS.iter().zip(renders) {
+        let Some(Ok(x)) = x else { continue };
+        let Some(var) = &x.film.variance else {
+            continue;
+        };
+        let rgb = x.film.linear_srgb();
+        let rel: f64 = pixels
+            .iter()
+            .flat_map(|&i| (0..3).map(move |c| (i, c)))
+            .map(|(i, c)| {
+                var[i][c] as f64 / ((rgb[i][c] as f64).powi(2) + heron::compare::REL_MSE_EPSILON)
+            })
+            .sum::<f64>()
+            / (3 * pixels.len()) as f64;
+        costs.push(format!(
+            "{stem} {}: relMSE {rel:.3e} in {:.2} s: {:.3e} s to relMSE 1e-3 ({})",
+            name(*k),
+            x.seconds,
+            x.seconds * rel / 1e-3,
+            if pixels.len() < lt_mask.len() {
+                "light tracing's pixels"
+            } else {
+                "all pixels"
+            }
+        ));
+    }
+    costs
+}
+
 #[test]
 fn every_integrator_agrees_with_every_other_on_every_scene_they_accept() {
     let budget = Budget::from_env();
@@ -381,20 +438,7 @@ fn every_integrator_agrees_with_every_other_on_every_scene_they_accept() {
         let r = Renderer::new(&scene).unwrap();
         let t = traits(&scene);
         let lt_mask = seen_by_light_tracing(&r, &scene);
-        // Whether the mask leaves any region of the test at least half covered.
-        let lt_regions = {
-            let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-            let e = budget.region as usize;
-            (0..h / e).any(|ry| {
-                (0..w / e).any(|rx| {
-                    let n = (ry * e..(ry + 1) * e)
-                        .flat_map(|y| (rx * e..(rx + 1) * e).map(move |x| y * w + x))
-                        .filter(|&i| lt_mask[i])
-                        .count();
-                    2 * n >= e * e
-                })
-            })
-        };
+        let lt_regions = any_region_half_covered(&lt_mask, &scene, budget.region);
         // Each integrator renders once, when a pair first needs it.
         let mut renders: Vec<Option<Result<Rendered, String>>> =
             KINDS.iter().map(|_| None).collect();
@@ -458,39 +502,7 @@ fn every_integrator_agrees_with_every_other_on_every_scene_they_accept() {
                 });
             }
         }
-        // Which integrator converges fastest here: each unbiased render's relMSE
-        // estimated from its variance channels, times its time, over the pixels light
-        // tracing sees (all pixels where it sees none).
-        let pixels: Vec<usize> = (0..lt_mask.len())
-            .filter(|&i| lt_mask[i] || !lt_mask.contains(&true))
-            .collect();
-        for (k, x) in KINDS.iter().zip(&renders) {
-            if let Some(Ok(x)) = x {
-                if let Some(var) = &x.film.variance {
-                    let rgb = x.film.linear_srgb();
-                    let rel: f64 = pixels
-                        .iter()
-                        .flat_map(|&i| (0..3).map(move |c| (i, c)))
-                        .map(|(i, c)| {
-                            var[i][c] as f64
-                                / ((rgb[i][c] as f64).powi(2) + heron::compare::REL_MSE_EPSILON)
-                        })
-                        .sum::<f64>()
-                        / (3 * pixels.len()) as f64;
-                    costs.push(format!(
-                        "{stem} {}: relMSE {rel:.3e} in {:.2} s: {:.3e} s to relMSE 1e-3 ({})",
-                        name(*k),
-                        x.seconds,
-                        x.seconds * rel / 1e-3,
-                        if pixels.len() < lt_mask.len() {
-                            "light tracing's pixels"
-                        } else {
-                            "all pixels"
-                        }
-                    ));
-                }
-            }
-        }
+        costs.extend(convergence_costs(stem, &renders, &lt_mask));
     }
     for c in &costs {
         eprintln!("cost: {c}");
