@@ -94,7 +94,7 @@ fn image_arg(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Image
 /// (array, variance array). b is the reference of the relative errors. region: edge in
 /// pixels (16); alpha: family-wise significance level (0.01); correction: "sidak" or
 /// "bonferroni"; mask: optional H×W booleans, the pixels to compare; tolerance: a
-/// relative margin, mean differences within it allowed (0; e.g. 0.03 for sppm's radius
+/// relative margin, mean differences within it allowed (0; e.g. 0.05 for sppm's radius
 /// bias); heatmap: optional
 /// path of a PNG heat map of the z-scores (written atomically).
 ///

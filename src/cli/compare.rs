@@ -22,7 +22,7 @@ pub(crate) struct CompareArgs {
     correction: String,
     /// An equivalence margin: mean differences within this fraction of the two images'
     /// means are allowed and only the excess is held to the noise (0: the plain
-    /// z-test). For an estimator biased by a stated bound, e.g. 0.03 for sppm.
+    /// z-test). For an estimator biased by a stated bound, e.g. 0.05 for sppm (tests/agree.rs).
     #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
     tolerance: f64,
     /// Write a PNG heat map of the regions' z-scores (red: A brighter, blue: B brighter;
