@@ -172,6 +172,65 @@ fn sensor_film_sampler_and_integrator_convert_with_mitsuba_s_conventions() {
     }
 }
 
+/// Mitsuba measures a focal length's field of view on the diagonal of 36 × 24 mm film,
+/// whatever the image's aspect ratio (src/render/sensor.cpp, `parse_fov`): the image's
+/// half-diagonal on a plane at distance 1 is half of 43.27 mm over the focal length.
+/// heron once took 36 mm along the longer side, which agrees only at 3:2 (issue 38 #7).
+#[test]
+fn a_focal_length_spans_the_film_diagonal_at_every_aspect_ratio() {
+    for (w, h) in [(128, 128), (400, 300), (320, 180), (180, 320), (300, 200)] {
+        for (focal, mm) in [
+            ("", 50.0),
+            ("<string name=\"focal_length\" value=\"35mm\"/>", 35.0),
+        ] {
+            let text = format!(
+                r#"<scene version="3.0.0"><sensor type="perspective">{focal}
+                <film type="hdrfilm"><integer name="width" value="{w}"/><integer name="height" value="{h}"/><rfilter type="box"/></film>
+                </sensor></scene>"#
+            );
+            let (_d, r) = import_text(&text);
+            let t = r.unwrap().table();
+            let d = f(get(&t, "camera.d"));
+            // heron's image plane is 1 high and w/h wide at distance d.
+            let half_diag = 0.5 * (1.0 + (w as f64 / h as f64).powi(2)).sqrt() / d;
+            let want = (36f64 * 36.0 + 24.0 * 24.0).sqrt() / (2.0 * mm);
+            // d is written with 12 significant digits.
+            assert!(
+                (half_diag - want).abs() < 1e-10,
+                "{w}×{h}, {mm} mm: tan of half the diagonal field {half_diag}, want {want}"
+            );
+        }
+    }
+    // fov_axis is read in any case, "smaller" of a square image is x (as Mitsuba), and
+    // both fov and focal_length is refused as Mitsuba refuses it.
+    let sensor = |inner: &str| {
+        format!(
+            r#"<scene version="3.0.0"><sensor type="perspective">{inner}
+            <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/><rfilter type="box"/></film>
+            </sensor></scene>"#
+        )
+    };
+    let tan_y = |inner: &str| {
+        let (_d, r) = import_text(&sensor(inner));
+        0.5 / f(get(&r.unwrap().table(), "camera.d"))
+    };
+    let t30 = (15f64).to_radians().tan();
+    let y = tan_y(r#"<float name="fov" value="30"/><string name="fov_axis" value="Y"/>"#);
+    assert!((y - t30).abs() < 1e-12, "{y}");
+    let y = tan_y(r#"<float name="fov" value="30"/><string name="fov_axis" value="smaller"/>"#);
+    assert!((y - t30).abs() < 1e-12, "{y}");
+    let y = tan_y(r#"<float name="fov" value="30"/><string name="fov_axis" value="larger"/>"#);
+    assert!((y - t30 / 2.0).abs() < 1e-12, "{y}");
+    let (_d, r) = import_text(&sensor(
+        r#"<float name="fov" value="30"/><string name="focal_length" value="35mm"/>"#,
+    ));
+    let e = r
+        .err()
+        .expect("fov and focal_length together are refused")
+        .to_string();
+    assert!(e.contains("expected fov or focal_length, not both"), "{e}");
+}
+
 #[test]
 fn bsdfs_convert_to_heron_materials_and_say_what_changes() {
     let body = r#"

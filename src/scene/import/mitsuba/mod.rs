@@ -374,35 +374,38 @@ impl<'a> Converter<'a> {
             }
         }
         let aspect = width as f64 / height as f64;
-        let fov_axis = p.string("fov_axis")?.unwrap_or("x");
-        // tan of half the vertical field of view (heron's image plane has height 1 at d).
-        let tan_y = match (p.float("fov")?, p.string("focal_length")?) {
-            (Some(fov), _) => {
+        let tan_y = self.tan_half_fov_y(n, &p, aspect)?;
+        let eye = to_world.transform_point3(DVec3::ZERO);
+        let look = to_world.transform_point3(DVec3::Z);
+        let up = to_world.transform_vector3(DVec3::Y);
+        let mut cam = schema::pinhole(eye, look, up, 0.5 / tan_y, (width, height));
+        // A camera constant beyond f64 is left to heron's default.
+        cam.d = cam.d.filter(|d| d.0.is_finite());
+        self.camera = Some(cam);
+        self.finish(&p)
+    }
+
+    /// tan of half the vertical field of view (heron's image plane has height 1 at d),
+    /// as Mitsuba 3's `parse_fov` (src/render/sensor.cpp) reads `fov`, `fov_axis` and
+    /// `focal_length`: without `fov`, the focal length (default 50 mm) is that of 36 × 24
+    /// mm film measured on the film's diagonal, whatever the image's aspect ratio.
+    fn tan_half_fov_y(&mut self, n: &Node, p: &Props, aspect: f64) -> Result<f64, Diagnostic> {
+        let fov = p.float("fov")?;
+        let focal = p.string("focal_length")?;
+        let (tan_half, axis) = match (fov, focal) {
+            (Some(_), Some(_)) => {
+                return Err(
+                    n.diag("expected fov or focal_length, not both (Mitsuba refuses both too)")
+                )
+            }
+            (Some(fov), None) => {
                 if !(fov > 0.0 && fov < 180.0) {
                     return Err(n.diag(format!("fov: expected degrees in (0, 180), got {fov}")));
                 }
-                let t = (0.5 * fov.to_radians()).tan();
-                let axis = match fov_axis {
-                    "smaller" if aspect < 1.0 => "x",
-                    "smaller" => "y",
-                    "larger" if aspect < 1.0 => "y",
-                    "larger" => "x",
-                    a => a,
-                };
-                match axis {
-                    "x" => t / aspect,
-                    "y" => t,
-                    "diagonal" => t / (1.0 + aspect * aspect).sqrt(),
-                    other => {
-                        return Err(n.diag(format!(
-                            "fov_axis: expected x, y, diagonal, smaller or larger, got {other:?}"
-                        )))
-                    }
-                }
+                let axis = p.string("fov_axis")?.unwrap_or("x").to_ascii_lowercase();
+                ((0.5 * fov.to_radians()).tan(), axis)
             }
             (None, f) => {
-                // Mitsuba: the focal length of 36 × 24 mm film, 36 mm along the longer
-                // image axis (checked against Mitsuba 3.9's x_fov).
                 let text = f.unwrap_or("50mm");
                 let mm = text
                     .trim()
@@ -415,22 +418,28 @@ impl<'a> Converter<'a> {
                             "focal_length: expected e.g. \"50mm\", got {text:?}"
                         ))
                     })?;
-                let t_long = 18.0 / mm;
-                if aspect >= 1.0 {
-                    t_long / aspect
-                } else {
-                    t_long
-                }
+                // Half the 36 × 24 mm film's diagonal over the focal length.
+                ((36.0f64.hypot(24.0) * 0.5) / mm, "diagonal".to_string())
             }
         };
-        let eye = to_world.transform_point3(DVec3::ZERO);
-        let look = to_world.transform_point3(DVec3::Z);
-        let up = to_world.transform_vector3(DVec3::Y);
-        let mut cam = schema::pinhole(eye, look, up, 0.5 / tan_y, (width, height));
-        // A camera constant beyond f64 is left to heron's default.
-        cam.d = cam.d.filter(|d| d.0.is_finite());
-        self.camera = Some(cam);
-        self.finish(&p)
+        // Mitsuba resolves smaller and larger with `aspect > 1` (a square image takes x).
+        let axis = match axis.as_str() {
+            "smaller" if aspect > 1.0 => "y",
+            "smaller" => "x",
+            "larger" if aspect > 1.0 => "x",
+            "larger" => "y",
+            a => a,
+        };
+        Ok(match axis {
+            "x" => tan_half / aspect,
+            "y" => tan_half,
+            "diagonal" => tan_half / (1.0 + aspect * aspect).sqrt(),
+            other => {
+                return Err(n.diag(format!(
+                    "fov_axis: expected x, y, diagonal, smaller or larger, got {other:?}"
+                )))
+            }
+        })
     }
 
     fn film(&mut self, f: &'a Node) -> Result<(u32, u32), Diagnostic> {
