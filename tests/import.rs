@@ -649,6 +649,125 @@ fn import_pbrt(text: &str) -> (tempfile::TempDir, heron::error::Result<Imported>
 
 const PBRT_CAMERA: &str = "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\nFilm \"rgb\" \"integer xresolution\" [ 40 ] \"integer yresolution\" [ 20 ]\nWorldBegin\n";
 
+/// X / Z of the image's mean: 0.87 for a grey metal under heron's white (D65) sky.
+fn x_over_z(scene: &heron::scene::Scene) -> f64 {
+    let film = run(scene, IntegratorKind::Path, 4, 1);
+    let (x, z) = film
+        .xyz
+        .iter()
+        .fold((0.0, 0.0), |(x, z), p| (x + p[0] as f64, z + p[2] as f64));
+    x / z
+}
+
+/// pbrt's `rgb eta`/`rgb k` and Mitsuba's `<rgb>`/`<spectrum>` eta and k keep every
+/// channel (issue 38, #8 and #12: pbrt's rgb once kept only its first number, a grey
+/// metal; Mitsuba's were refused). Gold's RGB index (pbrt-v4's and Mitsuba's own
+/// example values) fills the view as a smooth metal under a white sky: it reflects red
+/// far more than blue, X / Z ≈ 1.7 against 0.87 for any grey metal.
+#[test]
+fn rgb_and_spectral_metal_indices_keep_their_colour() {
+    let quad = "Shape \"trianglemesh\" \"point3 P\" [ -4 -4 0  4 -4 0  4 4 0  -4 4 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n";
+    for (eta, k, n_toml) in [
+        (
+            "\"rgb eta\" [ 0.143 0.374 1.442 ]",
+            "\"rgb k\" [ 3.983 2.385 1.603 ]",
+            "[0.143, 0.374, 1.442]",
+        ),
+        (
+            "\"spectrum eta\" [ 300 1.442 450 1.442 550 0.374 650 0.143 900 0.143 ]",
+            "\"spectrum k\" [ 300 1.603 450 1.603 550 2.385 650 3.983 900 3.983 ]",
+            "samples",
+        ),
+    ] {
+        let text = format!("{PBRT_CAMERA}Material \"conductor\" {eta} {k}\n{quad}");
+        let (_d, r) = import_pbrt(&text);
+        let imp = r.unwrap();
+        let n = get(&imp.table(), "materials.conductor-1.metal.n").to_string();
+        assert!(
+            n.replace(' ', "").contains(&n_toml.replace(' ', "")),
+            "{eta}: n = {n}"
+        );
+        let ratio = x_over_z(&load_imported(&imp).unwrap());
+        assert!(ratio > 1.4, "{eta}: X/Z {ratio}");
+    }
+    // Numbers stay a constant index (a grey metal), as before.
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Material \"conductor\" \"float eta\" 0.143 \"float k\" 3.983\n{quad}"
+    ));
+    let ratio = x_over_z(&load_imported(&r.unwrap()).unwrap());
+    assert!((ratio - 0.87).abs() < 0.02, "grey metal X/Z {ratio}");
+
+    // Mitsuba: <rgb> and <spectrum> eta and k.
+    let xml = |eta: &str, k: &str| {
+        format!(
+            r#"<scene version="3.0.0">
+            <sensor type="perspective"><float name="fov" value="30"/>
+                <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+                <film type="hdrfilm"><integer name="width" value="20"/><integer name="height" value="20"/><rfilter type="box"/></film>
+            </sensor>
+            <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>
+            <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform>
+                <bsdf type="conductor">{eta}{k}</bsdf></shape>
+            </scene>"#
+        )
+    };
+    for (eta, k) in [
+        (
+            r#"<rgb name="eta" value="0.143, 0.374, 1.442"/>"#,
+            r#"<rgb name="k" value="3.983, 2.385, 1.603"/>"#,
+        ),
+        (
+            r#"<spectrum name="eta" value="300:1.442, 450:1.442, 550:0.374, 650:0.143, 900:0.143"/>"#,
+            r#"<spectrum name="k" value="300:1.603, 450:1.603, 550:2.385, 650:3.983, 900:3.983"/>"#,
+        ),
+    ] {
+        let (_d, r) = import_text(&xml(eta, k));
+        let ratio = x_over_z(&load_imported(&r.unwrap()).unwrap());
+        assert!(ratio > 1.4, "{eta}: X/Z {ratio}");
+    }
+    // An index that is not one: one-line errors naming the parameter.
+    for (eta, k, want) in [
+        (
+            r#"<float name="eta" value="0"/>"#,
+            "",
+            "eta: expected finite values > 0",
+        ),
+        ("", r#"<float name="k" value="2"/>"#, "k without eta"),
+        (
+            r#"<rgb name="eta" value="0.2, 0.3, 0.4"/><string name="material" value="Au"/>"#,
+            "",
+            "not both",
+        ),
+    ] {
+        let (_d, r) = import_text(&xml(eta, k));
+        let e = r.err().expect(want).to_string();
+        assert!(e.contains(want) && e.lines().count() == 1, "{e}");
+    }
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Material \"conductor\" \"rgb eta\" [ 0 0 0 ] \"rgb k\" [ 1 1 1 ]\n{quad}"
+    ));
+    let e = r.err().expect("a zero rgb eta").to_string();
+    assert!(e.contains("rgb eta") && e.contains("> 0"), "{e}");
+    // In heron's own format, the same forms.
+    let toml = |metal: &str| {
+        format!("[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\n[materials.m]\ntype = \"conductor\"\nmetal = {metal}\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n")
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let good = "{ n = [0.143, 0.374, 1.442], k = { samples = [[400, 1.6], [700, 4.0]] } }";
+    load_scene(&write(dir.path(), "s.toml", &toml(good))).unwrap();
+    for bad in [
+        "{ n = [0.2, 0.3, -0.4], k = 1 }",
+        "{ n = 0, k = [1, 2, 3] }",
+        "{ n = { spectrum = \"D65\" }, k = 1 }",
+    ] {
+        let e = load_scene(&write(dir.path(), "s.toml", &toml(bad)))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("metal") && e.lines().count() == 1, "{bad}: {e}");
+    }
+}
+
 #[test]
 fn pbrt_materials_lights_and_shapes_convert_with_pbrt_s_conventions() {
     let text = format!(

@@ -42,6 +42,26 @@ pub fn rgb_to_illuminant(rgb: [f32; 3]) -> DenseSpectrum {
     s.mul(d65_unit()).scaled(m)
 }
 
+/// An unbounded spectrum (a conductor's n or k given in RGB) as pbrt-v4's
+/// `RGBUnboundedSpectrum` (Pharr, Jakob & Humphreys, PBR 4th ed., §4.6.6): with
+/// m = max(r, g, b), the reflectance-style spectrum of rgb / (2m), times 2m. The factor
+/// 2 keeps the fitted sigmoid away from its saturation at 1, where it cannot follow a
+/// colour's shape; the result reproduces the RGB curve's values roughly, not through a
+/// film (n and k are not colours seen by an observer). Negative or NaN components
+/// count as 0.
+pub fn rgb_to_unbounded(rgb: [f32; 3]) -> DenseSpectrum {
+    let rgb = rgb.map(|v| if v.is_nan() { 0.0 } else { v.max(0.0) });
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m <= 0.0 {
+        return DenseSpectrum::constant(0.0);
+    }
+    let scale = 2.0 * m;
+    srgb_table()
+        .coefficients(rgb.map(|v| v / scale))
+        .to_dense()
+        .scaled(scale)
+}
+
 /// Named spectra a scene may use: "E" (equal energy, 1 at every wavelength), and the
 /// CIE illuminants "D65" and "A", each scaled to Y = 1.
 pub const NAMED_SPECTRA: &[&str] = &["E", "D65", "A"];

@@ -140,6 +140,62 @@ impl Emission {
     }
 }
 
+impl Colour {
+    /// A conductor's n or k over wavelength ([`MetalSpec::Curves`]): a number is
+    /// constant, `[r, g, b]` is uplifted unbounded (`rgb_to_unbounded`, as pbrt-v4 and
+    /// Mitsuba's RGB variants mean an RGB index: a value per colour channel), samples are
+    /// themselves times their scale.
+    pub fn index_spectrum(&self) -> DenseSpectrum {
+        match self {
+            Colour::Grey(g) => DenseSpectrum::constant(*g as f32),
+            Colour::Rgb(rgb) => crate::spectrum::uplift::rgb_to_unbounded(rgb.map(|x| x as f32)),
+            _ => self
+                .named_spectrum()
+                .unwrap_or_else(|| DenseSpectrum::constant(0.0)),
+        }
+    }
+}
+
+/// Reads one of a conductor's n (`real_part`) or k as a number, `[r, g, b]` or
+/// `{ samples = ... }`: n must be > 0 at every wavelength, k ≥ 0.
+pub(super) fn index_curve(v: &toml::Value, real_part: bool) -> Result<Colour, String> {
+    let c = colour(v).map_err(|_| {
+        format!(
+            "expected a number, [r, g, b] or {{ samples = [[nm, value], ...], scale = number }}, got {}",
+            show(v)
+        )
+    })?;
+    if matches!(c, Colour::Named { .. } | Colour::Blackbody { .. }) {
+        return Err(format!(
+            "expected a number, [r, g, b] or {{ samples = ... }} (an index is not an illuminant), got {}",
+            show(v)
+        ));
+    }
+    c.check_index(real_part)
+        .map_err(|e| format!("{e}, got {}", show(v)))?;
+    Ok(c)
+}
+
+impl Colour {
+    /// An index curve's range: n > 0 at every wavelength (`real_part`), k ≥ 0, finite.
+    pub fn check_index(&self, real_part: bool) -> Result<(), String> {
+        if let Colour::Rgb(c) = self {
+            if c.iter().any(|x| !(*x >= 0.0)) {
+                return Err("expected [r, g, b] components >= 0".into());
+            }
+        }
+        let s = self.index_spectrum();
+        let (lo, hi) = (s.min_value(), s.max_value());
+        if !hi.is_finite() || (real_part && !(lo > 0.0)) || (!real_part && !(lo >= 0.0)) {
+            let want = if real_part { "> 0" } else { ">= 0" };
+            return Err(format!(
+                "expected finite values {want} at every wavelength (the spectrum reaches {lo})"
+            ));
+        }
+        Ok(())
+    }
+}
+
 pub(super) const COLOUR_FORMS: &str =
     "a colour: a number, [r, g, b], { spectrum = \"E\" | \"D65\" | \"A\", scale = number }, { blackbody = kelvin, scale = number } or { samples = [[nm, value], ...], scale = number }";
 

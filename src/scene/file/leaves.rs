@@ -306,7 +306,7 @@ impl<'de> Deserialize<'de> for MetalSpec {
         let v = raw(d)?;
         let expected = || {
             format!(
-                "expected a metal of the catalogue ({}), {{ table = \"nk.csv\" }} or {{ n = .., k = .. }}, got {}",
+                "expected a metal of the catalogue ({}), {{ table = \"nk.csv\" }} or {{ n = .., k = .. }} (each a number, [r, g, b] or {{ samples = [[nm, value], ...] }}), got {}",
                 METAL_NAMES.join(", "),
                 show(&v)
             )
@@ -336,6 +336,16 @@ impl<'de> Deserialize<'de> for MetalSpec {
                         "expected n > 0 and k >= 0, got {}",
                         show(&v)
                     ))),
+                    (2, _, _) if t.contains_key("n") && t.contains_key("k") => {
+                        let curve = |key: &str| {
+                            super::colour::index_curve(&t[key], key == "n")
+                                .map_err(|e| D::Error::custom(format!("{key}: {e}")))
+                        };
+                        Ok(MetalSpec::Curves {
+                            n: curve("n")?,
+                            k: curve("k")?,
+                        })
+                    }
                     _ => Err(D::Error::custom(expected())),
                 }
             }
@@ -486,6 +496,12 @@ impl Serialize for MetalSpec {
             MetalSpec::Named(name) => s.serialize_str(name),
             MetalSpec::Table(file) => one_key(s, "table", file),
             MetalSpec::Constant { n, k } => two_keys(s, ("n", *n), ("k", *k)),
+            MetalSpec::Curves { n, k } => {
+                let mut m = s.serialize_map(Some(2))?;
+                m.serialize_entry("n", n)?;
+                m.serialize_entry("k", k)?;
+                m.end()
+            }
         }
     }
 }

@@ -383,6 +383,13 @@ pub enum MetalSpec {
         n: f64,
         k: f64,
     },
+    /// n and k over wavelength, each a number, `[r, g, b]` (uplifted unbounded, as
+    /// pbrt-v4's `RGBUnboundedSpectrum`) or `{ samples = [[nm, value], ...] }`; at least
+    /// one of them is not a plain number (that is [`MetalSpec::Constant`]).
+    Curves {
+        n: Colour,
+        k: Colour,
+    },
 }
 
 /// The seed's modified Phong model, optionally over a refractive base (`ior`).

@@ -163,6 +163,15 @@ fn build_metal(
             n: DenseSpectrum::constant(*n as f32),
             k: DenseSpectrum::constant(*k as f32),
         }),
+        MetalSpec::Curves { n, k } => {
+            // Imported scenes arrive as SceneFile without the TOML reader's checks.
+            n.check_index(true).map_err(|e| format!("{at}.n: {e}"))?;
+            k.check_index(false).map_err(|e| format!("{at}.k: {e}"))?;
+            Ok(ComplexIor {
+                n: n.index_spectrum(),
+                k: k.index_spectrum(),
+            })
+        }
     }
 }
 

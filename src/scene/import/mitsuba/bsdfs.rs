@@ -3,7 +3,8 @@
 //! `mask`, `bumpmap`, `normalmap`), with the indices and roughnesses they name.
 use super::*;
 use crate::scene::file::{
-    ConductorFile, DielectricFile, GlossyFile, IorSpec, LambertianFile, MetalSpec, MirrorFile,
+    Colour, ConductorFile, DielectricFile, GlossyFile, IorSpec, LambertianFile, MetalSpec,
+    MirrorFile,
 };
 
 impl<'a> Converter<'a> {
@@ -177,28 +178,57 @@ impl<'a> Converter<'a> {
     ) -> Result<MaterialFile, Diagnostic> {
         Ok({
             let material = p.string("material")?;
-            let eta = p.float("eta");
-            let k = p.float("k");
-            let (eta, k) = (eta?, k?);
-            let metal = match (material, eta, k) {
-            (_, Some(n_), Some(k_)) => Some(MetalSpec::Constant {
-                n: schema::tidy(n_),
-                k: schema::tidy(k_),
-            }),
-            (Some(m), None, None) if METALS.contains(&m) => Some(MetalSpec::Named(m.into())),
-            (None | Some("none"), None, None) => None,
-            (Some(m), None, None) => {
-                return Err(n.diag(format!(
-                    "material: expected one of the metals heron tabulates ({}), \"none\", or eta and k as numbers, got {m:?}",
-                    METALS.join(", ")
-                )))
-            }
-            _ => {
-                return Err(n.diag(
-                    "expected both eta and k as <float> (spectral and RGB eta/k are not supported yet)",
-                ))
-            }
-        };
+            // Mitsuba's eta and k are unbounded textures: a float, an rgb (uplifted as
+            // pbrt-v4's RGBUnboundedSpectrum; Mitsuba's RGB variants use it per channel,
+            // its spectral ones clamp it to [0, 1] first, which heron does not copy) or a
+            // spectrum. Given eta, a missing k is 1 (conductor.cpp).
+            let index = |name: &str, default: f64, real: bool| {
+                let c = match p.colour(name) {
+                    Ok(c) => c.map(|c| c.colour()),
+                    Err(ColourError::Bad(d) | ColourError::Unsupported(d)) => return Err(d),
+                };
+                if let Some(c) = &c {
+                    if matches!(c, Colour::Named { .. } | Colour::Blackbody { .. }) {
+                        return Err(n.diag(format!(
+                            "{name}: expected a float, rgb or spectrum table, not an illuminant"
+                        )));
+                    }
+                    c.check_index(real)
+                        .map_err(|m| n.diag(format!("{name}: {m}")))?;
+                }
+                Ok(c.unwrap_or(Colour::Grey(default)))
+            };
+            let given = p.get("eta").is_some() || p.get("k").is_some();
+            let metal = match (material, given) {
+                (Some(m), true) if m != "none" => {
+                    return Err(n.diag(format!(
+                        "expected eta and k or material, not both (Mitsuba refuses both too), got material {m:?}"
+                    )))
+                }
+                (_, true) => {
+                    if p.get("eta").is_none() {
+                        // Mitsuba's eta is then 0, outside heron's conductor (n > 0).
+                        return Err(n.diag("k without eta: expected eta as well (Mitsuba's default eta 0 is not a refractive index heron takes)"));
+                    }
+                    let eta = index("eta", 0.0, true)?;
+                    let k = index("k", 1.0, false)?;
+                    Some(match (eta, k) {
+                        (Colour::Grey(n_), Colour::Grey(k_)) => MetalSpec::Constant {
+                            n: schema::tidy(n_),
+                            k: schema::tidy(k_),
+                        },
+                        (n_, k_) => MetalSpec::Curves { n: n_, k: k_ },
+                    })
+                }
+                (Some(m), false) if METALS.contains(&m) => Some(MetalSpec::Named(m.into())),
+                (None | Some("none"), false) => None,
+                (Some(m), false) => {
+                    return Err(n.diag(format!(
+                        "material: expected one of the metals heron tabulates ({}), \"none\", or eta and k, got {m:?}",
+                        METALS.join(", ")
+                    )))
+                }
+            };
             if let Some(c) = p.get("specular_reflectance") {
                 self.warn(c.diag("specular_reflectance: heron's conductor has no such factor, ignored (1 is used)"))?;
             }

@@ -4,8 +4,8 @@
 use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
-    ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec, LambertianFile,
-    MetalSpec, PointLightFile, SpotLightFile, UnitNumber,
+    Colour, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec,
+    LambertianFile, MetalSpec, PointLightFile, SpotLightFile, UnitNumber,
 };
 
 impl Conv {
@@ -185,9 +185,8 @@ impl Conv {
             "conductor" => {
                 let metal = match (p.get("eta"), p.get("k"), p.get("reflectance")) {
                     (None, None, None) => MetalSpec::Named("Cu".into()),
-                    (Some(e), Some(k), _) => match (e.nums.first(), k.nums.first(), e.strs.first(), k.strs.first()) {
-                        (Some(n), Some(kk), _, _) => MetalSpec::Constant { n: tidy(*n), k: tidy(*kk) },
-                        (_, _, Some(a), Some(b)) => {
+                    (Some(e), Some(k_param), _) => match (e.strs.first().filter(|s| s.starts_with("metal-")), k_param.strs.first().filter(|s| s.starts_with("metal-"))) {
+                        (Some(a), Some(b)) => {
                             let m = a.strip_prefix("metal-").and_then(|x| x.strip_suffix("-eta"));
                             let m2 = b.strip_prefix("metal-").and_then(|x| x.strip_suffix("-k"));
                             match (m, m2) {
@@ -195,7 +194,20 @@ impl Conv {
                                 _ => return Err(self.diag(path, e.line, format!("conductor: expected metal-Ag/Al/Au/Cu-eta and -k spectra or numbers, got {a:?} and {b:?}"))),
                             }
                         }
-                        _ => return Err(self.diag(path, e.line, "conductor: expected eta and k both as numbers or both as named spectra")),
+                        (None, None) => {
+                            // rgb, λ value pairs, files and numbers: pbrt-v4 reads them as
+                            // unbounded spectra (an rgb as RGBUnboundedSpectrum).
+                            let n = self.colour(path, p, "eta", 1.0)?.colour();
+                            let k = self.colour(path, p, "k", 0.0)?.colour();
+                            for (c, q, real) in [(&n, e, true), (&k, k_param, false)] {
+                                c.check_index(real).map_err(|m| self.diag(path, q.line, format!("conductor \"{} {}\": {m}", q.ty, q.name)))?;
+                            }
+                            match (&n, &k) {
+                                (Colour::Grey(n), Colour::Grey(k)) => MetalSpec::Constant { n: *n, k: *k },
+                                _ => MetalSpec::Curves { n, k },
+                            }
+                        }
+                        _ => return Err(self.diag(path, e.line, "conductor: expected eta and k both as named metal spectra or both as numbers, rgb or spectra")),
                     },
                     (_, _, Some(q)) => return Err(self.diag(path, q.line, "conductor: \"reflectance\" (an artist's colour) is not supported; give eta and k")),
                     (Some(q), None, _) | (None, Some(q), _) => return Err(self.diag(path, q.line, "conductor: expected both eta and k")),
