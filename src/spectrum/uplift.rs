@@ -86,6 +86,27 @@ mod tests {
     }
 
     #[test]
+    fn an_unbounded_uplift_keeps_greys_scales_linearly_and_follows_the_channels() {
+        // A grey index g is exactly constant: rgb / 2g is the grey 0.5.
+        let g = rgb_to_unbounded([2.5; 3]);
+        assert!((g.min_value() - 2.5).abs() < 1e-5 && (g.max_value() - 2.5).abs() < 1e-5);
+        // Scaling the channels scales the spectrum.
+        let a = rgb_to_unbounded([0.143, 0.374, 1.442]);
+        let b = rgb_to_unbounded([0.286, 0.748, 2.884]);
+        for l in [400.0, 500.0, 600.0, 700.0] {
+            assert!((2.0 * a.eval(l) - b.eval(l)).abs() < 1e-5 * b.eval(l).max(1.0));
+        }
+        // Gold's n: low in the red, high in the blue, near the channels' values.
+        assert!(
+            a.eval(620.0) < 0.3 && a.eval(450.0) > 1.0,
+            "{} {}",
+            a.eval(620.0),
+            a.eval(450.0)
+        );
+        assert_eq!(rgb_to_unbounded([0.0, -1.0, f32::NAN]).max_value(), 0.0);
+    }
+
+    #[test]
     fn reflectances_stay_within_zero_and_one() {
         for r in 0..=10 {
             for g in 0..=10 {
