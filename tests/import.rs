@@ -225,8 +225,7 @@ fn a_focal_length_spans_the_film_diagonal_at_every_aspect_ratio() {
         r#"<float name="fov" value="30"/><string name="focal_length" value="35mm"/>"#,
     ));
     let e = r
-        .err()
-        .expect("fov and focal_length together are refused")
+        .expect_err("fov and focal_length together are refused")
         .to_string();
     assert!(e.contains("expected fov or focal_length, not both"), "{e}");
 }
@@ -740,13 +739,13 @@ fn rgb_and_spectral_metal_indices_keep_their_colour() {
         ),
     ] {
         let (_d, r) = import_text(&xml(eta, k));
-        let e = r.err().expect(want).to_string();
+        let e = r.expect_err(want).to_string();
         assert!(e.contains(want) && e.lines().count() == 1, "{e}");
     }
     let (_d, r) = import_pbrt(&format!(
         "{PBRT_CAMERA}Material \"conductor\" \"rgb eta\" [ 0 0 0 ] \"rgb k\" [ 1 1 1 ]\n{quad}"
     ));
-    let e = r.err().expect("a zero rgb eta").to_string();
+    let e = r.expect_err("a zero rgb eta").to_string();
     assert!(e.contains("rgb eta") && e.contains("> 0"), "{e}");
     // In heron's own format, the same forms.
     let toml = |metal: &str| {
@@ -819,7 +818,7 @@ fn pbrt_errors_and_warnings_name_the_line() {
         assert!(e.contains(&format!("scene.pbrt: line {line}: ")) && e.contains(want), "{e}");
     }
     let (_d, r) = import_pbrt(&format!(
-        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"\nShape \"disk\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
+        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"\nShape \"cylinder\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
     ));
     let imp = r.unwrap();
     let has = |line: u32, s: &str| {
@@ -829,11 +828,115 @@ fn pbrt_errors_and_warnings_name_the_line() {
     };
     assert!(has(6, "Texture is not supported"), "{:?}", imp.warnings);
     assert!(
-        has(7, "Shape \"disk\" is not supported"),
+        has(7, "Shape \"cylinder\" is not supported"),
         "{:?}",
         imp.warnings
     );
     assert!(has(8, "zmin"), "{:?}", imp.warnings);
+}
+
+/// pbrt-v4's `disk` (issue 38, #10: a staircase scene lost five area lights to it): a
+/// fan, a ring with `innerradius`, a sector with `phimax`, at `height`, facing its
+/// object's +z (turned by Rotate, flipped by ReverseOrientation), emitting as an area
+/// light; and Mitsuba's top-level `<emitter type="area" id>` referenced from a shape
+/// (#9, Mitsuba's own cbox-rgb.xml) emits as the same emitter written inside it.
+#[test]
+fn pbrt_disks_and_referenced_mitsuba_area_emitters_import_as_lights() {
+    let n = heron::scene::import::DISK_SEGMENTS;
+    let pi = std::f64::consts::PI;
+    let fan = n as f64 / (2.0 * pi) * (2.0 * pi / n as f64).sin(); // polygon / circle
+    for (params, extra, want_area, want_tris) in [
+        ("\"float radius\" 0.5", "", 0.25 * pi * fan, n),
+        (
+            "\"float radius\" 0.5 \"float innerradius\" 0.2",
+            "",
+            (0.25 - 0.04) * pi * fan,
+            2 * n,
+        ),
+        (
+            "\"float radius\" 0.5 \"float phimax\" 180",
+            "",
+            0.125 * pi * fan,
+            n / 2,
+        ),
+        (
+            "\"float radius\" 0.5 \"float height\" 0.25",
+            "ReverseOrientation\n",
+            0.25 * pi * fan,
+            n,
+        ),
+    ] {
+        let text = format!(
+            "{PBRT_CAMERA}AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 4 4 4 ]\n{extra}Translate 0 1 0\nRotate 90 1 0 0\nShape \"disk\" {params}\nAttributeEnd\n"
+        );
+        let (_d, r) = import_pbrt(&text);
+        let imp = r.unwrap();
+        assert!(imp.warnings.is_empty(), "{params}: {:?}", imp.warnings);
+        let t = imp.table();
+        let tris = shapes(&t);
+        assert_eq!(tris.len(), want_tris, "{params}");
+        let mut area = 0.0;
+        for s in tris {
+            assert_eq!(v3(&s["emission"]), DVec3::splat(4.0));
+            let v = vertices(s);
+            let c = (v[1] - v[0]).cross(v[2] - v[0]);
+            area += 0.5 * c.length();
+            // Rotate 90 about x turns +z to −y; the height moves the disk along it.
+            let y = if extra.is_empty() { -1.0 } else { 1.0 };
+            assert!(
+                c.normalize().abs_diff_eq(DVec3::new(0.0, y, 0.0), 1e-9),
+                "{params}: {c}"
+            );
+            let h = if params.contains("height") { 0.75 } else { 1.0 };
+            assert!(v.iter().all(|p| (p.y - h).abs() < 1e-9), "{params}: {v:?}");
+        }
+        assert!(
+            (area / want_area - 1.0).abs() < 1e-9,
+            "{params}: area {area}, want {want_area}"
+        );
+        load_imported(&imp).unwrap();
+    }
+    for bad in [
+        "\"float radius\" 0.5 \"float innerradius\" 0.5",
+        "\"float phimax\" 0",
+        "\"float radius\" -1",
+    ] {
+        let (_d, r) = import_pbrt(&format!("{PBRT_CAMERA}Shape \"disk\" {bad}\n"));
+        let e = r.expect_err(bad).to_string();
+        assert!(
+            e.contains("line 6") && e.contains("Shape \"disk\": expected"),
+            "{e}"
+        );
+    }
+
+    // Mitsuba: an area emitter by reference, as written inline.
+    let light = r#"<rgb name="radiance" value="3, 2, 1"/>"#;
+    let referenced = scene(&format!(
+        r#"<emitter type="area" id="lamp">{light}</emitter>
+        <shape type="rectangle"><ref id="lamp"/><transform name="to_world"><translate y="1"/></transform></shape>
+        <shape type="sphere"><ref id="lamp"/></shape>"#
+    ));
+    let inline = scene(&format!(
+        r#"<shape type="rectangle"><emitter type="area">{light}</emitter><transform name="to_world"><translate y="1"/></transform></shape>
+        <shape type="sphere"><emitter type="area">{light}</emitter></shape>"#
+    ));
+    let (_d, a) = import_text(&referenced);
+    let (_d2, b) = import_text(&inline);
+    let (a, b) = (a.unwrap(), b.unwrap());
+    assert!(a.warnings.is_empty(), "{:?}", a.warnings);
+    assert_eq!(a.table(), b.table());
+    // Declared and never used: said, not an error.
+    let (_d, r) = import_text(&scene(&format!(
+        r#"<emitter type="area" id="lamp">{light}</emitter><shape type="sphere"/>"#
+    )));
+    let imp = r.unwrap();
+    assert!(
+        imp.warnings
+            .iter()
+            .any(|w| w.message.contains("no shape references")),
+        "{:?}",
+        imp.warnings
+    );
 }
 
 /// The heron shape tables of a converted scene.

@@ -91,6 +91,13 @@ struct Converter<'a> {
     render: Option<RenderFile>,
 }
 
+/// Whether any `<ref id="id"/>` in the tree under `n` names `id`.
+fn references(n: &Node, id: &str) -> bool {
+    n.children
+        .iter()
+        .any(|c| (c.tag == "ref" && c.attr("id") == Some(id)) || references(c, id))
+}
+
 /// Converts the document `root` (from [`super::xml::read_document`]) read from `path`.
 pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diagnostic> {
     let mut ids = HashMap::new();
@@ -115,6 +122,16 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
             "integrator" => c.integrator(child)?,
             "sensor" => c.sensor(child)?,
             "shape" => c.shape(child)?,
+            // An area emitter with an id is converted in the shapes that reference it
+            // (Mitsuba's own cbox-rgb.xml declares its light so).
+            "emitter" if child.attr("type") == Some("area") && child.attr("id").is_some() => {
+                let id = child.attr("id").unwrap_or_default();
+                if !references(root, id) {
+                    c.warn(child.diag(format!(
+                        "an area emitter that no shape references (<ref id=\"{id}\"/>), ignored"
+                    )))?;
+                }
+            }
             "emitter" => {
                 c.emitter(child, None)?;
             }

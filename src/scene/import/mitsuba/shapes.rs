@@ -56,17 +56,9 @@ impl<'a> Converter<'a> {
                 }
             }
             "disk" => {
-                let c = to_world.transform_point3(DVec3::ZERO);
-                for i in 0..DISK_SEGMENTS {
-                    let a0 = std::f64::consts::TAU * i as f64 / DISK_SEGMENTS as f64;
-                    let a1 = std::f64::consts::TAU * (i + 1) as f64 / DISK_SEGMENTS as f64;
-                    let v0 = to_world.transform_point3(DVec3::new(a0.cos(), a0.sin(), 0.0));
-                    let v1 = to_world.transform_point3(DVec3::new(a1.cos(), a1.sin(), 0.0));
-                    // Counter-clockwise about the transformed +z, as `quad` keeps it.
-                    let swap = flip ^ (to_world.determinant() < 0.0);
-                    let verts = if swap { [c, v1, v0] } else { [c, v0, v1] };
-                    entries.push(schema::triangle(verts));
-                }
+                let swap = flip ^ (to_world.determinant() < 0.0);
+                let tau = std::f64::consts::TAU;
+                entries.extend(schema::disk(&to_world, 1.0, 0.0, 0.0, tau, swap, DISK_SEGMENTS));
             }
             "sphere" => {
                 let center = p.point("center")?.unwrap_or(DVec3::ZERO);

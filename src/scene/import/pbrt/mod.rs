@@ -61,6 +61,13 @@ enum Geom {
     Ply {
         file: String,
     },
+    /// pbrt-v4's `disk` (a partial annulus at z = height), as triangles.
+    Disk {
+        height: f64,
+        radius: f64,
+        inner: f64,
+        phi_max: f64,
+    },
 }
 
 /// A `Shape` with the graphics state current at it (pbrt-v4's `ShapeSceneEntity`: the

@@ -518,11 +518,40 @@ impl Conv {
                     file: rel.to_string_lossy().replace('\\', "/"),
                 }
             }
+            "disk" => {
+                let radius = p.float("radius").unwrap_or(1.0);
+                let inner = p.float("innerradius").unwrap_or(0.0);
+                let height = p.float("height").unwrap_or(0.0);
+                let phi_max = p.float("phimax").unwrap_or(360.0);
+                if !(radius > 0.0
+                    && radius.is_finite()
+                    && inner >= 0.0
+                    && inner < radius
+                    && height.is_finite())
+                {
+                    return Err(self.diag(path, line, format!("Shape \"disk\": expected 0 <= innerradius < radius and a finite height, got radius {radius}, innerradius {inner}, height {height}")));
+                }
+                if !(phi_max > 0.0 && phi_max <= 360.0) {
+                    return Err(self.diag(
+                        path,
+                        line,
+                        format!(
+                            "Shape \"disk\": expected phimax in (0, 360] degrees, got {phi_max}"
+                        ),
+                    ));
+                }
+                Geom::Disk {
+                    height,
+                    radius,
+                    inner,
+                    phi_max: phi_max.to_radians(),
+                }
+            }
             other => {
                 for q in &p.0 {
                     q.used.set(true);
                 }
-                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
+                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, disk, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
                 return Ok(None);
             }
         }))
@@ -601,6 +630,17 @@ impl Conv {
                         entries.push(schema::triangle(t.map(|k| verts[k])));
                     }
                 }
+            }
+            Geom::Disk {
+                height,
+                radius,
+                inner,
+                phi_max,
+            } => {
+                let segs = crate::scene::import::DISK_SEGMENTS;
+                entries.extend(schema::disk(
+                    &m, *radius, *inner, *height, *phi_max, flip, segs,
+                ));
             }
             Geom::Ply { file: f } => {
                 if flip {
