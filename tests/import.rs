@@ -939,6 +939,77 @@ fn pbrt_disks_and_referenced_mitsuba_area_emitters_import_as_lights() {
     );
 }
 
+/// pbrt's dielectric `eta` is a relative index and may be below 1 (issue 38, #13): a
+/// bubble of air in water, eta 0.75, becomes index 1 inside 1.3333 outside, the same
+/// relative index; 0 or less is an error at its line.
+#[test]
+fn a_pbrt_relative_index_below_one_keeps_its_ratio() {
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Material \"dielectric\" \"float eta\" 0.75\nShape \"sphere\"\n"
+    ));
+    let imp = r.unwrap();
+    let t = imp.table();
+    let inside = f(get(&t, "materials.dielectric-1.ior"));
+    let outside = f(get(&t, "materials.dielectric-1.outside_ior"));
+    // Written with 12 significant digits.
+    assert!(
+        (inside / outside - 0.75).abs() < 1e-10,
+        "{inside} / {outside}"
+    );
+    assert!(inside >= 1.0 && outside >= 1.0);
+    load_imported(&imp).unwrap();
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Material \"dielectric\"\n  \"float eta\" -1\nShape \"sphere\"\n"
+    ));
+    let e = r.expect_err("a negative eta").to_string();
+    assert!(
+        e.contains("line 7") && e.contains("expected a relative index > 0"),
+        "{e}"
+    );
+}
+
+/// Mitsuba's `moment` renders its nested integrator, pbrt's `simplepath` and
+/// `randomwalk` are path tracers of the same expectation (issue 38, #5): none falls back
+/// to the Whitted tracer any more.
+#[test]
+fn wrapping_and_simpler_integrators_become_the_path_tracer() {
+    let (_d, r) = import_text(&scene(
+        r#"<integrator type="moment"><integrator type="path"><integer name="max_depth" value="5"/></integrator></integrator><shape type="sphere"/>"#,
+    ));
+    let imp = r.unwrap();
+    let t = imp.table();
+    assert_eq!(get(&t, "render.integrator").as_str(), Some("path"));
+    assert_eq!(get(&t, "render.max_depth").as_integer(), Some(4));
+    assert!(
+        imp.warnings.iter().any(|w| w
+            .message
+            .contains("moment: the nested integrator is rendered")),
+        "{:?}",
+        imp.warnings
+    );
+    let (_d, r) = import_text(&scene(
+        r#"<integrator type="moment"/><shape type="sphere"/>"#,
+    ));
+    let e = r
+        .expect_err("moment without a nested integrator")
+        .to_string();
+    assert!(e.contains("expected a nested <integrator>"), "{e}");
+    for kind in ["simplepath", "randomwalk"] {
+        let (_d, r) = import_pbrt(&format!(
+            "Integrator \"{kind}\" \"integer maxdepth\" 3 \"bool samplelights\" true\n{PBRT_CAMERA}Shape \"sphere\"\n"
+        ));
+        let imp = r.unwrap();
+        let t = imp.table();
+        assert_eq!(
+            get(&t, "render.integrator").as_str(),
+            Some("path"),
+            "{kind}"
+        );
+        assert_eq!(get(&t, "render.max_depth").as_integer(), Some(3), "{kind}");
+        assert!(imp.warnings.is_empty(), "{kind}: {:?}", imp.warnings);
+    }
+}
+
 /// The heron shape tables of a converted scene.
 fn shapes(t: &toml::Table) -> &Vec<toml::Value> {
     get(t, "shapes").as_array().unwrap()

@@ -300,6 +300,22 @@ impl<'a> Converter<'a> {
     fn integrator(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
         let p = Props::new(n);
         let kind = Self::plugin(n)?;
+        if kind == "moment" {
+            // Mitsuba's moment integrator renders its nested integrators and adds their
+            // second moments as extra channels: heron renders the first, and its
+            // variance channels (--variance) are the per-pixel second moment's use.
+            let nested = p.objects(&["integrator"]);
+            let Some(first) = nested.first() else {
+                return Err(n.diag("moment: expected a nested <integrator>"));
+            };
+            let first = self.resolve(first)?;
+            self.warn(n.diag(format!(
+                "moment: the nested integrator is rendered{}; its second-moment channels are not written (heron's --variance writes per-pixel variance)",
+                if nested.len() > 1 { " (the first of them)" } else { "" }
+            )))?;
+            self.integrator(first)?;
+            return self.finish(&p);
+        }
         let (integrator, depth) = match kind {
             "path" | "volpath" | "volpathmis" => ("path", p.integer("max_depth")?.unwrap_or(-1)),
             // Mitsuba's `direct` is emitters seen directly plus one bounce of direct

@@ -297,12 +297,14 @@ impl Conv {
     fn integrator(&mut self, d: &Directive) -> Result<(), Diagnostic> {
         let (path, line, p) = (d.path, d.line(), d.params());
         let kind = match d.name().as_str() {
-            "path" | "volpath" => "path",
+            // simplepath (no MIS) and randomwalk (BSDF sampling only) estimate the same
+            // image as path, with more noise: heron's path tracer renders it.
+            "path" | "volpath" | "simplepath" | "randomwalk" => "path",
             "bdpt" => "bdpt",
             "sppm" => "sppm",
             "lightpath" => "lighttrace",
             other => {
-                return self.warn(self.diag(path, line, format!("Integrator {other:?} is not supported (path, volpath, bdpt, sppm, lightpath are), heron's default is used")));
+                return self.warn(self.diag(path, line, format!("Integrator {other:?} is not supported (path, volpath, simplepath, randomwalk, bdpt, sppm, lightpath are), heron's default is used")));
             }
         };
         self.render().integrator = Some(kind.into());
@@ -317,8 +319,9 @@ impl Conv {
         let depth = schema::positive_count("Integrator: maxdepth", depth)
             .map_err(|m| self.diag(path, line, m))?;
         self.render().max_depth = Some(depth);
-        p.get("regularize");
-        p.get("lightsampler");
+        for k in ["regularize", "lightsampler", "samplelights", "samplebsdf"] {
+            p.get(k);
+        }
         Ok(())
     }
 

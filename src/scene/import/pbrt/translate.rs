@@ -175,11 +175,29 @@ impl Conv {
                 };
                 let roughness = self.roughness(p);
                 p.get("remaproughness");
+                // pbrt's eta is the relative index inside / outside; below 1 (an air
+                // bubble in water, say) heron writes it as a unit index inside 1 / eta
+                // outside, the same relative index.
+                let (ior, outside_ior) = match ior {
+                    IorSpec::Constant(e) if e > 0.0 && e < 1.0 => (
+                        IorSpec::Constant(1.0),
+                        Some(IorSpec::Constant(tidy(1.0 / e))),
+                    ),
+                    IorSpec::Constant(e) if !(e > 0.0 && e.is_finite()) => {
+                        let at = p.get("eta").map_or(line, |q| q.line);
+                        return Err(self.diag(
+                            path,
+                            at,
+                            format!("\"eta\": expected a relative index > 0, got {e}"),
+                        ));
+                    }
+                    other => (other, None),
+                };
                 MaterialFile::Dielectric(DielectricFile {
                     ior,
                     fresnel: None,
                     roughness,
-                    outside_ior: None,
+                    outside_ior,
                 })
             }
             "conductor" => {
