@@ -1010,6 +1010,43 @@ fn wrapping_and_simpler_integrators_become_the_path_tracer() {
     }
 }
 
+/// A pbrt mesh with zero-area triangles among good ones keeps the good ones, with one
+/// warning at its line; a mesh of none is dropped with a warning, not an error that
+/// rejects the scene (issue 38, #13).
+#[test]
+fn zero_area_pbrt_triangles_are_dropped_with_a_warning() {
+    let good = "0 0 0  1 0 0  0 1 0";
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Shape \"trianglemesh\" \"point3 P\" [ {good}  2 2 2  3 3 3 ] \"integer indices\" [ 0 1 2  0 3 4  1 1 2 ]\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 1 1  2 2 2 ] \"integer indices\" [ 0 1 2 ]\nShape \"sphere\"\n"
+    ));
+    let imp = r.unwrap();
+    let t = imp.table();
+    let kinds: Vec<_> = shapes(&t)
+        .iter()
+        .map(|s| s["type"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["triangle", "sphere"]);
+    let said = |line: u32, s: &str| {
+        imp.warnings
+            .iter()
+            .any(|w| w.line == line && w.message.contains(s))
+    };
+    assert!(
+        said(6, "2 triangle(s) of zero area dropped (1 kept)"),
+        "{:?}",
+        imp.warnings
+    );
+    assert!(
+        said(
+            7,
+            "1 triangle(s) of zero area dropped (the shape is dropped)"
+        ),
+        "{:?}",
+        imp.warnings
+    );
+    load_imported(&imp).unwrap();
+}
+
 /// The heron shape tables of a converted scene.
 fn shapes(t: &toml::Table) -> &Vec<toml::Value> {
     get(t, "shapes").as_array().unwrap()

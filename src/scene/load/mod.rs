@@ -43,7 +43,7 @@ mod sky;
 pub use materials::ior_from_value;
 pub use media::MEDIUM_DEFAULT_NODES;
 pub use shapes::scene_bounds;
-pub(crate) use shapes::{mesh_shapes, shapes_of_groups};
+pub(crate) use shapes::{is_degenerate, mesh_shapes, shapes_of_groups};
 
 use super::file::SceneFile;
 use super::{Scene, SceneParts};

@@ -372,7 +372,7 @@ pub(super) fn cross_overflows(a: Vec3, b: Vec3, c: Vec3) -> bool {
 
 /// Zero area up to f32 rounding: |e1 × e2| ≤ ε |e1| |e2| (the angle between the edges is
 /// below about 1e-7 rad), or a zero-length edge.
-pub(super) fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
+pub(crate) fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
     let (e1, e2) = (b - a, c - a);
     let cross = e1.cross(e2).length();
     let limit = f32::EPSILON * e1.length() * e2.length();

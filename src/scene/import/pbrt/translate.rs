@@ -625,6 +625,13 @@ impl Conv {
                 faces,
             } => {
                 let verts: Vec<DVec3> = points.iter().map(|&q| m.transform_point3(q)).collect();
+                // heron's own triangles must have an area; an imported mesh loses its
+                // zero-area ones (never hit) with one warning, as pbrt renders it.
+                let flat = |t: [usize; 3]| {
+                    let v = t.map(|k| schema::point(verts[k]).get());
+                    crate::scene::load::is_degenerate(v[0], v[1], v[2])
+                };
+                let (before, mut dropped) = (entries.len(), 0usize);
                 for ix in faces {
                     // A flat parallelogram patch (p00, p10, p01, p11) is heron's quad,
                     // normal (p10 − p00) × (p01 − p00) as pbrt's; others two triangles.
@@ -644,9 +651,22 @@ impl Conv {
                         vec![[ix[0], ix[1], ix[3]], [ix[0], ix[3], ix[2]]]
                     };
                     for t in tris {
+                        if flat(t) {
+                            dropped += 1;
+                            continue;
+                        }
                         let t = if flip { [t[0], t[2], t[1]] } else { t };
                         entries.push(schema::triangle(t.map(|k| verts[k])));
                     }
+                }
+                if dropped > 0 {
+                    let kept = entries.len() - before;
+                    let what = if kept == 0 {
+                        "the shape is dropped".to_string()
+                    } else {
+                        format!("{kept} kept")
+                    };
+                    self.warn(self.diag(&file, line, format!("{ctx}Shape {kind:?}: {dropped} triangle(s) of zero area dropped ({what})")))?;
                 }
             }
             Geom::Disk {
