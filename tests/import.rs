@@ -570,6 +570,70 @@ fn includes_are_spliced_and_a_cycle_is_an_error() {
     assert!(e.contains("includes nested more than"), "{e}");
 }
 
+/// Files are looked up as Mitsuba 3's resolver does (issue 38, #2): in the `<path>`
+/// folders (the last declared first), then the main scene's folder, and only then the
+/// folder of an included file that names them; an include is looked for in the
+/// including file's folder, then the same way.
+#[test]
+fn files_are_found_through_path_folders_and_the_main_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("assets/meshes")).unwrap();
+    std::fs::create_dir_all(d.join("parts")).unwrap();
+    std::fs::create_dir_all(d.join("other")).unwrap();
+    let tri = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    write(&d.join("assets/meshes"), "tri.ply", tri);
+    // The same name in the included file's own folder loses to the <path> folder.
+    write(
+        &d.join("parts"),
+        "tri.ply",
+        &tri.replace("0 1 0\n3", "0 2 0\n3"),
+    );
+    write(d, "grey.spd", "400 0.25\n700 0.25\n");
+    // The included file names a mesh through <path> and a spectrum in the main folder;
+    // it is itself found through <path>.
+    write(
+        &d.join("other"),
+        "shapes.xml",
+        r#"<scene version="3.0.0"><shape type="ply"><string name="filename" value="tri.ply"/>
+        <bsdf type="diffuse"><spectrum name="reflectance" filename="grey.spd"/></bsdf></shape></scene>"#,
+    );
+    let p = write(
+        d,
+        "scene.xml",
+        &scene(
+            r#"<path value="other"/><path value="assets/meshes"/><include filename="shapes.xml"/>"#,
+        ),
+    );
+    let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+    let t = imp.table();
+    assert_eq!(
+        get(&t, "shapes.0.file").as_str(),
+        Some("assets/meshes/tri.ply")
+    );
+    assert_eq!(load_imported(&imp).unwrap().shapes.len(), 1);
+    // A <path> that is not a folder, or not at the top: one-line errors at its line.
+    for (body, want) in [
+        (
+            r#"<path value="missing"/>"#,
+            "<path>: folder \"missing\" not found",
+        ),
+        (
+            r#"<shape type="sphere"><path value="assets"/></shape>"#,
+            "<path> must be a child of the root",
+        ),
+    ] {
+        let p = write(d, "bad.xml", &scene(body));
+        let e = import_scene(&p, &ImportOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(want) && e.contains("bad.xml") && e.lines().count() == 1,
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn heron_convert_writes_a_scene_that_renders_like_the_xml() {
     let dir = tempfile::tempdir().unwrap();

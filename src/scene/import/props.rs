@@ -24,6 +24,9 @@ const VALUE_TAGS: &[&str] = &[
 pub struct Props<'a> {
     pub node: &'a Node,
     used: Vec<Cell<bool>>,
+    /// Where files are looked for ([`super::xml::find_file`]): the `<path>` folders and
+    /// the main scene's folder; without them, the naming file's folder only.
+    files: Option<(Vec<std::path::PathBuf>, std::path::PathBuf)>,
 }
 
 /// A colour property in the forms of heron's scene files: grey, RGB, a tabulated
@@ -232,6 +235,23 @@ impl<'a> Props<'a> {
         Props {
             node,
             used: node.children.iter().map(|_| Cell::new(false)).collect(),
+            files: None,
+        }
+    }
+
+    /// These properties with Mitsuba's file lookup: `folders` (the `<path>`s, in
+    /// declaration order) and the main scene's folder `main`.
+    pub fn with_files(mut self, folders: &[std::path::PathBuf], main: &std::path::Path) -> Self {
+        self.files = Some((folders.to_vec(), main.to_path_buf()));
+        self
+    }
+
+    /// The file `name` names as Mitsuba finds it, `n` the element naming it.
+    pub fn find(&self, n: &Node, name: &str) -> std::path::PathBuf {
+        let own = n.file.parent().unwrap_or(std::path::Path::new(""));
+        match &self.files {
+            Some((folders, main)) => super::xml::find_file(name, folders, main, own),
+            None => own.join(name),
         }
     }
 
@@ -370,8 +390,7 @@ impl<'a> Props<'a> {
             }
             "spectrum" if n.attr("filename").is_some() => {
                 let f = n.attr("filename").unwrap_or("");
-                let folder = n.file.parent().unwrap_or(std::path::Path::new(""));
-                let pairs = read_spd(&folder.join(f)).map_err(bad)?;
+                let pairs = read_spd(&self.find(n, f)).map_err(bad)?;
                 Ok(Some(ColourValue::Samples {
                     samples: mitsuba_samples(&pairs),
                     scale: 1.0,

@@ -77,15 +77,64 @@ impl Node {
 /// defaults substituted; `defines` override `<default>` values (as Mitsuba's `-D`).
 pub fn read_document(path: &Path, defines: &BTreeMap<String, String>) -> Result<Node, Diagnostic> {
     let mut params = defines.clone();
-    read_file(path, &mut params, defines, 0, None)
+    let main = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let mut reading = Reading {
+        params: &mut params,
+        defines,
+        folders: Vec::new(),
+        main,
+    };
+    read_file(path, &mut reading, 0, None)
+}
+
+/// What reading a document carries from file to file: the `<default>`s seen so far
+/// (includes share their parent's), the caller's overrides, the `<path>` folders
+/// declared so far and the main scene's folder.
+struct Reading<'r> {
+    params: &'r mut BTreeMap<String, String>,
+    defines: &'r BTreeMap<String, String>,
+    folders: Vec<PathBuf>,
+    main: PathBuf,
+}
+
+/// Where a relative file name is looked for, as Mitsuba 3's file resolver does
+/// (src/core/parser.cpp, `fresolver.cpp`): the `<path>` folders, the one declared last
+/// first, then the main scene's folder; heron then tries the folder of the file that
+/// names it (an included file's own folder), which Mitsuba does not. The first
+/// candidate that exists, or the first candidate when none does (its error names it).
+pub fn find_file(name: &str, folders: &[PathBuf], main: &Path, own: &Path) -> PathBuf {
+    let name = Path::new(name);
+    if name.is_absolute() {
+        return name.to_path_buf();
+    }
+    let candidates: Vec<PathBuf> = folders
+        .iter()
+        .rev()
+        .map(|f| f.join(name))
+        .chain([main.join(name), own.join(name)])
+        .collect();
+    candidates
+        .iter()
+        .find(|c| c.exists())
+        .unwrap_or(&candidates[0])
+        .clone()
+}
+
+/// The `<path value="…">` folders of a document read by [`read_document`], in the order
+/// they were declared, each already resolved.
+pub fn path_folders(root: &Node) -> Vec<PathBuf> {
+    root.children
+        .iter()
+        .filter(|c| c.tag == "path")
+        .filter_map(|c| c.attr("value").map(PathBuf::from))
+        .collect()
 }
 
 /// Reads one file; `params` holds the `<default>`s seen so far (includes share their
 /// parent's), `defines` the caller's overrides, `from` the including element.
 fn read_file(
     path: &Path,
-    params: &mut BTreeMap<String, String>,
-    defines: &BTreeMap<String, String>,
+    r: &mut Reading,
     depth: usize,
     from: Option<&Node>,
 ) -> Result<Node, Diagnostic> {
@@ -105,7 +154,7 @@ fn read_file(
     }
     let text = std::fs::read_to_string(path)
         .map_err(|e| at_from(format!("cannot read {}: {e}", path.display())))?;
-    parse_text(&text, path, params, defines, depth)
+    parse_text(&text, path, r, depth)
 }
 
 /// The document of `text`, read as if from `path` (includes resolve from its folder).
@@ -115,16 +164,17 @@ pub fn read_document_from_str(
     defines: &BTreeMap<String, String>,
 ) -> Result<Node, Diagnostic> {
     let mut params = defines.clone();
-    parse_text(text, path, &mut params, defines, 0)
+    let main = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let mut reading = Reading {
+        params: &mut params,
+        defines,
+        folders: Vec::new(),
+        main,
+    };
+    parse_text(text, path, &mut reading, 0)
 }
 
-fn parse_text(
-    text: &str,
-    path: &Path,
-    params: &mut BTreeMap<String, String>,
-    defines: &BTreeMap<String, String>,
-    depth: usize,
-) -> Result<Node, Diagnostic> {
+fn parse_text(text: &str, path: &Path, r: &mut Reading, depth: usize) -> Result<Node, Diagnostic> {
     let file = Arc::new(path.to_path_buf());
     let doc = roxmltree::Document::parse(text).map_err(|e| {
         let pos = e.pos();
@@ -148,7 +198,7 @@ fn parse_text(
         });
     }
     let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    convert(&doc, root, &file, &base, params, defines, depth)
+    convert(&doc, root, &file, &base, r, depth)
 }
 
 fn convert(
@@ -156,8 +206,7 @@ fn convert(
     el: roxmltree::Node,
     file: &Arc<PathBuf>,
     base: &Path,
-    params: &mut BTreeMap<String, String>,
-    defines: &BTreeMap<String, String>,
+    r: &mut Reading,
     depth: usize,
 ) -> Result<Node, Diagnostic> {
     let line = doc.text_pos_at(el.range().start).row;
@@ -170,28 +219,62 @@ fn convert(
         children: Vec::new(),
     };
     for a in el.attributes() {
-        let value = substitute(a.value(), params).map_err(|m| node.diag(m))?;
+        let value = substitute(a.value(), r.params).map_err(|m| node.diag(m))?;
         node.attrs.push((a.name().to_string(), value));
     }
     for child in el.children().filter(|c| c.is_element()) {
-        let c = convert(doc, child, file, base, params, defines, depth)?;
+        let mut c = convert(doc, child, file, base, r, depth)?;
         match c.tag.as_str() {
             "default" => {
                 let (Some(name), Some(value)) = (c.attr("name"), c.attr("value")) else {
                     return Err(c.diag("expected the attributes name and value"));
                 };
                 // A define given by the caller wins over the file's default.
-                if !defines.contains_key(name) {
-                    params.insert(name.to_string(), value.to_string());
+                if !r.defines.contains_key(name) {
+                    r.params.insert(name.to_string(), value.to_string());
                 }
             }
             "include" => {
                 let Some(f) = c.attr("filename") else {
                     return Err(c.diag("expected the attribute filename"));
                 };
-                let included = read_file(&base.join(f), params, defines, depth + 1, Some(&c))?;
+                // Mitsuba looks in the including file's folder first, then where every
+                // other file is looked for.
+                let own = base.join(f);
+                let found = if own.exists() {
+                    own
+                } else {
+                    find_file(f, &r.folders, &r.main, base)
+                };
+                let included = read_file(&found, r, depth + 1, Some(&c))?;
                 node.children.extend(included.children);
             }
+            // A resource folder (Mitsuba's <path>, a child of the root only): relative to
+            // the declaring file's folder, else looked up as files are; it must exist.
+            // Its value becomes the resolved folder.
+            "path" if el == doc.root_element() => {
+                let Some(v) = c.attr("value").map(str::to_string) else {
+                    return Err(c.diag("expected the attribute value"));
+                };
+                let own = base.join(&v);
+                let found = if own.is_dir() {
+                    own
+                } else {
+                    find_file(&v, &r.folders, &r.main, base)
+                };
+                if !found.is_dir() {
+                    return Err(c.diag(format!(
+                        "<path>: folder {v:?} not found (looked in {})",
+                        base.display()
+                    )));
+                }
+                c.attrs.retain(|(k, _)| k != "value");
+                c.attrs
+                    .push(("value".into(), found.to_string_lossy().into_owned()));
+                r.folders.push(found);
+                node.children.push(c);
+            }
+            "path" => return Err(c.diag("<path> must be a child of the root <scene>")),
             _ => node.children.push(c),
         }
     }

@@ -57,7 +57,7 @@ impl<'a> Converter<'a> {
         n: &'a Node,
     ) -> Result<Option<MaterialFile>, Diagnostic> {
         let kind = Self::plugin(n)?;
-        let p = Props::new(n);
+        let p = self.props(n);
         let t = match kind {
             "twosided" | "mask" | "bumpmap" | "normalmap" => return self.wrapper_bsdf(n, &p, kind),
             "diffuse" => self.diffuse(&p)?,

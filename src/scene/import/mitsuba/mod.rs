@@ -75,6 +75,8 @@ struct Converter<'a> {
     /// The folder of the top-level file; mesh paths are written relative to it.
     base: PathBuf,
     strict: bool,
+    /// The `<path>` folders, in declaration order (files are looked up in them).
+    folders: Vec<PathBuf>,
     ids: HashMap<&'a str, &'a Node>,
     warnings: Vec<Diagnostic>,
     materials: BTreeMap<String, MaterialFile>,
@@ -105,6 +107,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
     let mut c = Converter {
         base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
         strict,
+        folders: super::xml::path_folders(root),
         ids,
         warnings: Vec::new(),
         materials: BTreeMap::new(),
@@ -135,6 +138,8 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
             "emitter" => {
                 c.emitter(child, None)?;
             }
+            // Read with the document (xml.rs): the folders files are looked up in.
+            "path" => {}
             // Named objects at the top level are converted where they are referenced.
             "bsdf" | "texture" | "spectrum" | "rgb" | "float" if child.attr("id").is_some() => {}
             "bsdf" => {
@@ -202,6 +207,17 @@ impl<'a> Converter<'a> {
     }
 
     /// Warnings for what `p`'s object held that nothing read.
+    /// The properties of `n`, looking files up as Mitsuba does.
+    fn props(&self, n: &'a Node) -> Props<'a> {
+        Props::new(n).with_files(&self.folders, &self.base)
+    }
+
+    /// The file `name` that element `n` names, as Mitsuba looks it up.
+    fn find(&self, n: &Node, name: &str) -> PathBuf {
+        let own = n.file.parent().unwrap_or(Path::new(""));
+        super::xml::find_file(name, &self.folders, &self.base, own)
+    }
+
     fn finish(&mut self, p: &Props) -> Result<(), Diagnostic> {
         for d in p.unread() {
             self.warn(d)?;
@@ -245,12 +261,11 @@ impl<'a> Converter<'a> {
             return Ok(None);
         }
         p.get(name);
-        let tp = Props::new(t);
+        let tp = self.props(t);
         let Some(file) = tp.string("filename")? else {
             return Err(t.diag("expected <string name=\"filename\" value=\"…\"/>"));
         };
-        let folder = t.file.parent().unwrap_or(Path::new(""));
-        let rel = relative_to(&folder.join(file), &self.base);
+        let rel = relative_to(&self.find(t, file), &self.base);
         for (key, default) in [("filter_type", "bilinear"), ("wrap_mode", "repeat")] {
             if let Some(v) = tp.string(key)? {
                 if v != default {
@@ -298,7 +313,7 @@ impl<'a> Converter<'a> {
     // ---- integrator, sensor, film, sampler ---------------------------------------
 
     fn integrator(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
-        let p = Props::new(n);
+        let p = self.props(n);
         let kind = Self::plugin(n)?;
         if kind == "moment" {
             // Mitsuba's moment integrator renders its nested integrators and adds their
@@ -376,7 +391,7 @@ impl<'a> Converter<'a> {
                 "expected a perspective sensor (or thinlens, rendered as a pinhole), got {kind:?}"
             )));
         }
-        let p = Props::new(n);
+        let p = self.props(n);
         let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         if to_world.determinant() < 0.0 {
             self.warn(n.diag(
@@ -480,7 +495,7 @@ impl<'a> Converter<'a> {
         if kind != "hdrfilm" && kind != "specfilm" {
             self.unsupported(f, "heron writes an OpenEXR film like hdrfilm; read as one")?;
         }
-        let p = Props::new(f);
+        let p = self.props(f);
         let width = p.integer("width")?.unwrap_or(768);
         let height = p.integer("height")?.unwrap_or(576);
         for (k, v) in [("width", width), ("height", height)] {
@@ -524,7 +539,7 @@ impl<'a> Converter<'a> {
     }
 
     fn sampler(&mut self, s: &'a Node) -> Result<(), Diagnostic> {
-        let p = Props::new(s);
+        let p = self.props(s);
         if let Some(spp) = p.integer("sample_count")? {
             if spp < 1 {
                 return Err(s.diag(format!("sample_count: expected at least 1, got {spp}")));

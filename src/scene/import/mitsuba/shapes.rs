@@ -6,7 +6,7 @@ use crate::scene::file::{DirectionalLightFile, PointLightFile, SpotLightFile};
 impl<'a> Converter<'a> {
     pub(super) fn shape(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
         let kind = Self::plugin(n)?;
-        let p = Props::new(n);
+        let p = self.props(n);
         let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         let flip = p.boolean("flip_normals")?.unwrap_or(false);
         // The BSDF and an area emitter.
@@ -83,9 +83,7 @@ impl<'a> Converter<'a> {
                 let Some(file) = p.string("filename")? else {
                     return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
                 };
-                let folder = n.file.parent().unwrap_or(Path::new(""));
-                let full = folder.join(file);
-                let rel = relative_to(&full, &self.base);
+                let rel = relative_to(&self.find(n, file), &self.base);
                 if flip {
                     self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
                 }
@@ -127,7 +125,7 @@ impl<'a> Converter<'a> {
         shape: Option<&Node>,
     ) -> Result<Option<Emission>, Diagnostic> {
         let kind = Self::plugin(n)?;
-        let p = Props::new(n);
+        let p = self.props(n);
         let out = match (kind, shape) {
             ("area", Some(_)) => {
                 let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
@@ -210,8 +208,7 @@ impl<'a> Converter<'a> {
                 let Some(file) = p.string("filename")? else {
                     return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
                 };
-                let folder = n.file.parent().unwrap_or(Path::new(""));
-                let rel = relative_to(&folder.join(file), &self.base);
+                let rel = relative_to(&self.find(n, file), &self.base);
                 let scale = p.float("scale")?.unwrap_or(1.0);
                 if !(scale >= 0.0) {
                     return Err(n.diag(format!("scale: expected a number ≥ 0, got {scale}")));
