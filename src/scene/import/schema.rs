@@ -127,6 +127,7 @@ pub fn quad(origin: DVec3, edge1: DVec3, edge2: DVec3) -> ShapeFile {
 pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> ShapeFile {
     ShapeFile::Mesh(MeshFile {
         file,
+        shape_index: None,
         material: None,
         groups: BTreeMap::new(),
         scale: None,
