@@ -139,3 +139,14 @@ pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> Sh
         medium: None,
     })
 }
+
+/// Shape `shape_index` of a Mitsuba serialized file (relative to the scene's folder),
+/// placed by `transform` unless it is the identity. Its texture coordinates are read as
+/// they are, as Mitsuba reads them.
+pub fn serialized_mesh(file: String, transform: DMat4, shape_index: Option<u32>) -> ShapeFile {
+    let mut shape = mesh(file, transform, None);
+    if let ShapeFile::Mesh(m) = &mut shape {
+        m.shape_index = shape_index;
+    }
+    shape
+}
