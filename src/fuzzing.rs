@@ -389,6 +389,7 @@ fn imported_scene(r: crate::Result<crate::scene::import::Imported>) -> Outcome {
 fn mesh_entry(file: &str) -> MeshFile {
     MeshFile {
         file: file.into(),
+        shape_index: None,
         material: Some("m".into()),
         groups: BTreeMap::new(),
         scale: None,

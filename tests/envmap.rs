@@ -5,7 +5,7 @@
 //! tests/python/test_mitsuba_xml.py.)
 mod common;
 
-use common::images::write_exr;
+use common::images::{write_exr, write_pfm};
 
 use common::render::{mean_se, run};
 use heron::scene::load_scene;
@@ -119,6 +119,41 @@ fn the_map_is_seen_where_its_layout_and_transform_put_it() {
     assert!(c[1] < 1e-6 && c[0].abs() < 1e-6, "{c:?}");
 }
 
+/// A PFM map (colour in both byte orders, and grey) is the EXR of the same texels: the
+/// same image, bit for bit, so its rows come in the EXR's order (a pattern that differs
+/// from top to bottom and left to right, reflected by the sphere in every direction).
+#[test]
+fn a_pfm_map_renders_the_pixels_of_the_exr_of_the_same_texels() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let colour = |i: usize, j: usize| {
+        [
+            0.1 + 0.2 * j as f32,
+            0.05 * i as f32,
+            1.0 / (1 + i + j) as f32,
+        ]
+    };
+    let grey = |i: usize, j: usize| [0.3 * j as f32 + 0.01 * i as f32; 3];
+    write_exr(&d.join("colour.exr"), 16, 8, colour);
+    write_exr(&d.join("grey.exr"), 16, 8, grey);
+    write_pfm(&d.join("le.pfm"), 16, 8, false, true, colour);
+    write_pfm(&d.join("be.pfm"), 16, 8, false, false, colour);
+    write_pfm(&d.join("grey.pfm"), 16, 8, true, true, grey);
+    let render = |map: &str| {
+        let s = load_scene(&scene(d, &format!("map = \"{map}\""), SPHERE, 8)).unwrap();
+        run(&s, IntegratorKind::Path, 4, 3).xyz
+    };
+    let want = render("colour.exr");
+    assert_eq!(render("le.pfm"), want);
+    assert_eq!(render("be.pfm"), want);
+    assert_eq!(render("grey.pfm"), render("grey.exr"));
+    // Upside down, it is another image.
+    write_pfm(&d.join("flipped.pfm"), 16, 8, false, true, |i, j| {
+        colour(i, 7 - j)
+    });
+    assert_ne!(render("flipped.pfm"), want);
+}
+
 fn load_err(path: &Path) -> String {
     match load_scene(path) {
         Ok(_) => panic!("expected an error for {}", path.display()),
@@ -144,11 +179,19 @@ fn bad_maps_are_one_line_errors_naming_the_key_and_the_file() {
             [1.0; 3]
         }
     });
+    std::fs::write(d.join("sky.tga"), b"not an image").unwrap();
     std::fs::write(d.join("sky.jpg"), b"not an image").unwrap();
     std::fs::write(d.join("bad.exr"), b"not an exr").unwrap();
+    write_pfm(&d.join("sq.pfm"), 8, 8, false, true, |_, _| [1.0; 3]);
+    let pfm = std::fs::read(d.join("sq.pfm")).unwrap();
+    std::fs::write(d.join("short.pfm"), &pfm[..pfm.len() - 5]).unwrap();
+    std::fs::write(d.join("p6.pfm"), b"P6\n8 8\n255\n").unwrap();
     let cases: &[(&str, &[&str])] = &[
         ("map = \"missing.exr\"", &["environment.map: ", "missing.exr"]),
-        ("map = \"sky.jpg\"", &["environment.map: ", "expected an image file ending in .exr, .hdr or .png"]),
+        ("map = \"sky.tga\"", &["environment.map: ", "expected an image file ending in .exr, .hdr, .pfm, .png, .jpg or .jpeg, got \"tga\""]),
+        ("map = \"sky.jpg\"", &["environment.map: ", "sky.jpg: cannot decode it"]),
+        ("map = \"short.pfm\"", &["environment.map: ", "short.pfm: the pixels end early: 8 × 8 × 3 floats need 768 bytes, the file has 763"]),
+        ("map = \"p6.pfm\"", &["environment.map: ", "p6.pfm: expected the PFM header PF (colour) or Pf (grey), got \"P6\""]),
         ("map = \"bad.exr\"", &["environment.map: ", "bad.exr: cannot read it as OpenEXR"]),
         ("map = \"nan.exr\"", &["environment.map: ", "pixel (2, 1)", "expected finite values ≥ 0"]),
         ("map = \"wide.exr\"\nmapping = \"equal-area\"", &["environment.map: an equal-area map is square, wide.exr is 16 × 8"]),

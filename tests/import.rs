@@ -517,7 +517,9 @@ fn malformed_files_are_one_line_errors_with_file_and_line() {
         (&scene("<shape type=\"sphere\"><float name=\"radius\" value=\"one\"/></shape>"), "line 7: <float name=\"radius\">: value: expected a finite number, got \"one\""),
         (&scene("<shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>"), "$r is not defined"),
         (&scene("<shape type=\"sphere\"><transform name=\"to_world\"><scale x=\"1\" y=\"2\"/></transform></shape>"), "heron's spheres take a uniform scale only"),
-        (&scene("<shape type=\"serialized\"/>"), "save the mesh as PLY"),
+        (&scene("<shape type=\"serialized\"/>"), "line 7: <shape type=\"serialized\">: expected <string name=\"filename\""),
+        (&scene("<shape type=\"serialized\"><string name=\"filename\" value=\"missing.serialized\"/><integer name=\"shape_index\" value=\"-1\"/></shape>"), "shape_index: expected an integer ≥ 0, got -1"),
+        (&scene("<shape type=\"serialized\"><string name=\"filename\" value=\"missing.serialized\"/></shape>"), "cannot read the mesh file"),
         (&scene("<bsdf type=\"conductor\" id=\"m\"><string name=\"material\" value=\"Unobtainium\"/></bsdf><shape type=\"sphere\"><ref id=\"m\"/></shape>"), "expected one of the metals heron tabulates (Ag, Al, Au, Cu)"),
         (&scene("<bsdf type=\"dielectric\" id=\"g\"><string name=\"int_ior\" value=\"glass\"/></bsdf><shape type=\"sphere\"><ref id=\"g\"/></shape>"), "int_ior: expected a number or one of Mitsuba's named indices"),
         ("<scene version=\"3.0.0\"><shape type=\"sphere\"/></scene>", "expected a <sensor type=\"perspective\">"),
@@ -540,7 +542,12 @@ fn malformed_files_are_one_line_errors_with_file_and_line() {
         };
         assert!(e.contains(want), "want {want:?}, got {e:?}\nfor {text}");
         assert!(!e.contains('\n'), "{e}");
-        assert!(e.contains("scene.xml") || e.contains("missing.obj"), "{e}");
+        assert!(
+            e.contains("scene.xml")
+                || e.contains("missing.obj")
+                || e.contains("missing.serialized"),
+            "{e}"
+        );
     }
 }
 

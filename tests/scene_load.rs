@@ -464,7 +464,7 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[[lights]]\ntype = \"directional\"\ndirection = [0, 0, 0]\nradiance = 1\n",
      &["lights[0].direction: expected a non-zero vector"]),
     ("", "[[shapes]]\ntype = \"mesh\"\nfile = \"\"\nmaterial = \"floor\"\n",
-     &["shapes[0].file: expected the path of an OBJ file, got an empty string"]),
+     &["shapes[0].file: expected the path of a mesh file (.obj, .ply or .serialized), got an empty string"]),
     ("", "[[shapes]]\ntype = \"mesh\"\nfile = \"m.obj\"\nmaterial = \"floor\"\nscale = 0\n",
      &["shapes[0].scale: expected a positive finite number, got 0"]),
     ("", "[[shapes]]\ntype = \"mesh\"\nfile = \"m.obj\"\nmaterial = \"floor\"\ngroups = { a = \"gold\" }\n",

@@ -168,8 +168,8 @@ fn texture_errors_name_the_material_and_the_file() {
             "materials.m.texture: ",
         ),
         (
-            "type = \"lambertian\"\ntexture = \"t.jpg\"",
-            "expected an image file ending in .exr, .hdr or .png",
+            "type = \"lambertian\"\ntexture = \"t.gif\"",
+            "expected an image file ending in .exr, .hdr, .pfm, .png, .jpg or .jpeg, got \"gif\"",
         ),
     ] {
         let e = load_scene(&scene(dir.path(), m)).unwrap_err().to_string();
@@ -254,4 +254,37 @@ fn obj_and_ply_texture_coordinates_place_the_texture_as_the_quad_does() {
         e.contains("line 5: texture coordinate index 5 out of range"),
         "{e}"
     );
+}
+
+/// A JPEG texture is sRGB-decoded as a PNG is: it renders the pixels of the PNG of its own
+/// decoded 8-bit values (JPEG is lossy, so the PNG is made from what the JPEG decodes to).
+#[test]
+fn a_jpeg_texture_renders_the_pixels_of_the_png_of_its_decoded_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let img = image::RgbImage::from_fn(32, 16, |i, j| {
+        let t = TEXELS[(j as usize / 8) * 4 + i as usize / 8];
+        image::Rgb(t.map(|c| (c * 255.0) as u8))
+    });
+    let mut f = std::fs::File::create(d.join("t.jpeg")).unwrap();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut f, 90)
+        .encode_image(&img)
+        .unwrap();
+    drop(f);
+    image::open(d.join("t.jpeg"))
+        .unwrap()
+        .to_rgb8()
+        .save(d.join("t.png"))
+        .unwrap();
+    let render = |file: &str| {
+        let s = load_scene(&scene(
+            d,
+            &format!("type = \"lambertian\"\ntexture = \"{file}\""),
+        ))
+        .unwrap();
+        run(&s, IntegratorKind::Path, 4, 2).xyz
+    };
+    let want = render("t.png");
+    std::fs::rename(d.join("t.jpeg"), d.join("t.JPG")).unwrap();
+    assert_eq!(render("t.JPG"), want);
 }

@@ -598,12 +598,17 @@ pub struct WaveFile {
     pub phase: f32,
 }
 
-/// A triangle mesh: a Wavefront OBJ file, or a PLY file (by its `.ply` extension).
+/// A triangle mesh: a Wavefront OBJ file, a PLY file (by its `.ply` extension) or a
+/// Mitsuba serialized file (by its `.serialized` extension).
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshFile {
     /// Relative to the folder of the scene file.
     pub file: String,
+    /// Which shape of a serialized file (which may hold several), from 0 (the default,
+    /// as Mitsuba's `shape_index`); an error for other files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_index: Option<u32>,
     /// Material of the OBJ objects/groups not listed in `groups`; may be left out when
     /// `groups` covers every object of the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -622,7 +627,8 @@ pub struct MeshFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<Vec<Vec<f64>>>,
     /// Use the file's texture coordinates (u, v) as (u, 1 − v): default true for OBJ
-    /// (whose images start at the bottom row), false for PLY, as Mitsuba 3 reads them.
+    /// (whose images start at the bottom row), false for PLY and serialized meshes, as
+    /// Mitsuba 3 reads them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flip_tex_coords: Option<bool>,
     /// Radiance emitted by every triangle of the mesh: it becomes an area light.

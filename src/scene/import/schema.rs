@@ -161,6 +161,7 @@ pub fn quad(origin: DVec3, edge1: DVec3, edge2: DVec3) -> ShapeFile {
 pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> ShapeFile {
     ShapeFile::Mesh(MeshFile {
         file,
+        shape_index: None,
         material: None,
         groups: BTreeMap::new(),
         scale: None,
@@ -171,4 +172,15 @@ pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> Sh
         two_sided: None,
         medium: None,
     })
+}
+
+/// Shape `shape_index` of a Mitsuba serialized file (relative to the scene's folder),
+/// placed by `transform` unless it is the identity. Its texture coordinates are read as
+/// they are, as Mitsuba reads them.
+pub fn serialized_mesh(file: String, transform: DMat4, shape_index: Option<u32>) -> ShapeFile {
+    let mut shape = mesh(file, transform, None);
+    if let ShapeFile::Mesh(m) = &mut shape {
+        m.shape_index = shape_index;
+    }
+    shape
 }

@@ -20,13 +20,15 @@
 //!
 //! Rooms, one per concern, each building its models from their tables: `errors.rs`
 //! (stages 1 and 2's messages, key paths, `scene_error`), `materials.rs`, `shapes.rs`
-//! (spheres, triangles, planes, quads, meshes; `obj.rs` reads OBJ text), `media.rs`,
+//! (spheres, triangles, planes, quads, meshes; `obj.rs` reads OBJ text, `ply.rs` PLY,
+//! `serialized.rs` Mitsuba's serialized meshes), `media.rs`,
 //! `lights.rs` (the file's lights and the area lights of emitting shapes), `sky.rs`
 //! (`[sky]` to a [`crate::sky::SkySpec`]), `environment.rs` (`[environment]`, its image
 //! read by `image.rs`), `settings.rs` (`[render]`), `camera.rs`.
 //! [`build`] runs them in the order of the errors they report.
 pub(crate) mod obj;
 pub(crate) mod ply;
+pub(crate) mod serialized;
 
 mod camera;
 mod environment;

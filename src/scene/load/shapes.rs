@@ -1,7 +1,8 @@
-//! Shapes: spheres, triangles, planes, quads and OBJ meshes from the `[[shapes]]`
-//! entries, each with its material (named, or one the loader adds) and no light or
-//! medium yet (`lights.rs` and `media.rs` give them theirs); the geometric checks
-//! (finite, non-degenerate, a finite bounding sphere) and the bounding sphere itself.
+//! Shapes: spheres, triangles, planes, quads and meshes (OBJ, PLY, Mitsuba serialized)
+//! from the `[[shapes]]` entries, each with its material (named, or one the loader adds)
+//! and no light or medium yet (`lights.rs` and `media.rs` give them theirs); the
+//! geometric checks (finite, non-degenerate, a finite bounding sphere) and the bounding
+//! sphere itself.
 use super::errors::{fmt_path, fmt_points, scene_error, Seg};
 use super::materials::Materials;
 use super::obj;
@@ -408,27 +409,37 @@ fn build_mesh(
     if m.file.trim().is_empty() {
         return Err(scene_error(
             scene_path,
-            format!("{at}.file: expected the path of an OBJ file, got an empty string"),
+            format!("{at}.file: expected the path of a mesh file (.obj, .ply or .serialized), got an empty string"),
         ));
     }
 
     let mesh_path: PathBuf = base_dir.join(&m.file);
+    let format = MeshFormat::of(&mesh_path);
+    if let (Some(k), false) = (m.shape_index, format == MeshFormat::Serialized) {
+        return Err(scene_error(
+            scene_path,
+            format!(
+                "{at}.shape_index: applies to Mitsuba serialized meshes (a file ending in .serialized) only, got shape_index = {k} for {:?}",
+                m.file
+            ),
+        ));
+    }
     let read_error = |e: std::io::Error| {
         scene_error(
             &mesh_path,
             format!("{at}.file: cannot read the mesh file: {e}"),
         )
     };
-    let is_ply = mesh_path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
-    if is_ply {
+    if format != MeshFormat::Obj {
         let bytes = std::fs::read(&mesh_path).map_err(read_error)?;
         let stem = mesh_path
             .file_stem()
             .map_or(String::new(), |s| s.to_string_lossy().into_owned());
-        let groups = super::ply::parse_ply(&bytes, &stem)
-            .map_err(|msg| scene_error(&mesh_path, format!("{at}.file: {msg}")))?;
+        let groups = match format {
+            MeshFormat::Ply => super::ply::parse_ply(&bytes, &stem),
+            _ => super::serialized::parse_serialized(&bytes, m.shape_index.unwrap_or(0), &stem),
+        }
+        .map_err(|msg| scene_error(&mesh_path, format!("{at}.file: {msg}")))?;
         return shapes_of_groups(
             groups,
             scene_path,
@@ -449,6 +460,27 @@ fn build_mesh(
         &group_material,
         default_material,
     )
+}
+
+/// A mesh file's format, by its extension (in any case): `.ply`, `.serialized`, else OBJ.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum MeshFormat {
+    Obj,
+    Ply,
+    Serialized,
+}
+
+impl MeshFormat {
+    fn of(path: &Path) -> MeshFormat {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if ext.eq_ignore_ascii_case("ply") {
+            MeshFormat::Ply
+        } else if ext.eq_ignore_ascii_case("serialized") {
+            MeshFormat::Serialized
+        } else {
+            MeshFormat::Obj
+        }
+    }
 }
 
 /// A mesh entry's `transform`: four rows of four finite numbers, the last `[0, 0, 0,
@@ -512,7 +544,7 @@ pub(crate) fn mesh_shapes(
 }
 
 /// The shapes of mesh entry `m` from its file's groups (OBJ objects and groups, or the
-/// one group of a PLY file).
+/// one group of a PLY file or of a serialized file's shape).
 pub(crate) fn shapes_of_groups(
     groups: Vec<obj::ObjGroup>,
     scene_path: &Path,
@@ -531,12 +563,11 @@ pub(crate) fn shapes_of_groups(
         transform,
     };
     // Mitsuba 3's readers: an OBJ's v is flipped (its images start at the bottom row,
-    // heron's uv at the top), a PLY's is not (`flip_tex_coords`, src/shapes/obj.cpp and
-    // ply.cpp).
-    let is_ply = mesh_path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
-    let flip = m.flip_tex_coords.unwrap_or(!is_ply);
+    // heron's uv at the top), a PLY's and a serialized mesh's are not (`flip_tex_coords`,
+    // src/shapes/obj.cpp and ply.cpp; serialized.cpp has no flip).
+    let flip = m
+        .flip_tex_coords
+        .unwrap_or(MeshFormat::of(mesh_path) == MeshFormat::Obj);
     // The triangles per material, in the order the materials first appear.
     let mut parts: Vec<Part> = Vec::new();
     let mut any_triangle = false;

@@ -30,7 +30,12 @@ impl<'a> Converter<'a> {
         let mut entries: Vec<ShapeFile> = Vec::new();
         match kind {
             "rectangle" => {
-                let mut q = quad(&to_world, [-1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+                let mut q = quad(
+                    &to_world,
+                    [-1.0, -1.0, 0.0],
+                    [2.0, 0.0, 0.0],
+                    [0.0, 2.0, 0.0],
+                );
                 if flip {
                     q.reverse_edges();
                 }
@@ -58,7 +63,15 @@ impl<'a> Converter<'a> {
             "disk" => {
                 let swap = flip ^ (to_world.determinant() < 0.0);
                 let tau = std::f64::consts::TAU;
-                entries.extend(schema::disk(&to_world, 1.0, 0.0, 0.0, tau, swap, DISK_SEGMENTS));
+                entries.extend(schema::disk(
+                    &to_world,
+                    1.0,
+                    0.0,
+                    0.0,
+                    tau,
+                    swap,
+                    DISK_SEGMENTS,
+                ));
             }
             "sphere" => {
                 let center = p.point("center")?.unwrap_or(DVec3::ZERO);
@@ -95,13 +108,35 @@ impl<'a> Converter<'a> {
                 entries.push(schema::mesh(file, to_world, flip_uv));
             }
             "serialized" => {
-                return Err(n.diag(
-                    "Mitsuba's serialized meshes are not supported; save the mesh as PLY (Mitsuba 3: mesh.write_ply) and use <shape type=\"ply\">",
-                ))
+                let Some(file) = p.string("filename")? else {
+                    return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
+                };
+                // heron tells a mesh file's format by its extension (Mitsuba by the
+                // shape's type), so another name would be read as OBJ.
+                let ext = Path::new(file).extension().and_then(|e| e.to_str());
+                if !ext.is_some_and(|e| e.eq_ignore_ascii_case("serialized")) {
+                    return Err(n.diag(format!(
+                        "filename: expected a file ending in .serialized (heron tells mesh formats by their extension), got {file:?}"
+                    )));
+                }
+                let index = match p.integer("shape_index")? {
+                    None => None,
+                    Some(k) => Some(u32::try_from(k).map_err(|_| {
+                        n.diag(format!("shape_index: expected an integer ≥ 0, got {k}"))
+                    })?),
+                };
+                let rel = relative_to(&self.find(n, file), &self.base);
+                if flip {
+                    self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
+                }
+                // heron shades every mesh by its face normals, as for OBJ and PLY.
+                p.get("face_normals");
+                let file = rel.to_string_lossy().replace('\\', "/");
+                entries.push(schema::serialized_mesh(file, to_world, index));
             }
             other => {
                 self.warn(n.diag(format!(
-                    "shape {other:?} is not supported (rectangle, cube, disk, sphere, obj, ply are), ignored"
+                    "shape {other:?} is not supported (rectangle, cube, disk, sphere, obj, ply, serialized are), ignored"
                 )))?;
                 return self.finish(&p);
             }
