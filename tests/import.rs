@@ -1118,6 +1118,57 @@ fn zero_area_pbrt_triangles_are_dropped_with_a_warning() {
     load_imported(&imp).unwrap();
 }
 
+/// Mitsuba's `shapegroup` and `instance` (issue 38, #13), flattened: each instance
+/// copies the group's shapes with its `to_world` after theirs; what Mitsuba refuses
+/// (emitters in a group, nesting, an instance of anything else) is an error here too.
+#[test]
+fn mitsuba_instances_copy_their_shapegroup() {
+    let group = r#"<shape type="shapegroup" id="pair">
+        <shape type="sphere"><transform name="to_world"><translate x="1"/></transform><bsdf type="diffuse"/></shape>
+        <shape type="rectangle"/>
+    </shape>"#;
+    let body = format!(
+        r#"{group}
+        <shape type="instance"><ref id="pair"/><transform name="to_world"><scale value="2"/></transform></shape>
+        <shape type="instance"><ref id="pair"/><transform name="to_world"><translate y="5"/></transform></shape>"#
+    );
+    let (_d, r) = import_text(&scene(&body));
+    let imp = r.unwrap();
+    let t = imp.table();
+    let s = shapes(&t);
+    let kinds: Vec<_> = s.iter().map(|x| x["type"].as_str().unwrap()).collect();
+    assert_eq!(kinds, ["sphere", "quad", "sphere", "quad"]);
+    // The instance's scale after the sphere's translation: centre (2, 0, 0), radius 2.
+    assert_eq!(v3(&s[0]["center"]), DVec3::new(2.0, 0.0, 0.0));
+    assert_eq!(f(&s[0]["radius"]), 2.0);
+    assert_eq!(v3(&s[2]["center"]), DVec3::new(1.0, 5.0, 0.0));
+    assert_eq!(v3(&s[3]["origin"]), DVec3::new(-1.0, 4.0, 0.0));
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    load_imported(&imp).unwrap();
+    for (body, want) in [
+        (
+            r#"<shape type="shapegroup" id="g"><shape type="sphere"><emitter type="area"/></shape></shape><shape type="instance"><ref id="g"/></shape>"#,
+            "instancing of emitters is not supported",
+        ),
+        (
+            r#"<shape type="shapegroup" id="g"><shape type="shapegroup"/></shape><shape type="instance"><ref id="g"/></shape>"#,
+            "Mitsuba forbids nesting",
+        ),
+        (
+            r#"<shape type="sphere" id="s"/><shape type="instance"><ref id="s"/></shape>"#,
+            "expected a reference to a shapegroup",
+        ),
+        (
+            r#"<shape type="instance"/>"#,
+            "expected exactly one shapegroup",
+        ),
+    ] {
+        let (_d, r) = import_text(&scene(body));
+        let e = r.expect_err(want).to_string();
+        assert!(e.contains(want) && e.lines().count() == 1, "{e}");
+    }
+}
+
 /// The heron shape tables of a converted scene.
 fn shapes(t: &toml::Table) -> &Vec<toml::Value> {
     get(t, "shapes").as_array().unwrap()

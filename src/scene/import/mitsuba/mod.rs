@@ -77,6 +77,8 @@ struct Converter<'a> {
     strict: bool,
     /// The `<path>` folders, in declaration order (files are looked up in them).
     folders: Vec<PathBuf>,
+    /// While a shapegroup is copied for an instance, the instance's `to_world`.
+    placing: Option<DMat4>,
     ids: HashMap<&'a str, &'a Node>,
     warnings: Vec<Diagnostic>,
     materials: BTreeMap<String, MaterialFile>,
@@ -108,6 +110,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
         strict,
         folders: super::xml::path_folders(root),
+        placing: None,
         ids,
         warnings: Vec::new(),
         materials: BTreeMap::new(),
@@ -124,6 +127,8 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         match child.tag.as_str() {
             "integrator" => c.integrator(child)?,
             "sensor" => c.sensor(child)?,
+            // A shapegroup with an id is copied where instances reference it.
+            "shape" if child.attr("type") == Some("shapegroup") && child.attr("id").is_some() => {}
             "shape" => c.shape(child)?,
             // An area emitter with an id is converted in the shapes that reference it
             // (Mitsuba's own cbox-rgb.xml declares its light so).

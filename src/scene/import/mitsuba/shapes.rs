@@ -6,8 +6,17 @@ use crate::scene::file::{DirectionalLightFile, PointLightFile, SpotLightFile};
 impl<'a> Converter<'a> {
     pub(super) fn shape(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
         let kind = Self::plugin(n)?;
+        match kind {
+            "instance" => return self.instance(n),
+            "shapegroup" if self.placing.is_some() => {
+                return Err(n.diag("a shapegroup inside a shapegroup (Mitsuba forbids nesting)"))
+            }
+            "shapegroup" => return Err(n.diag("a shapegroup needs an id; it renders through <shape type=\"instance\"> referencing it")),
+            _ => {}
+        }
         let p = self.props(n);
-        let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        let to_world = self.placing.unwrap_or(DMat4::IDENTITY)
+            * p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         let flip = p.boolean("flip_normals")?.unwrap_or(false);
         // The BSDF and an area emitter.
         let mut material = None;
@@ -147,6 +156,66 @@ impl<'a> Converter<'a> {
             *em = emission.clone();
             self.shapes.push(e);
         }
+        self.finish(&p)
+    }
+
+    /// Mitsuba's `instance` of a `shapegroup` (src/shapes/instance.cpp), flattened: a
+    /// copy of each of the group's shapes with the instance's `to_world` applied after
+    /// the shape's own, as pbrt's object instances are. As in Mitsuba, a group holds no
+    /// emitters, no nested group and no instance.
+    fn instance(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
+        if self.placing.is_some() {
+            return Err(n.diag("an instance inside a shapegroup (Mitsuba forbids nesting)"));
+        }
+        let p = self.props(n);
+        let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        let groups: Vec<&'a Node> = p.objects(&["shape"]);
+        let group = match groups.as_slice() {
+            [g] => self.resolve(g)?,
+            _ => {
+                return Err(
+                    n.diag("an instance: expected exactly one shapegroup (a <ref id=…/> to it)")
+                )
+            }
+        };
+        if group.tag != "shape" || group.attr("type") != Some("shapegroup") {
+            return Err(n.diag(format!(
+                "an instance: expected a reference to a shapegroup, got {}",
+                group.describe()
+            )));
+        }
+        self.placing = Some(to_world);
+        let mut out = Ok(());
+        for c in &group.children {
+            let c = match self.resolve(c) {
+                Ok(c) => c,
+                Err(e) => {
+                    out = Err(e);
+                    break;
+                }
+            };
+            if c.tag != "shape" {
+                out = Err(c.diag("a shapegroup holds shapes only"));
+                break;
+            }
+            let has_emitter = c.children.iter().any(|e| {
+                e.tag == "emitter"
+                    || (e.tag == "ref"
+                        && e.attr("id")
+                            .and_then(|id| self.ids.get(id))
+                            .is_some_and(|t| t.tag == "emitter"))
+            });
+            if has_emitter {
+                out = Err(c.diag("a shape with an emitter in a shapegroup (Mitsuba: instancing of emitters is not supported)"));
+                break;
+            }
+            if let Err(e) = self.shape(c) {
+                out = Err(e);
+                break;
+            }
+        }
+        self.placing = None;
+        out?;
         self.finish(&p)
     }
 
