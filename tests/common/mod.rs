@@ -7,3 +7,4 @@ pub mod cli;
 pub mod images;
 pub mod render;
 pub mod scenes;
+pub mod serialized;

@@ -136,6 +136,28 @@ pub fn mitsuba_samples(pairs: &[(f64, f64)]) -> Vec<(f64, f64)> {
     out
 }
 
+/// A conductor's tabulated n or k as heron uses it: the zeros [`mitsuba_samples`] put
+/// beyond a table's ends (Mitsuba's and pbrt-v4's tables are zero there) are taken off,
+/// so heron holds the end values, since an index of 0 is no material (it would make a
+/// perfect mirror of those wavelengths). Returns the covered range when the table does
+/// not span heron's 360–830 nm, for the warning that says so.
+pub fn index_samples(c: Colour) -> (Colour, Option<(f64, f64)>) {
+    let Colour::Samples { mut samples, scale } = c else {
+        return (c, None);
+    };
+    let added = |a: (f64, f64), b: (f64, f64)| a.1 == 0.0 && (a.0 - b.0).abs() <= 1.001e-3;
+    if samples.len() > 2 && added(samples[0], samples[1]) {
+        samples.remove(0);
+    }
+    let n = samples.len();
+    if n > 2 && added(samples[n - 1], samples[n - 2]) {
+        samples.pop();
+    }
+    let (lo, hi) = (samples[0].0, samples[samples.len() - 1].0);
+    let short = (lo > 360.0 || hi < 830.0).then_some((lo, hi));
+    (Colour::Samples { samples, scale }, short)
+}
+
 /// `λ:v, λ:v, …` (Mitsuba's inline tabulated spectrum): at least two pairs, wavelengths
 /// increasing, values finite and ≥ 0.
 fn parse_pairs(text: &str) -> Result<Vec<(f64, f64)>, String> {

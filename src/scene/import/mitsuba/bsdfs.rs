@@ -6,6 +6,7 @@ use crate::scene::file::{
     Colour, ConductorFile, DielectricFile, GlossyFile, IorSpec, LambertianFile, MetalSpec,
     MirrorFile,
 };
+use crate::scene::import::props::index_samples;
 
 impl<'a> Converter<'a> {
     /// The name of heron's material for BSDF element `n` (converted once).
@@ -182,9 +183,16 @@ impl<'a> Converter<'a> {
             // pbrt-v4's RGBUnboundedSpectrum; Mitsuba's RGB variants use it per channel,
             // its spectral ones clamp it to [0, 1] first, which heron does not copy) or a
             // spectrum. Given eta, a missing k is 1 (conductor.cpp).
-            let index = |name: &str, default: f64, real: bool| {
+            let mut short = Vec::new();
+            let mut index = |name: &str, default: f64, real: bool| {
                 let c = match p.colour(name) {
-                    Ok(c) => c.map(|c| c.colour()),
+                    Ok(c) => c.map(|c| {
+                        let (c, range) = index_samples(c.colour());
+                        if let Some(r) = range {
+                            short.push((name.to_string(), r));
+                        }
+                        c
+                    }),
                     Err(ColourError::Bad(d) | ColourError::Unsupported(d)) => return Err(d),
                 };
                 if let Some(c) = &c {
@@ -229,6 +237,11 @@ impl<'a> Converter<'a> {
                     )))
                 }
             };
+            for (name, (lo, hi)) in short {
+                self.warn(n.diag(format!(
+                    "{name}: the table covers {lo}–{hi} nm; heron holds its end values over the rest of 360–830 nm, where Mitsuba takes 0 (a perfect mirror there)"
+                )))?;
+            }
             if let Some(c) = p.get("specular_reflectance") {
                 self.warn(c.diag("specular_reflectance: heron's conductor has no such factor, ignored (1 is used)"))?;
             }

@@ -215,8 +215,15 @@ impl Conv {
                         (None, None) => {
                             // rgb, λ value pairs, files and numbers: pbrt-v4 reads them as
                             // unbounded spectra (an rgb as RGBUnboundedSpectrum).
-                            let n = self.colour(path, p, "eta", 1.0)?.colour();
-                            let k = self.colour(path, p, "k", 0.0)?.colour();
+                            let curve = |this: &mut Self, name: &str, q: &crate::scene::import::pbrt::tokens::Param| -> Result<Colour, Diagnostic> {
+                                let (c, short) = crate::scene::import::props::index_samples(this.colour(path, p, name, 1.0)?.colour());
+                                if let Some((lo, hi)) = short {
+                                    this.warn(this.diag(path, q.line, format!("conductor \"{} {name}\": the table covers {lo}–{hi} nm; heron holds its end values over the rest of 360–830 nm, where pbrt-v4 takes 0", q.ty)))?;
+                                }
+                                Ok(c)
+                            };
+                            let n = curve(self, "eta", e)?;
+                            let k = curve(self, "k", k_param)?;
                             for (c, q, real) in [(&n, e, true), (&k, k_param, false)] {
                                 c.check_index(real).map_err(|m| self.diag(path, q.line, format!("conductor \"{} {}\": {m}", q.ty, q.name)))?;
                             }
