@@ -81,6 +81,7 @@ class Scene:
         sppm_radius: Optional[float] = None,
         polarization: Optional[bool] = None,
         polarizer: Optional[float] = None,
+        hide_emitters: Optional[bool] = None,
     ) -> "RenderResult":
         """Renders the scene with ``heron render``'s options and defaults.
 
@@ -96,7 +97,9 @@ class Scene:
         ``--sppm-radius``); polarization=True renders Stokes vectors (``--polarization``;
         None keeps the scene's ``[render] polarization``) into ``RenderResult.stokes``;
         polarizer puts an analyser at that many degrees in front of the camera
-        (``--polarizer``, over the scene's ``[camera] polarizer``).
+        (``--polarizer``, over the scene's ``[camera] polarizer``); hide_emitters=True
+        makes emitters seen directly by the camera black (``--hide-emitters``; None
+        keeps the scene's ``[render] hide_emitters``).
         The GIL is released while
         rendering; Ctrl-C stops the render within a row of a tile and raises
         KeyboardInterrupt.

@@ -97,6 +97,11 @@ pub const SPPM_KEYS: [&str; 3] = ["sppmPhotons", "sppmAlpha", "sppmRadius"];
 /// unpolarised EXRs keep their bytes.
 pub const POLARIZATION_KEYS: [&str; 2] = ["polarization", "polarizer"];
 
+/// The key written last only when emitters seen directly are hidden (`[render]
+/// hide_emitters`), so that other EXRs keep their bytes; a checkpoint or shard of the
+/// other setting then differs from this render's in it, and is refused.
+pub const HIDE_EMITTERS_KEYS: [&str; 1] = ["hideEmitters"];
+
 impl Provenance {
     /// The provenance a film's settings key holds (`FilmKey::provenance`: every entry
     /// but spp), with `spp` samples per pixel: what `heron merge` writes, the same as the
@@ -109,6 +114,7 @@ impl Provenance {
             .chain(MEDIA_KEYS.iter().filter(|k| key.contains_key(**k)))
             .chain(SPPM_KEYS.iter().filter(|k| key.contains_key(**k)))
             .chain(POLARIZATION_KEYS.iter().filter(|k| key.contains_key(**k)))
+            .chain(HIDE_EMITTERS_KEYS.iter().filter(|k| key.contains_key(**k)))
             .map(|&k| {
                 Some((
                     k,
@@ -177,6 +183,9 @@ impl Provenance {
             if let Some(a) = settings.polarizer.or(scene.camera.polarizer) {
                 p.0.push(("polarizer", a.to_degrees().to_string()));
             }
+        }
+        if settings.hide_emitters {
+            p.0.push(("hideEmitters", "true".to_string()));
         }
         p
     }

@@ -469,6 +469,12 @@ pub struct RenderSettings {
     /// horizontal, counter-clockwise as the photographer sees it), in place of the
     /// scene's `[camera] polarizer` (`--polarizer`); polarised renders only.
     pub polarizer: Option<f32>,
+    /// Emitters seen directly by the camera contribute nothing (`[render]
+    /// hide_emitters`, `--hide-emitters`; Mitsuba 3's `hide_emitters`): an area light
+    /// a camera ray hits before any scattering, and what a camera ray that escapes sees
+    /// (background, environment map, sky, the sun's disk). Light reaching the camera
+    /// through any scattering event, and all lighting of surfaces, are unchanged.
+    pub hide_emitters: bool,
 }
 
 impl Default for RenderSettings {
@@ -495,6 +501,7 @@ impl Default for RenderSettings {
             sppm: SppmSettings::default(),
             polarization: false,
             polarizer: None,
+            hide_emitters: false,
         }
     }
 }
@@ -576,6 +583,8 @@ pub struct SettingsArgs<'a> {
     pub polarization: Option<bool>,
     /// `--polarizer` in degrees.
     pub polarizer: Option<f64>,
+    /// `--hide-emitters` (true hides them; a scene's `true` stays on without it).
+    pub hide_emitters: Option<bool>,
 }
 
 impl SettingsArgs<'_> {
@@ -671,6 +680,9 @@ impl RenderSettings {
                 ));
             }
             s.polarizer = Some((deg as f32).to_radians());
+        }
+        if let Some(h) = a.hide_emitters {
+            s.hide_emitters = h;
         }
         *self = s;
         Ok(())

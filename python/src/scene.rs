@@ -32,6 +32,7 @@ const RENAMES: &[(&str, &str)] = &[
     ("--sppm-radius", "sppm_radius"),
     ("--polarization", "polarization"),
     ("--polarizer", "polarizer"),
+    ("--hide-emitters", "hide_emitters"),
     ("--variance", "variance"),
 ];
 
@@ -181,12 +182,14 @@ impl Scene {
     /// stochastic progressive photon mapping, spp its iterations; sppm_photons (per
     /// iteration, 0: one per pixel), sppm_alpha (in (0, 1)) and sppm_radius (scene
     /// units, 0: automatic) are `heron render --sppm-photons`, `--sppm-alpha`,
-    /// `--sppm-radius`.
+    /// `--sppm-radius`. hide_emitters=True makes emitters seen directly by the camera
+    /// black (`heron render --hide-emitters`; None keeps the scene's `[render]
+    /// hide_emitters`).
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None, polarization=None, polarizer=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None, polarization=None, polarizer=None, hide_emitters=None))]
     fn render(
         &self,
         py: Python<'_>,
@@ -209,6 +212,7 @@ impl Scene {
         sppm_radius: Option<f64>,
         polarization: Option<bool>,
         polarizer: Option<f64>,
+        hide_emitters: Option<bool>,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -239,6 +243,7 @@ impl Scene {
                     sppm_radius,
                     polarization,
                     polarizer,
+                    hide_emitters,
                 },
                 variance,
                 threads: threads as usize,

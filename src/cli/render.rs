@@ -95,6 +95,13 @@ pub(crate) struct RenderArgs {
     /// [camera] polarizer; needs --polarization or [render] polarization = true).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     polarizer: Option<f64>,
+    /// Emitters seen directly by the camera contribute nothing: area lights hit by a
+    /// camera ray, and the background, environment map, sky and sun's disk behind
+    /// escaping camera rays are black; light through any reflection or refraction and
+    /// the lighting of surfaces are unchanged (Mitsuba 3's hide_emitters; default: the
+    /// scene's [render] hide_emitters).
+    #[arg(long)]
+    hide_emitters: bool,
     /// Add N spectral channels (equal bins over 360–830 nm, the layout of Fichet et al.
     /// 2021, readable by colour.read_spectral_image_Fichet2021).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=470))]
@@ -276,6 +283,7 @@ fn settings_args(args: &RenderArgs) -> SettingsArgs<'_> {
         sppm_radius: args.sppm_radius,
         polarization: args.polarization.then_some(true),
         polarizer: args.polarizer,
+        hide_emitters: args.hide_emitters.then_some(true),
     }
 }
 

@@ -91,8 +91,10 @@ impl PixelIntegrator for LightTracer {
                 })
             };
 
-        // An emitting surface seen by the camera: the light's own vertex.
-        if let Some(n) = le.normal {
+        // An emitting surface seen by the camera: the light's own vertex; none under
+        // `[render] hide_emitters`, which hides exactly these (Mitsuba 3's particle
+        // tracer skips its `sample_visible_emitters` so).
+        if let (Some(n), false) = (le.normal, settings.hide_emitters) {
             if let Some(cs) = cam.sample_wi(le.origin) {
                 let emitted = scene.lights[start.index].l(n, cs.wi, wl);
                 if !emitted.is_zero() {

@@ -200,7 +200,9 @@ impl StepIntegrator for PathTracer {
             1.0
         };
         let Some(hit) = hit else {
-            if on(K, ESCAPE) {
+            // `[render] hide_emitters`: a camera ray that escapes before any scattering
+            // event sees nothing (see `surface_vertex`).
+            if on(K, ESCAPE) && !(s.depth == 0 && ctx.settings.hide_emitters) {
                 for &i in &scene.infinite_lights {
                     let le = scene.lights[i as usize].le(ray.dir, wl);
                     if !le.is_zero() {
@@ -620,8 +622,12 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
     s.bsdf_ctx.uv = it.uv;
     let wo = -ray.dir;
 
-    // Emission of an area light the path has reached.
-    let emitter = if on(K, EMITTERS) {
+    // Emission of an area light the path has reached, unless `[render] hide_emitters`
+    // and the path has not scattered yet (`depth` counts scattering events, at surfaces
+    // and in media, as Mitsuba 3's does: a camera ray that crossed a medium or an
+    // index-matched boundary unscattered still sees the light directly, and it is
+    // hidden, as in Mitsuba 3's volpath).
+    let emitter = if on(K, EMITTERS) && !(s.depth == 0 && ctx.settings.hide_emitters) {
         scene.shapes[hit.geom_id as usize].light
     } else {
         NO_LIGHT

@@ -149,17 +149,22 @@ pub fn camera_path<const N: usize>(
         length: 0.0,
     };
     let mut ray = cam.ray;
-    for _ in 0..ctx.settings.max_depth {
+    for bounce in 0..ctx.settings.max_depth {
+        // `[render] hide_emitters`: on the camera ray itself emitters are seen directly,
+        // and give nothing; after a delta bounce they are seen through it, and kept.
+        let hidden = bounce == 0 && ctx.settings.hide_emitters;
         let Some(hit) = next_hit(ctx, &ray, &mut None, counters) else {
             // Every bounce so far was a delta: what the ray sees is whole.
-            out.l += beta * scene.escaped_radiance(ray.dir, wl);
+            if !hidden {
+                out.l += beta * scene.escaped_radiance(ray.dir, wl);
+            }
             return out;
         };
         let (it, material) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
         bsdf_ctx.uv = it.uv;
         out.length += hit.t * ray.dir.length();
         let emitter = scene.shapes[hit.geom_id as usize].light;
-        if emitter != NO_LIGHT {
+        if emitter != NO_LIGHT && !hidden {
             out.l += beta * scene.lights[emitter as usize].l(it.n_outward, -ray.dir, wl);
         }
         let u_light = sampler.get_1d();

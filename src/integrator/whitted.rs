@@ -115,8 +115,13 @@ impl StepIntegrator for Whitted {
     ) -> bool {
         let (ctx, wl) = (t.ctx, t.wl);
         let scene = ctx.scene;
+        // `[render] hide_emitters`: before the first continuation (`depth` counts the
+        // seed's specular continuations) the camera sees emitters directly, and they
+        // give nothing; what a later segment finds is light through a mirror or a
+        // refraction, kept (Mitsuba 3's `depth == 0 && hide_emitters`).
+        let hidden = s.depth == 0 && ctx.settings.hide_emitters;
         let Some(hit) = hit else {
-            if on(K, ESCAPE) {
+            if on(K, ESCAPE) && !hidden {
                 if T::POLARIZED {
                     for &i in &scene.infinite_lights {
                         let le = scene.lights[i as usize].le(ray.dir, wl);
@@ -133,7 +138,7 @@ impl StepIntegrator for Whitted {
         let wo = -ray.dir;
         if on(K, EMITTERS) {
             let emitter = scene.shapes[hit.geom_id as usize].light;
-            if emitter != NO_LIGHT {
+            if emitter != NO_LIGHT && !hidden {
                 let c = s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
                 t.found(&mut s.l, c, emitter as usize, ray.dir);
             }

@@ -389,6 +389,15 @@ impl PixelIntegrator for Bidirectional {
                 if (s == 1 && t == 1) || depth < 0 || depth > max_depth as isize {
                     continue;
                 }
+                // `[render] hide_emitters`: the paths camera → emitter (or → infinity)
+                // are the emitters seen directly. Their strategies are (0, 2) and (1, 1),
+                // and (1, 1) is never used, so (0, 2) carries them whole (`mis_weight`
+                // is 1 for s + t = 2); dropping it removes that family of paths and no
+                // other: every other strategy samples a path of more vertices, whose
+                // weights sum over strategies of its own length only.
+                if s == 0 && t == 2 && ctx.settings.hide_emitters {
+                    continue;
+                }
                 if let Some(c) = b.connect::<T>(&carry, &mut paths, (s, t), sampler, counters) {
                     c.add(&mut l, splats, wl);
                 }

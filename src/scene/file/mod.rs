@@ -260,6 +260,10 @@ pub struct RenderFile {
     /// Polarised transport (default false); `--polarization` turns it on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarization: Option<bool>,
+    /// Emitters seen directly by the camera contribute nothing (default false);
+    /// `--hide-emitters` turns it on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hide_emitters: Option<bool>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.

@@ -67,5 +67,8 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
     if let Some(p) = r.polarization {
         settings.polarization = p;
     }
+    if let Some(h) = r.hide_emitters {
+        settings.hide_emitters = h;
+    }
     Ok(settings)
 }

@@ -377,8 +377,8 @@ impl<'a> Converter<'a> {
                 }
             }
         }
-        if p.boolean("hide_emitters")? == Some(true) {
-            self.warn(n.diag("hide_emitters is not supported, emitters stay visible"))?;
+        if let Some(hide) = p.boolean("hide_emitters")? {
+            self.render().hide_emitters = Some(hide);
         }
         self.finish(&p)
     }
