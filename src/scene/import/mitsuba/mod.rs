@@ -379,6 +379,14 @@ impl<'a> Converter<'a> {
         }
         if let Some(hide) = p.boolean("hide_emitters")? {
             self.render().hide_emitters = Some(hide);
+            if hide {
+                // Mitsuba 3.7.1+'s path and volpath continue a camera ray through a
+                // hidden area light (`skip_area_emitters`); heron's integrators all keep
+                // it opaque, black, as Mitsuba's ptracer and older versions do.
+                self.warn(n.diag(
+                    "hide_emitters: an area light the camera sees is black and opaque in heron; Mitsuba 3.7+'s path and volpath show what is behind it",
+                ))?;
+            }
         }
         self.finish(&p)
     }
