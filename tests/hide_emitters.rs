@@ -88,26 +88,7 @@ fn render_polarized(
 /// nothing at all.
 fn first_hits(scene: &Scene, geom: Option<u32>) -> Vec<bool> {
     let r = Renderer::new(scene).unwrap();
-    let cam = &scene.camera;
-    let mut mask = Vec::new();
-    for y in 0..cam.height {
-        for x in 0..cam.width {
-            mask.push(
-                [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
-                    .iter()
-                    .all(|&(dx, dy)| {
-                        let q = heron::accel::embree::RayQuery {
-                            origin: cam.eye,
-                            dir: cam.direction(x as f32 + dx, y as f32 + dy),
-                            tnear: 0.0,
-                            tfar: f32::INFINITY,
-                        };
-                        r.accel().intersect1(&q).map(|h| h.geom_id) == geom
-                    }),
-            );
-        }
-    }
-    mask
+    common::render::first_hit_mask_by(&r, scene, |g| g == geom)
 }
 
 /// A pixel some of whose camera rays may see the light (or the sky) directly: not

@@ -98,6 +98,18 @@ pub fn first_hit_mask(
     scene: &Scene,
     keep: impl Fn(&heron::bsdf::Material) -> bool,
 ) -> Vec<bool> {
+    first_hit_mask_by(r, scene, |geom| {
+        geom.is_some_and(|g| keep(&scene.materials[scene.shapes[g as usize].material as usize]))
+    })
+}
+
+/// Pixels whose four corners' camera rays all first meet a shape (its geometry id,
+/// or None for nothing) that `keep` accepts.
+pub fn first_hit_mask_by(
+    r: &Renderer,
+    scene: &Scene,
+    keep: impl Fn(Option<u32>) -> bool,
+) -> Vec<bool> {
     let cam = &scene.camera;
     let mut mask = Vec::with_capacity((cam.width * cam.height) as usize);
     for y in 0..cam.height {
@@ -112,12 +124,7 @@ pub fn first_hit_mask(
                             tnear: 0.0,
                             tfar: f32::INFINITY,
                         };
-                        r.accel().intersect1(&q).is_some_and(|h| {
-                            keep(
-                                &scene.materials
-                                    [scene.shapes[h.geom_id as usize].material as usize],
-                            )
-                        })
+                        keep(r.accel().intersect1(&q).map(|h| h.geom_id))
                     }),
             );
         }

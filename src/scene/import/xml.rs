@@ -77,14 +77,7 @@ impl Node {
 /// defaults substituted; `defines` override `<default>` values (as Mitsuba's `-D`).
 pub fn read_document(path: &Path, defines: &BTreeMap<String, String>) -> Result<Node, Diagnostic> {
     let mut params = defines.clone();
-    let main = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    let mut reading = Reading {
-        params: &mut params,
-        defines,
-        folders: Vec::new(),
-        main,
-    };
-    read_file(path, &mut reading, 0, None)
+    read_file(path, &mut Reading::new(&mut params, defines, path), 0, None)
 }
 
 /// What reading a document carries from file to file: the `<default>`s seen so far
@@ -95,6 +88,23 @@ struct Reading<'r> {
     defines: &'r BTreeMap<String, String>,
     folders: Vec<PathBuf>,
     main: PathBuf,
+}
+
+impl<'r> Reading<'r> {
+    /// The start of reading the document at `path` (its folder is the main one).
+    fn new(
+        params: &'r mut BTreeMap<String, String>,
+        defines: &'r BTreeMap<String, String>,
+        path: &Path,
+    ) -> Self {
+        let main = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        Reading {
+            params,
+            defines,
+            folders: Vec::new(),
+            main,
+        }
+    }
 }
 
 /// Where a relative file name is looked for, as Mitsuba 3's file resolver does
@@ -164,14 +174,7 @@ pub fn read_document_from_str(
     defines: &BTreeMap<String, String>,
 ) -> Result<Node, Diagnostic> {
     let mut params = defines.clone();
-    let main = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    let mut reading = Reading {
-        params: &mut params,
-        defines,
-        folders: Vec::new(),
-        main,
-    };
-    parse_text(text, path, &mut reading, 0)
+    parse_text(text, path, &mut Reading::new(&mut params, defines, path), 0)
 }
 
 fn parse_text(text: &str, path: &Path, r: &mut Reading, depth: usize) -> Result<Node, Diagnostic> {
