@@ -101,47 +101,8 @@ impl<'a> Converter<'a> {
                     radius * s[0],
                 ));
             }
-            "obj" | "ply" => {
-                let Some(file) = p.string("filename")? else {
-                    return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
-                };
-                let rel = relative_to(&self.find(n, file), &self.base);
-                if flip {
-                    self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
-                }
-                // heron shades every mesh by its face normals (README, "Mitsuba 3 scenes").
-                p.get("face_normals");
-                // heron's defaults are Mitsuba's (true for OBJ, false for PLY).
-                let flip_uv = p.boolean("flip_tex_coords")?;
-                let file = rel.to_string_lossy().replace('\\', "/");
-                entries.push(schema::mesh(file, to_world, flip_uv));
-            }
-            "serialized" => {
-                let Some(file) = p.string("filename")? else {
-                    return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
-                };
-                // heron tells a mesh file's format by its extension (Mitsuba by the
-                // shape's type), so another name would be read as OBJ.
-                let ext = Path::new(file).extension().and_then(|e| e.to_str());
-                if !ext.is_some_and(|e| e.eq_ignore_ascii_case("serialized")) {
-                    return Err(n.diag(format!(
-                        "filename: expected a file ending in .serialized (heron tells mesh formats by their extension), got {file:?}"
-                    )));
-                }
-                let index = match p.integer("shape_index")? {
-                    None => None,
-                    Some(k) => Some(u32::try_from(k).map_err(|_| {
-                        n.diag(format!("shape_index: expected an integer ≥ 0, got {k}"))
-                    })?),
-                };
-                let rel = relative_to(&self.find(n, file), &self.base);
-                if flip {
-                    self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
-                }
-                // heron shades every mesh by its face normals, as for OBJ and PLY.
-                p.get("face_normals");
-                let file = rel.to_string_lossy().replace('\\', "/");
-                entries.push(schema::serialized_mesh(file, to_world, index));
+            "obj" | "ply" | "serialized" => {
+                entries.push(self.mesh_file(n, &p, kind, to_world, flip)?)
             }
             other => {
                 self.warn(n.diag(format!(
@@ -157,6 +118,48 @@ impl<'a> Converter<'a> {
             self.shapes.push(e);
         }
         self.finish(&p)
+    }
+
+    /// An `obj`, `ply` or `serialized` shape: a mesh entry of its file, looked up as
+    /// Mitsuba does, placed by `to_world`.
+    fn mesh_file(
+        &mut self,
+        n: &Node,
+        p: &Props<'a>,
+        kind: &str,
+        to_world: DMat4,
+        flip: bool,
+    ) -> Result<ShapeFile, Diagnostic> {
+        let Some(file) = p.string("filename")? else {
+            return Err(n.diag("expected <string name=\"filename\" value=\"…\"/>"));
+        };
+        // heron tells a mesh file's format by its extension (Mitsuba by the shape's
+        // type), so a serialized file of another name would be read as OBJ.
+        let ext = Path::new(file).extension().and_then(|e| e.to_str());
+        if kind == "serialized" && !ext.is_some_and(|e| e.eq_ignore_ascii_case("serialized")) {
+            return Err(n.diag(format!(
+                "filename: expected a file ending in .serialized (heron tells mesh formats by their extension), got {file:?}"
+            )));
+        }
+        let rel = relative_to(&self.find(n, file), &self.base);
+        let file = rel.to_string_lossy().replace('\\', "/");
+        if flip {
+            self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
+        }
+        // heron shades every mesh by its face normals (README, "Mitsuba 3 scenes").
+        p.get("face_normals");
+        if kind == "serialized" {
+            let index = match p.integer("shape_index")? {
+                None => None,
+                Some(k) => Some(u32::try_from(k).map_err(|_| {
+                    n.diag(format!("shape_index: expected an integer ≥ 0, got {k}"))
+                })?),
+            };
+            return Ok(schema::serialized_mesh(file, to_world, index));
+        }
+        // heron's defaults are Mitsuba's (true for OBJ, false for PLY).
+        let flip_uv = p.boolean("flip_tex_coords")?;
+        Ok(schema::mesh(file, to_world, flip_uv))
     }
 
     /// Mitsuba's `instance` of a `shapegroup` (src/shapes/instance.cpp), flattened: a
