@@ -300,60 +300,6 @@ impl<'de> Deserialize<'de> for NonNegativeNumber {
     }
 }
 
-impl<'de> Deserialize<'de> for MetalSpec {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use crate::spectrum::metals::METAL_NAMES;
-        let v = raw(d)?;
-        let expected = || {
-            format!(
-                "expected a metal of the catalogue ({}), {{ table = \"nk.csv\" }} or {{ n = .., k = .. }} (each a number, [r, g, b] or {{ samples = [[nm, value], ...] }}), got {}",
-                METAL_NAMES.join(", "),
-                show(&v)
-            )
-        };
-        match &v {
-            toml::Value::String(name) => {
-                if METAL_NAMES.contains(&name.as_str()) {
-                    Ok(MetalSpec::Named(name.clone()))
-                } else {
-                    Err(D::Error::custom(format!(
-                        "unknown metal {name:?}, expected one of {}",
-                        METAL_NAMES.join(", ")
-                    )))
-                }
-            }
-            toml::Value::Table(t) => {
-                if let (1, Some(toml::Value::String(f))) = (t.len(), t.get("table")) {
-                    return Ok(MetalSpec::Table(f.clone()));
-                }
-                let n = t.get("n").and_then(finite_in_f32);
-                let k = t.get("k").and_then(finite_in_f32);
-                match (t.len(), n, k) {
-                    (2, Some(n), Some(k)) if n as f32 > 0.0 && k as f32 >= 0.0 => {
-                        Ok(MetalSpec::Constant { n, k })
-                    }
-                    (2, Some(_), Some(_)) => Err(D::Error::custom(format!(
-                        "expected n > 0 and k >= 0, got {}",
-                        show(&v)
-                    ))),
-                    (2, _, _) if t.contains_key("n") && t.contains_key("k") => {
-                        let curve = |key: &str| {
-                            super::colour::index_curve(&t[key], key == "n")
-                                .map_err(|e| D::Error::custom(format!("{key}: {e}")))
-                        };
-                        Ok(MetalSpec::Curves {
-                            n: curve("n")?,
-                            k: curve("k")?,
-                        })
-                    }
-                    _ => Err(D::Error::custom(expected())),
-                }
-            }
-            _ => Err(D::Error::custom(expected())),
-        }
-    }
-}
-
 impl<'de> Deserialize<'de> for UnitNumber {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let v = raw(d)?;
@@ -465,7 +411,11 @@ pub(super) fn one_key<S: Serializer, T: Serialize + ?Sized>(
 }
 
 /// `{ a = x, b = y }`, the two-number tables (`n_d`/`v_d`, `n`/`k`).
-fn two_keys<S: Serializer>(s: S, a: (&str, f64), b: (&str, f64)) -> Result<S::Ok, S::Error> {
+pub(super) fn two_keys<S: Serializer>(
+    s: S,
+    a: (&str, f64),
+    b: (&str, f64),
+) -> Result<S::Ok, S::Error> {
     let mut m = s.serialize_map(Some(2))?;
     m.serialize_entry(a.0, &a.1)?;
     m.serialize_entry(b.0, &b.1)?;
@@ -486,22 +436,6 @@ impl Serialize for IorSpec {
             IorSpec::Cauchy(abc) => one_key(s, "cauchy", abc),
             IorSpec::Table(file) => one_key(s, "table", file),
             IorSpec::Abbe { n_d, v_d } => two_keys(s, ("n_d", *n_d), ("v_d", *v_d)),
-        }
-    }
-}
-
-impl Serialize for MetalSpec {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        match self {
-            MetalSpec::Named(name) => s.serialize_str(name),
-            MetalSpec::Table(file) => one_key(s, "table", file),
-            MetalSpec::Constant { n, k } => two_keys(s, ("n", *n), ("k", *k)),
-            MetalSpec::Curves { n, k } => {
-                let mut m = s.serialize_map(Some(2))?;
-                m.serialize_entry("n", n)?;
-                m.serialize_entry("k", k)?;
-                m.end()
-            }
         }
     }
 }

@@ -63,6 +63,7 @@ use std::fmt::Write as _;
 
 mod colour;
 mod leaves;
+mod metal;
 mod show;
 
 pub use colour::{Colour, Emission, Reflectance};
