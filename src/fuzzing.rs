@@ -389,6 +389,8 @@ fn imported_scene(r: crate::Result<crate::scene::import::Imported>) -> Outcome {
 fn mesh_entry(file: &str) -> MeshFile {
     MeshFile {
         file: file.into(),
+        vertices: None,
+        triangles: None,
         shape_index: None,
         material: Some("m".into()),
         groups: BTreeMap::new(),

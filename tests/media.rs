@@ -272,6 +272,62 @@ ior = 1.5"#,
 }
 
 #[test]
+fn white_furnace_holds_for_a_chromatic_medium() {
+    // σ_s given as RGB (uplifted unbounded: σ_s(λ) varies fourfold over the visible),
+    // σ_a = 0: every lane scatters at its own rate while the free flights follow the
+    // hero's, so L = 1 holds only if the companions' weights are right (spectral MIS
+    // over the lanes). Same size and standard-error bound as the grey furnace above.
+    let dir = temp_dir("chromatic-furnace");
+    let scene = load_in(
+        &dir,
+        &common::scenes::furnace_sphere(
+            r#"{ type = "henyey-greenstein", sigma_a = 0.0, sigma_s = [0.5, 1.5, 3.0], g = 0.3 }"#,
+            "",
+        ),
+    );
+    assert_mean(&run(&scene, 64), 1.0, 0.005, "chromatic HG furnace");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn medium_coefficients_take_numbers_rgb_and_samples() {
+    use heron::spectrum::uplift::rgb_to_unbounded;
+    let dir = temp_dir("coefficients");
+    let hg = |sigma: &str| {
+        let text = common::scenes::furnace_sphere(
+            &format!(r#"{{ type = "henyey-greenstein", sigma_a = 0.1, sigma_s = {sigma} }}"#),
+            "",
+        );
+        load_scene_from_str(&text, &dir.join("c.toml")).map(|s| match &s.media[0] {
+            Medium::HenyeyGreenstein(m) => m.clone(),
+            other => panic!("{other:?}"),
+        })
+    };
+    let rgb = hg("[0.2, 0.5, 0.9]").unwrap();
+    let want = rgb_to_unbounded([0.2, 0.5, 0.9]);
+    for l in [400.0, 550.0, 700.0] {
+        assert!((rgb.sigma_s.eval(l) - want.eval(l)).abs() < 1e-6);
+        assert!((rgb.sigma_t.eval(l) - want.eval(l) - 0.1).abs() < 1e-5);
+    }
+    assert!(rgb.sigma_s.eval(450.0) > 2.0 * rgb.sigma_s.eval(650.0));
+    let table = hg("{ samples = [[400, 1.0], [700, 4.0]], scale = 0.5 }").unwrap();
+    assert!((table.sigma_s.eval(550.0) - 1.25).abs() < 1e-6);
+    assert_eq!(hg("2").unwrap().sigma_s.eval(500.0), 2.0);
+    for (bad, says) in [
+        ("-1", "expected a coefficient per scene unit"),
+        ("[1, -1, 0]", "expected [r, g, b] components >= 0"),
+        (
+            r#"{ spectrum = "D65" }"#,
+            "expected a coefficient per scene unit",
+        ),
+    ] {
+        let e = hg(bad).unwrap_err().to_string();
+        assert!(e.contains("sigma_s") && e.contains(says), "{bad}: {e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn slab_transmittance_is_exponential() {
     // A purely absorbing slab (σ_s = 0) of thickness d = 1.5 seen straight through, in
     // front of an environment of radiance 1: L = exp(−σ_a d). The path tracer samples

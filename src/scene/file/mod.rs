@@ -61,11 +61,13 @@ use serde::de::{Deserialize, Deserializer, Error as _};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+mod coefficient;
 mod colour;
 mod leaves;
 mod metal;
 mod show;
 
+pub use coefficient::Coefficient;
 pub use colour::{Colour, Emission, Reflectance};
 pub use leaves::{
     Direction3, IorSpec, Point2, Point3, PositiveCount, PositiveNumber, Resolution, UnitNumber,
@@ -472,6 +474,19 @@ impl ShapeFile {
         }
     }
 
+    /// The entry's medium, to be set (as the importers give a closed shape its
+    /// interior medium).
+    pub fn medium_mut(&mut self) -> &mut Option<MediumFile> {
+        match self {
+            ShapeFile::Sphere(x) => &mut x.medium,
+            ShapeFile::Triangle(x) => &mut x.medium,
+            ShapeFile::Plane(x) => &mut x.medium,
+            ShapeFile::Quad(x) => &mut x.medium,
+            ShapeFile::Mesh(x) => &mut x.medium,
+            ShapeFile::Waves(x) => &mut x.medium,
+        }
+    }
+
     /// The entry's `type` value.
     pub fn name(&self) -> &'static str {
         let i = match self {
@@ -603,13 +618,24 @@ pub struct WaveFile {
     pub phase: f32,
 }
 
-/// A triangle mesh: a Wavefront OBJ file, a PLY file (by its `.ply` extension) or a
-/// Mitsuba serialized file (by its `.serialized` extension).
+/// A triangle mesh: a Wavefront OBJ file, a PLY file (by its `.ply` extension), a
+/// Mitsuba serialized file (by its `.serialized` extension), or triangles written in
+/// the scene (`vertices` and `triangles`, as the importers write a closed shape around
+/// a medium).
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshFile {
-    /// Relative to the folder of the scene file.
+    /// Relative to the folder of the scene file; left out when the triangles are
+    /// written in the scene (`vertices` and `triangles`).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub file: String,
+    /// The mesh written in the scene instead of a file: its vertex positions …
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertices: Option<Vec<Point3>>,
+    /// … and its triangles, three vertex indices each (from 0); a triangle (a, b, c)
+    /// faces (b − a) × (c − a), as a file's do.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triangles: Option<Vec<[u32; 3]>>,
     /// Which shape of a serialized file (which may hold several), from 0 (the default,
     /// as Mitsuba's `shape_index`); an error for other files.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -652,7 +678,8 @@ pub struct MeshFile {
 /// `absorption` (default true: water's imaginary index), `lambda_step` (nm between
 /// the Lorenz–Mie wavelength nodes, default 10) and `forward_cutoff` (degrees, default
 /// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
-/// `sigma_a`, `sigma_s` (per scene unit) and `g` in (−1, 1). The keys are checked
+/// `sigma_a`, `sigma_s` (per scene unit; each a number, `[r, g, b]` or samples) and `g`
+/// in (−1, 1). The keys are checked
 /// against the type in `load/media.rs`.
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -674,10 +701,13 @@ pub struct MediumFile {
     pub lambda_step: Option<PositiveNumber>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub forward_cutoff: Option<NonNegativeNumber>,
+    /// Absorption coefficient per scene unit: a number, `[r, g, b]` or samples
+    /// ([`Coefficient`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma_a: Option<NonNegativeNumber>,
+    pub sigma_a: Option<Coefficient>,
+    /// Scattering coefficient per scene unit, as `sigma_a`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma_s: Option<NonNegativeNumber>,
+    pub sigma_s: Option<Coefficient>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub g: Option<f32>,
 }

@@ -138,8 +138,9 @@ impl Imported {
             *f = rel.to_string_lossy().replace('\\', "/");
         };
         for s in &mut scene.shapes {
-            if let ShapeFile::Mesh(m) = s {
-                rebase(&mut m.file);
+            match s {
+                ShapeFile::Mesh(m) if !m.file.is_empty() => rebase(&mut m.file),
+                _ => {}
             }
         }
         for m in scene.materials.values_mut() {

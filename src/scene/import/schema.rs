@@ -161,6 +161,8 @@ pub fn quad(origin: DVec3, edge1: DVec3, edge2: DVec3) -> ShapeFile {
 pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> ShapeFile {
     ShapeFile::Mesh(MeshFile {
         file,
+        vertices: None,
+        triangles: None,
         shape_index: None,
         material: None,
         groups: BTreeMap::new(),
@@ -181,6 +183,31 @@ pub fn serialized_mesh(file: String, transform: DMat4, shape_index: Option<u32>)
     let mut shape = mesh(file, transform, None);
     if let ShapeFile::Mesh(m) = &mut shape {
         m.shape_index = shape_index;
+    }
+    shape
+}
+
+/// Triangles written in the scene as one mesh entry (`vertices` and `triangles`),
+/// corners that are equal in f64 sharing a vertex: the form a closed shape around a
+/// medium takes (a triangle (a, b, c) faces (b − a) × (c − a)).
+pub fn triangle_mesh(tris: &[[DVec3; 3]]) -> ShapeFile {
+    let mut vertices: Vec<Point3> = Vec::new();
+    let mut index: BTreeMap<[u64; 3], u32> = BTreeMap::new();
+    let mut triangles = Vec::with_capacity(tris.len());
+    for t in tris {
+        triangles.push(t.map(|v| {
+            let p = point(v);
+            let key = p.0.to_array().map(|x| (x + 0.0).to_bits());
+            *index.entry(key).or_insert_with(|| {
+                vertices.push(p);
+                vertices.len() as u32 - 1
+            })
+        }));
+    }
+    let mut shape = mesh(String::new(), DMat4::IDENTITY, None);
+    if let ShapeFile::Mesh(m) = &mut shape {
+        m.vertices = Some(vertices);
+        m.triangles = Some(triangles);
     }
     shape
 }

@@ -17,7 +17,11 @@ pub const MEDIUM_DEFAULT_NODES: usize = 8;
 #[derive(Clone, Debug, PartialEq)]
 pub(super) enum MediumPlan {
     Mie(crate::medium::MieSpec),
-    Hg { sigma_a: f32, sigma_s: f32, g: f32 },
+    Hg {
+        sigma_a: DenseSpectrum,
+        sigma_s: DenseSpectrum,
+        g: f32,
+    },
 }
 
 impl MediumPlan {
@@ -29,11 +33,7 @@ impl MediumPlan {
                 sigma_a,
                 sigma_s,
                 g,
-            } => Medium::HenyeyGreenstein(HgMedium::new(
-                DenseSpectrum::constant(*sigma_a),
-                DenseSpectrum::constant(*sigma_s),
-                *g,
-            )),
+            } => Medium::HenyeyGreenstein(HgMedium::new(sigma_a.clone(), sigma_s.clone(), *g)),
         }
     }
 }
@@ -207,11 +207,23 @@ fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> 
             "{at}.g: expected a mean cosine in (-1, 1), got {g}"
         ));
     }
-    let sigma_a = m.sigma_a.map_or(0.0, |x| x.get());
-    let sigma_s = m.sigma_s.map_or(0.0, |x| x.get());
-    if !(sigma_a + sigma_s).is_finite() || sigma_a + sigma_s <= 0.0 {
+    let zero = crate::scene::file::Coefficient::grey(0.0);
+    let sigma_a = m.sigma_a.as_ref().unwrap_or(&zero).spectrum();
+    let sigma_s = m.sigma_s.as_ref().unwrap_or(&zero).spectrum();
+    // Each is finite and ≥ 0 at every wavelength (`Coefficient`); the medium must
+    // interact somewhere. A grey pair keeps its message in numbers.
+    let peak = (sigma_a.values().iter())
+        .zip(sigma_s.values())
+        .map(|(a, s)| a + s)
+        .fold(0.0f32, f32::max);
+    if !peak.is_finite() || peak <= 0.0 {
+        let show = |c: &Option<crate::scene::file::Coefficient>| {
+            c.as_ref().map_or("0".to_string(), |c| c.0.describe())
+        };
         return Err(format!(
-            "{at}: expected sigma_a + sigma_s finite and > 0, got {sigma_a} + {sigma_s}"
+            "{at}: expected sigma_a + sigma_s finite and > 0, got {} + {}",
+            show(&m.sigma_a),
+            show(&m.sigma_s)
         ));
     }
     Ok(MediumPlan::Hg {

@@ -83,7 +83,9 @@ pub(super) fn build_shapes(
                     (None, None) => None,
                 };
                 shapes.extend(build_mesh(path, base_dir, &at, m, materials, fallback)?);
-                inputs.push(m.file.clone());
+                if !m.file.is_empty() {
+                    inputs.push(m.file.clone());
+                }
             }
         }
         shape_entry.resize(shapes.len(), i);
@@ -406,6 +408,17 @@ fn build_mesh(
         let gk = fmt_path(&[Seg::Key("groups".into()), Seg::Key(group.clone())]);
         group_material.insert(group.as_str(), lookup(format!("{at}.{gk}"), name)?);
     }
+    if let Some(groups) = inline_mesh(at, m).map_err(|msg| scene_error(scene_path, msg))? {
+        return shapes_of_groups(
+            groups,
+            scene_path,
+            scene_path,
+            at,
+            m,
+            &group_material,
+            default_material,
+        );
+    }
     if m.file.trim().is_empty() {
         return Err(scene_error(
             scene_path,
@@ -460,6 +473,54 @@ fn build_mesh(
         &group_material,
         default_material,
     )
+}
+
+/// The one group of a mesh written in the scene (`vertices` and `triangles`), checked,
+/// or None for a mesh file.
+fn inline_mesh(at: &str, m: &MeshFile) -> std::result::Result<Option<Vec<obj::ObjGroup>>, String> {
+    let (vertices, triangles) = match (&m.vertices, &m.triangles) {
+        (None, None) => return Ok(None),
+        (Some(v), Some(t)) => (v, t),
+        (Some(_), None) => {
+            return Err(format!(
+                "{at}.triangles: missing required key (vertices are given: expected the triangles' vertex indices)"
+            ))
+        }
+        (None, Some(_)) => {
+            return Err(format!(
+                "{at}.vertices: missing required key (triangles are given: expected the vertex positions)"
+            ))
+        }
+    };
+    if !m.file.is_empty() {
+        return Err(format!(
+            "{at}: expected either file or vertices and triangles, got both"
+        ));
+    }
+    if let Some(k) = m.shape_index {
+        return Err(format!(
+            "{at}.shape_index: applies to Mitsuba serialized meshes, got shape_index = {k} for a mesh written in the scene"
+        ));
+    }
+    if let Some(g) = m.groups.keys().next() {
+        return Err(format!(
+            "{at}.groups: a mesh written in the scene has one group; got a group {g:?} (give material instead)"
+        ));
+    }
+    for (i, t) in triangles.iter().enumerate() {
+        if let Some(k) = t.iter().find(|&&k| k as usize >= vertices.len()) {
+            return Err(format!(
+                "{at}.triangles[{i}]: expected vertex indices below {} (the number of vertices), got {k}",
+                vertices.len()
+            ));
+        }
+    }
+    Ok(Some(vec![obj::ObjGroup {
+        name: String::new(),
+        positions: vertices.iter().map(|p| p.get()).collect(),
+        indices: triangles.clone(),
+        uvs: Vec::new(),
+    }]))
 }
 
 /// A mesh file's format, by its extension (in any case): `.ply`, `.serialized`, else OBJ.

@@ -17,6 +17,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 mod bsdfs;
+mod media;
 mod shapes;
 
 /// A triangle fan of this many triangles stands for a `disk` (area 0.9996 of the disk).
@@ -146,7 +147,8 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
             // Read with the document (xml.rs): the folders files are looked up in.
             "path" => {}
             // Named objects at the top level are converted where they are referenced.
-            "bsdf" | "texture" | "spectrum" | "rgb" | "float" if child.attr("id").is_some() => {}
+            "bsdf" | "texture" | "spectrum" | "rgb" | "float" | "medium" | "phase"
+                if child.attr("id").is_some() => {}
             "bsdf" => {
                 c.warn(child.diag("a BSDF that no shape uses (it has no id), ignored"))?;
             }

@@ -18,23 +18,46 @@ impl<'a> Converter<'a> {
         let to_world = self.placing.unwrap_or(DMat4::IDENTITY)
             * p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         let flip = p.boolean("flip_normals")?.unwrap_or(false);
-        // The BSDF and an area emitter.
+        // The BSDF, an area emitter and the interior medium.
         let mut material = None;
         let mut emission = None;
+        let mut null_bsdf = false;
+        let mut medium = None;
         for o in p.objects(&["bsdf", "emitter", "medium"]) {
+            // A medium's role is the name on the element naming it (a `ref` too).
+            let role = o.attr("name");
             let o = self.resolve(o)?;
             match o.tag.as_str() {
+                "bsdf" if o.attr("type") == Some("null") => {
+                    null_bsdf = true;
+                    self.finish(&self.props(o))?;
+                }
                 "bsdf" => material = Some(self.bsdf(o)?),
                 "emitter" => emission = self.emitter(o, Some(n))?,
-                "medium" => {
-                    self.unsupported(o, "media are not supported by heron's import yet, ignored")?
-                }
+                "medium" => match role {
+                    Some("interior") => medium = self.medium(o)?,
+                    Some("exterior") => self.warn(o.diag(
+                        "an exterior medium is not supported (heron's media fill closed shapes and the camera is outside every medium), ignored",
+                    ))?,
+                    _ => {
+                        return Err(o.diag(
+                            "a shape's medium: expected name=\"interior\" or name=\"exterior\"",
+                        ))
+                    }
+                },
                 _ => return Err(o.diag("expected a bsdf, an emitter or a medium inside a shape")),
             }
         }
-        let material = match material {
-            Some(m) => m,
-            None => self.default_material(),
+        let Some(material) = self.surface(n, kind, material, null_bsdf, &emission, &mut medium)?
+        else {
+            // A null surface around no medium is invisible: nothing to render, and
+            // nothing of it to warn about.
+            for c in &n.children {
+                if let Some(name) = c.attr("name") {
+                    p.get(name);
+                }
+            }
+            return self.finish(&p);
         };
         let mut entries: Vec<ShapeFile> = Vec::new();
         match kind {
@@ -50,18 +73,12 @@ impl<'a> Converter<'a> {
                 }
                 entries.push(q.shape());
             }
+            "cube" if medium.is_some() => {
+                // A medium needs one closed mesh, not six quads.
+                entries.push(schema::triangle_mesh(&cube_triangles(&to_world, flip)));
+            }
             "cube" => {
-                // The six faces of [-1, 1]³, each (origin, edge1, edge2) with edge1 × edge2
-                // outward.
-                let faces = [
-                    ([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
-                    ([-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]),
-                    ([-1.0, 1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]),
-                    ([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
-                    ([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
-                    ([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]),
-                ];
-                for (o, e1, e2) in faces {
+                for (o, e1, e2) in CUBE_FACES {
                     let mut q = quad(&to_world, o, e1, e2);
                     if flip {
                         q.reverse_edges();
@@ -113,8 +130,9 @@ impl<'a> Converter<'a> {
         }
         for mut e in entries {
             let (m, em, _) = e.surface_mut();
-            *m = Some(material.clone());
+            *m = material.clone();
             *em = emission.clone();
+            *e.medium_mut() = medium.clone();
             self.shapes.push(e);
         }
         self.finish(&p)
@@ -373,6 +391,17 @@ impl Quad {
     }
 }
 
+/// The six faces of Mitsuba's cube, [-1, 1]³, each (origin, edge1, edge2) with
+/// edge1 × edge2 outward.
+pub(super) const CUBE_FACES: [([f64; 3], [f64; 3], [f64; 3]); 6] = [
+    ([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
+    ([-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]),
+    ([-1.0, 1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]),
+    ([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
+    ([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+    ([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]),
+];
+
 pub(super) fn quad(m: &DMat4, o: [f64; 3], e1: [f64; 3], e2: [f64; 3]) -> Quad {
     let o = DVec3::from_array(o);
     let (e1, e2) = (DVec3::from_array(e1), DVec3::from_array(e2));
@@ -388,4 +417,25 @@ pub(super) fn quad(m: &DMat4, o: [f64; 3], e1: [f64; 3], e2: [f64; 3]) -> Quad {
         q.reverse_edges();
     }
     q
+}
+
+/// Mitsuba's cube placed by `to_world` as twelve outward-facing triangles (inward with
+/// `flip_normals`), corners shared, so that it is closed around a medium.
+pub(super) fn cube_triangles(to_world: &DMat4, flip: bool) -> Vec<[DVec3; 3]> {
+    let mirror = to_world.determinant() < 0.0;
+    let mut out = Vec::with_capacity(12);
+    for (o, e1, e2) in CUBE_FACES {
+        let (o, e1, e2) = (
+            DVec3::from_array(o),
+            DVec3::from_array(e1),
+            DVec3::from_array(e2),
+        );
+        // Corners from exact local coordinates, so that faces share them exactly.
+        let at = |p: DVec3| to_world.transform_point3(p);
+        for t in [[o, o + e1, o + e1 + e2], [o, o + e1 + e2, o + e2]] {
+            let t = t.map(at);
+            out.push(if flip ^ mirror { [t[0], t[2], t[1]] } else { t });
+        }
+    }
+    out
 }

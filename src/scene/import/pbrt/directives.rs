@@ -152,9 +152,13 @@ impl Conv {
             }
             "Import" => self.import(d),
             "WorldEnd" | "OptionBool" | "ColorSpace" | "Option" => Ok(()),
-            "Texture" | "MakeNamedMedium" | "MediumInterface" | "CoordinateSystem"
-            | "CoordSysTransform" | "Attribute" | "PixelFilter" | "Accelerator"
-            | "ActiveTransform" | "TransformTimes" => {
+            "MakeNamedMedium" => self.make_medium(path, line, &d.name(), d.params()),
+            "MediumInterface" => {
+                self.medium_interface(&d.st.strs);
+                Ok(())
+            }
+            "Texture" | "CoordinateSystem" | "CoordSysTransform" | "Attribute" | "PixelFilter"
+            | "Accelerator" | "ActiveTransform" | "TransformTimes" => {
                 for q in &d.params().0 {
                     q.used.set(true);
                 }
@@ -244,6 +248,10 @@ impl Conv {
             if p.get(k).is_some() {
                 self.warn(self.diag(path, line, format!("Camera: {k} is not supported, ignored")))?;
             }
+        }
+        if !self.g.outside.is_empty() {
+            let m = format!("Camera: the camera is inside the medium {:?} (MediumInterface), which heron does not render: its camera is outside every medium", self.g.outside);
+            self.warn(self.diag(path, line, m))?;
         }
         self.camera_from_world = Some((self.g.ctm, line, path.to_path_buf(), fov));
         Ok(())

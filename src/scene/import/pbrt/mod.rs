@@ -31,6 +31,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 mod directives;
+mod media;
 mod tokens;
 mod translate;
 
@@ -41,6 +42,9 @@ struct Graphics {
     /// The area light's radiance and two-sidedness.
     area: Option<(Emission, bool)>,
     reverse: bool,
+    /// `MediumInterface`'s inside and outside medium names ("" for none).
+    inside: String,
+    outside: String,
 }
 
 /// A shape as its `Shape` directive gave it, in its own (object) space: what
@@ -79,6 +83,9 @@ struct ShapeDef {
     reverse: bool,
     material: String,
     area: Option<(Emission, bool)>,
+    /// The medium names of the `MediumInterface` current at the shape.
+    inside: String,
+    outside: String,
     file: PathBuf,
     line: u32,
 }
@@ -127,6 +134,10 @@ struct Conv {
     warnings: Vec<Diagnostic>,
     materials: BTreeMap<String, MaterialFile>,
     named: HashMap<String, String>,
+    /// `MakeNamedMedium`s by name (None: a type heron does not have).
+    media: HashMap<String, Option<crate::scene::file::MediumFile>>,
+    /// Outside media warned about (once each).
+    outside_warned: std::collections::HashSet<String>,
     shapes: Vec<Slot>,
     lights: Vec<LightFile>,
     background: Option<Emission>,
@@ -170,6 +181,8 @@ impl Conv {
             warnings: Vec::new(),
             materials: BTreeMap::new(),
             named: HashMap::new(),
+            media: HashMap::new(),
+            outside_warned: std::collections::HashSet::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
             background: None,
@@ -183,6 +196,8 @@ impl Conv {
                 material: None,
                 area: None,
                 reverse: false,
+                inside: String::new(),
+                outside: String::new(),
             },
             stack: Vec::new(),
             n_material: 0,

@@ -150,6 +150,8 @@ impl Conv {
         name: Option<&str>,
     ) -> Result<String, Diagnostic> {
         let t = match ty {
+            // Not a material: the shape bounds a medium (`media.rs`).
+            "interface" => return Ok(super::media::INTERFACE.to_string()),
             "diffuse" => lambertian(self.colour(path, p, "reflectance", 0.5)?),
             "dielectric" | "thindielectric" => {
                 if ty == "thindielectric" {
@@ -425,6 +427,8 @@ impl Conv {
             reverse: self.g.reverse,
             material,
             area,
+            inside: self.g.inside.clone(),
+            outside: self.g.outside.clone(),
             file: path.to_path_buf(),
             line,
         };
@@ -609,6 +613,19 @@ impl Conv {
             None => (sd.file.clone(), sd.line, String::new()),
         };
         let flip = sd.reverse ^ (m.determinant() < 0.0);
+        let closed = match &sd.geom {
+            Geom::Sphere { .. } | Geom::Ply { .. } => true,
+            Geom::Disk { .. } => false,
+            Geom::Mesh { kind, faces, .. } => faces_closed(kind, faces),
+        };
+        let medium = self.interior(sd, closed, &file, line, &ctx)?;
+        let interface = sd.material == super::media::INTERFACE;
+        if interface && medium.is_none() {
+            // Only a boundary between media, and no medium here: nothing to render.
+            return Ok(Vec::new());
+        }
+        // A medium needs its mesh as one closed entry, not separate triangles.
+        let mut one_mesh: Option<Vec<[DVec3; 3]>> = medium.is_some().then(Vec::new);
         let mut entries: Vec<ShapeFile> = Vec::new();
         match &sd.geom {
             Geom::Sphere { radius } => {
@@ -642,7 +659,7 @@ impl Conv {
                 for ix in faces {
                     // A flat parallelogram patch (p00, p10, p01, p11) is heron's quad,
                     // normal (p10 − p00) × (p01 − p00) as pbrt's; others two triangles.
-                    if *kind == "bilinearmesh" {
+                    if *kind == "bilinearmesh" && one_mesh.is_none() {
                         let (o, a, b, c) = (verts[ix[0]], verts[ix[1]], verts[ix[2]], verts[ix[3]]);
                         let scale = (a - o).length().max((b - o).length());
                         if (c - (a + b - o)).length() <= 1e-9 * scale {
@@ -663,8 +680,14 @@ impl Conv {
                             continue;
                         }
                         let t = if flip { [t[0], t[2], t[1]] } else { t };
-                        entries.push(schema::triangle(t.map(|k| verts[k])));
+                        match &mut one_mesh {
+                            Some(tris) => tris.push(t.map(|k| verts[k])),
+                            None => entries.push(schema::triangle(t.map(|k| verts[k]))),
+                        }
                     }
+                }
+                if let Some(tris) = one_mesh.take().filter(|t| !t.is_empty()) {
+                    entries.push(schema::triangle_mesh(&tris));
                 }
                 if dropped > 0 {
                     let kept = entries.len() - before;
@@ -698,11 +721,12 @@ impl Conv {
             .into_iter()
             .map(|mut e| {
                 let (material, emission, two_sided) = e.surface_mut();
-                *material = Some(sd.material.clone());
+                *material = (!interface).then(|| sd.material.clone());
                 if let Some((l, two)) = &sd.area {
                     *emission = Some(l.clone());
                     *two_sided = two.then_some(true);
                 }
+                *e.medium_mut() = medium.clone();
                 e
             })
             .collect())
@@ -729,6 +753,26 @@ impl Conv {
         self.camera = Some(schema::pinhole(eye, look, up, 0.5 / tan_y, (w, h)));
         Ok(())
     }
+}
+
+/// Whether a `trianglemesh` (3 indices a face) or `bilinearmesh` (4) is closed: every
+/// edge, by vertex index, shared by exactly two triangles.
+fn faces_closed(kind: &str, faces: &[Vec<usize>]) -> bool {
+    let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
+    for f in faces {
+        let tris: Vec<[usize; 3]> = if kind == "trianglemesh" {
+            vec![[f[0], f[1], f[2]]]
+        } else {
+            vec![[f[0], f[1], f[3]], [f[0], f[3], f[2]]]
+        };
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+    }
+    !edges.is_empty() && edges.values().all(|&c| c == 2)
 }
 
 /// A diffuse material of reflectance `rho`.
