@@ -282,8 +282,8 @@ fn diffuse_transmission_with_unit_albedo_is_a_white_furnace() {
                 let w = s.weight();
                 // The hero's weight is exactly ρ_r + τ = 1.
                 assert!((w.0[0] - 1.0).abs() < 1e-5, "{:?}", w.0);
-                for l in 0..4 {
-                    sum[l] += w.0[l] as f64 / n as f64;
+                for (acc, wl) in sum.iter_mut().zip(w.0) {
+                    *acc += wl as f64 / n as f64;
                 }
             }
             // Companions: ρ_r(λ)/P(r) or τ(λ)/P(t), mean 1 within a few standard
@@ -482,9 +482,7 @@ fn bad_values_are_one_line_errors() {
     assert!(e.contains("materials.p.ior"), "{e}");
     let e = bad("type = \"thin-dielectric\"\nior = 1.5\nroughness = 0.1");
     assert!(e.contains("roughness"), "{e}");
-    for e in [e] {
-        assert!(!e.trim_end().contains('\n'), "{e}");
-    }
+    assert!(!e.trim_end().contains('\n'), "{e}");
     // A thin sheet cannot hold a medium: it is not an interface.
     let t = "[camera]\neye = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nresolution = [8, 8]\n\
 [materials.pane]\ntype = \"thin-dielectric\"\nior = 1.5\n\
