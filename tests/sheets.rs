@@ -172,7 +172,7 @@ fn sheet_chooses_its_lobes_with_probability_r_prime() {
     for (name, ior, eta) in [
         ("n = 1.5", Ior::Constant(1.5), 1.5f32),
         (
-            "n = 1/1.33 (less dense than outside)",
+            "n = 0.75 (less dense than outside)",
             Ior::Constant(0.75),
             0.75,
         ),
