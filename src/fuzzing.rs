@@ -27,7 +27,7 @@ use crate::geometry::{Shape, ShapeKind};
 use crate::light::Light;
 use crate::scene::file::{
     ConductorFile, DielectricFile, GlossyFile, IorSpec, MaterialFile, MeshFile, MetalSpec,
-    SceneFile, ShapeFile,
+    SceneFile, ShapeFile, ThinDielectricFile,
 };
 use crate::scene::load::{self, SkyTables};
 use crate::spectrum::csv::SpectrumCsv;
@@ -166,6 +166,16 @@ fn check_material(m: &Material) {
         Material::Retarder(r) => {
             assert!(r.axis.is_finite() && r.angle.is_finite() && r.retardance.is_finite());
         }
+        Material::ThinDielectric(d) => {
+            check_ior("ior", &d.ior);
+            check_ior("outside ior", &d.outside);
+        }
+        Material::DiffuseTransmission(d) => {
+            reflectance("reflectance", &d.reflectance);
+            reflectance("transmittance", &d.transmittance);
+            let sum = d.reflectance.values().iter().zip(d.transmittance.values());
+            assert!(sum.map(|(r, t)| r + t).fold(0.0f32, f32::max) <= 1.0 + 1e-5);
+        }
     }
 }
 
@@ -239,6 +249,11 @@ fn stays_in_folder(f: &SceneFile) -> bool {
                     .chain(table(outside_ior.as_ref())),
             ),
             MaterialFile::Glossy(GlossyFile { ior, .. }) => files.extend(table(ior.as_ref())),
+            MaterialFile::ThinDielectric(ThinDielectricFile { ior, outside_ior }) => files.extend(
+                table(Some(ior))
+                    .into_iter()
+                    .chain(table(outside_ior.as_ref())),
+            ),
             MaterialFile::Conductor(ConductorFile {
                 metal: MetalSpec::Table(t),
                 ..

@@ -502,6 +502,13 @@ fn non_delta_materials() -> Vec<(String, Material)> {
             "Glossy over glass".into(),
             glossy(0.1, 0.5, 42.0, Some(Dielectric::new(glass(), true))),
         ),
+        (
+            "DiffuseTransmission 0.3/0.5".into(),
+            Material::DiffuseTransmission(heron::bsdf::DiffuseTransmission {
+                reflectance: DenseSpectrum::constant(0.3),
+                transmittance: DenseSpectrum::constant(0.5),
+            }),
+        ),
     ];
     for &a in &[0.05f32, 0.2, 0.5, 1.0] {
         v.push((

@@ -1728,3 +1728,89 @@ fn a_mitsuba_bitmap_reflectance_converts_to_a_texture() {
     let t = imp.to_toml(&out);
     assert!(t.contains("texture = \"../tex/wood.png\""), "{t}");
 }
+
+/// Mitsuba 3's `thindielectric` and pbrt-v4's `thindielectric` and
+/// `diffusetransmission` become heron's thin sheet and diffuse transmission, with the
+/// importers' defaults and warnings.
+#[test]
+fn thin_dielectrics_and_diffuse_transmission_import_as_heron_s_sheets() {
+    let body = r#"
+    <bsdf type="thindielectric" id="pane"/>
+    <bsdf type="thindielectric" id="film"><float name="int_ior" value="1.33"/><float name="ext_ior" value="1.0"/><float name="specular_transmittance" value="1"/></bsdf>
+    <bsdf type="thindielectric" id="tinted"><rgb name="specular_transmittance" value="0.5, 0.6, 0.7"/></bsdf>
+    <shape type="rectangle"><ref id="pane"/></shape>
+    <shape type="rectangle"><ref id="film"/></shape>
+    <shape type="rectangle"><ref id="tinted"/></shape>
+"#;
+    let (_d, r) = import_text(&scene(body));
+    let imp = r.unwrap();
+    let t = &imp.table();
+    assert_eq!(
+        get(t, "materials.pane.type").as_str(),
+        Some("thin-dielectric")
+    );
+    // Mitsuba's defaults, read as the dielectric reads them.
+    assert_eq!(get(t, "materials.pane.ior").as_str(), Some("N-BK7"));
+    assert_eq!(f(get(t, "materials.pane.outside_ior")), 1.000277);
+    assert_eq!(f(get(t, "materials.film.ior")), 1.33);
+    assert_eq!(f(get(t, "materials.film.outside_ior")), 1.0);
+    // A factor of 1 is Mitsuba's default and says nothing; another is ignored, said.
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(imp.warnings.len(), 1, "{w:#?}");
+    assert!(
+        imp.warnings[0].line == 10
+            && imp.warnings[0]
+                .message
+                .contains("specular_transmittance: heron's thin dielectric has no such factor"),
+        "{w:#?}"
+    );
+    load_imported(&imp).unwrap();
+
+    let text = format!(
+        "{PBRT_CAMERA}Material \"thindielectric\"\nShape \"sphere\"\nMaterial \"thindielectric\" \"spectrum eta\" \"glass-F11\"\nShape \"sphere\"\nMaterial \"diffusetransmission\"\nShape \"sphere\"\nMaterial \"diffusetransmission\" \"rgb reflectance\" [ 0.2 0.4 0.6 ] \"rgb transmittance\" [ 0.1 0.3 0.2 ] \"float scale\" 1.5\nShape \"sphere\"\nMaterial \"diffusetransmission\" \"float reflectance\" 0.7 \"float transmittance\" 0.6\nShape \"sphere\"\n"
+    );
+    let (_d, r) = import_pbrt(&text);
+    let imp = r.unwrap();
+    let t = &imp.table();
+    assert_eq!(
+        get(t, "materials.thindielectric-1.type").as_str(),
+        Some("thin-dielectric")
+    );
+    assert_eq!(f(get(t, "materials.thindielectric-1.ior")), 1.5);
+    assert_eq!(
+        get(t, "materials.thindielectric-2.ior").as_str(),
+        Some("N-SF11")
+    );
+    assert_eq!(
+        get(t, "materials.diffusetransmission-3.type").as_str(),
+        Some("diffuse-transmission")
+    );
+    assert_eq!(
+        f(get(t, "materials.diffusetransmission-3.reflectance")),
+        0.25
+    );
+    assert_eq!(
+        f(get(t, "materials.diffusetransmission-3.transmittance")),
+        0.25
+    );
+    // `scale` multiplies both (0.9 + 0.3 = 1.2 > 1 in green: both scaled by 1/1.2).
+    let r4 = v3(get(t, "materials.diffusetransmission-4.reflectance"));
+    let t4 = v3(get(t, "materials.diffusetransmission-4.transmittance"));
+    assert!(
+        (r4 - DVec3::new(0.25, 0.5, 0.75)).abs().max_element() < 1e-6,
+        "{r4}"
+    );
+    assert!(
+        (t4 - DVec3::new(0.125, 0.375, 0.25)).abs().max_element() < 1e-6,
+        "{t4}"
+    );
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(imp.warnings.len(), 2, "{w:#?}");
+    assert!(imp.warnings.iter().all(|d| d.message.contains("scaled by")));
+    assert_eq!(
+        (imp.warnings[0].line, imp.warnings[1].line),
+        (12, 14),
+        "{w:#?}"
+    );
+    load_imported(&imp).unwrap();
+}

@@ -28,6 +28,7 @@
 //! dispersive transmission exactly as `sample` does.
 pub mod conductor;
 pub mod dielectric;
+pub mod diffuse_transmission;
 pub mod fresnel;
 pub mod lambertian;
 pub mod microfacet;
@@ -40,9 +41,11 @@ pub mod rough_conductor;
 pub mod rough_dielectric;
 pub mod texture;
 pub mod textured_diffuse;
+pub mod thin_dielectric;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
+pub use diffuse_transmission::DiffuseTransmission;
 pub use lambertian::Lambertian;
 pub use mirror::Mirror;
 pub use phong::Glossy;
@@ -53,6 +56,7 @@ pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
 pub use texture::ImageTexture;
 pub use textured_diffuse::TexturedDiffuse;
+pub use thin_dielectric::ThinDielectric;
 
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -380,6 +384,11 @@ pub enum Material {
     Polarizer(Polarizer),
     /// A linear retarder, a wave plate (light passes straight through).
     Retarder(Retarder),
+    /// A dielectric sheet of no thickness: mirror reflection and straight-through
+    /// transmission, with the sheet's internal reflections summed.
+    ThinDielectric(ThinDielectric),
+    /// Lambertian reflection and Lambertian transmission (paper, leaves).
+    DiffuseTransmission(DiffuseTransmission),
 }
 
 /// `match` over the models, the same call in every arm.
@@ -396,6 +405,8 @@ macro_rules! dispatch {
             Material::RoughDielectric($m) => $call,
             Material::Polarizer($m) => $call,
             Material::Retarder($m) => $call,
+            Material::ThinDielectric($m) => $call,
+            Material::DiffuseTransmission($m) => $call,
         }
     };
 }

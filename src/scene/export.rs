@@ -49,6 +49,10 @@ pub fn spectra_json(scene: &Scene) -> Value {
             Material::Retarder(r) => json!({"type": "retarder",
                 "axis": [r.axis.x, r.axis.y, r.axis.z], "angle": r.angle,
                 "retardance": r.retardance}),
+            Material::ThinDielectric(d) => json!({"type": "thin-dielectric",
+                "ior": ior_values(&d.ior), "outside_ior": ior_values(&d.outside)}),
+            Material::DiffuseTransmission(d) => json!({"type": "diffuse-transmission",
+                "reflectance": values(&d.reflectance), "transmittance": values(&d.transmittance)}),
         };
         materials.insert(name.clone(), v);
     }

@@ -280,6 +280,10 @@ pub enum MaterialFile {
     Conductor(ConductorFile),
     Polarizer(PolarizerFile),
     Retarder(RetarderFile),
+    #[serde(rename = "thin-dielectric")]
+    ThinDielectric(ThinDielectricFile),
+    #[serde(rename = "diffuse-transmission")]
+    DiffuseTransmission(DiffuseTransmissionFile),
 }
 
 impl MaterialFile {
@@ -293,7 +297,32 @@ impl MaterialFile {
         "conductor",
         "polarizer",
         "retarder",
+        "thin-dielectric",
+        "diffuse-transmission",
     ];
+}
+
+/// A dielectric sheet of no thickness (src/bsdf/thin_dielectric.rs): a window pane
+/// modelled by one surface.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThinDielectricFile {
+    /// The sheet's index, as a dielectric's.
+    pub ior: IorSpec,
+    /// Index of the medium on both sides of the sheet; default 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outside_ior: Option<IorSpec>,
+}
+
+/// Lambertian reflection and transmission (src/bsdf/diffuse_transmission.rs), with
+/// reflectance + transmittance ≤ 1 at every wavelength.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiffuseTransmissionFile {
+    /// ρ_r, reflected back to the side the light came from.
+    pub reflectance: Reflectance,
+    /// τ, transmitted diffusely to the other side.
+    pub transmittance: Reflectance,
 }
 
 /// A linear polariser sheet (src/bsdf/polarizer.rs): light passes straight through.

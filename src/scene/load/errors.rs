@@ -5,10 +5,10 @@
 //! messages show.
 use crate::error::HeronError;
 use crate::scene::file::{
-    show, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, LambertianFile,
-    LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile, PolarizerFile,
-    QuadFile, RetarderFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile, TriangleFile,
-    WavesFile,
+    show, ConductorFile, DielectricFile, DiffuseTransmissionFile, DirectionalLightFile, GlossyFile,
+    LambertianFile, LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile,
+    PolarizerFile, QuadFile, RetarderFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile,
+    ThinDielectricFile, TriangleFile, WavesFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -189,6 +189,8 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("materials", "conductor") => check::<ConductorFile>(t),
         ("materials", "polarizer") => check::<PolarizerFile>(t),
         ("materials", "retarder") => check::<RetarderFile>(t),
+        ("materials", "thin-dielectric") => check::<ThinDielectricFile>(t),
+        ("materials", "diffuse-transmission") => check::<DiffuseTransmissionFile>(t),
         ("shapes", "sphere") => check::<SphereFile>(t),
         ("shapes", "triangle") => check::<TriangleFile>(t),
         ("shapes", "plane") => check::<PlaneFile>(t),

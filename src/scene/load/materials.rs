@@ -4,10 +4,10 @@
 use super::errors::key;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    Conductor, Dielectric, Glossy, ImageTexture, Lambertian, Material, Mirror, Polarizer, Retarder,
-    RoughConductor, RoughDielectric, TexturedDiffuse,
+    Conductor, Dielectric, DiffuseTransmission, Glossy, ImageTexture, Lambertian, Material, Mirror,
+    Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse, ThinDielectric,
 };
-use crate::scene::file::{IorSpec, MaterialFile, MetalSpec, SceneFile};
+use crate::scene::file::{DiffuseTransmissionFile, IorSpec, MaterialFile, MetalSpec, SceneFile};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::DenseSpectrum;
@@ -319,7 +319,52 @@ fn build_material(
                 retardance: waves * std::f32::consts::TAU,
             })
         }
+        MaterialFile::ThinDielectric(d) => {
+            let mut sheet =
+                ThinDielectric::new(build_ior(&format!("{at}.ior"), &d.ior, base_dir, inputs)?);
+            if let Some(o) = &d.outside_ior {
+                sheet.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir, inputs)?;
+            }
+            Material::ThinDielectric(sheet)
+        }
+        MaterialFile::DiffuseTransmission(d) => diffuse_transmission(at, d)?,
     })
+}
+
+/// Diffuse transmission, with ρ_r + τ ≤ 1 (energy conservation) checked per RGB channel
+/// when both are given as RGB (or numbers), else per wavelength. Two RGB colours whose
+/// channels sum to at most 1 can have uplifted spectra summing to a little more at some
+/// wavelengths (the uplift is not linear); there both are scaled down to sum to 1.
+fn diffuse_transmission(
+    at: &str,
+    d: &DiffuseTransmissionFile,
+) -> std::result::Result<Material, String> {
+    let (r, t) = (&d.reflectance.0, &d.transmittance.0);
+    let (mut rs, mut ts) = (d.reflectance.spectrum(), d.transmittance.spectrum());
+    let sum_max = match (r.rgb(), t.rgb()) {
+        (Some(a), Some(b)) => (0..3).fold(f32::MIN, |m, i| m.max(a[i] + b[i])),
+        _ => rs
+            .values()
+            .iter()
+            .zip(ts.values())
+            .fold(f32::MIN, |m, (a, b)| m.max(a + b)),
+    };
+    if sum_max > 1.0 + 1e-6 {
+        return Err(format!(
+            "{at}: expected reflectance + transmittance <= 1 at every wavelength (energy conservation), got reflectance = {} and transmittance = {} (sum up to {sum_max})",
+            r.describe(),
+            t.describe()
+        ));
+    }
+    let sum = DenseSpectrum::from_fn(|l| rs.eval(l) + ts.eval(l));
+    if sum.max_value() > 1.0 {
+        let scale = DenseSpectrum::from_fn(|l| 1.0 / sum.eval(l).max(1.0));
+        (rs, ts) = (rs.mul(&scale), ts.mul(&scale));
+    }
+    Ok(Material::DiffuseTransmission(DiffuseTransmission {
+        reflectance: rs,
+        transmittance: ts,
+    }))
 }
 
 /// A sheet's `angle` in degrees, as radians (default 0).

@@ -274,6 +274,12 @@ pub(super) fn assign_media(
         match &materials.list[shape.material as usize] {
             _ if entry.emission().0.is_none() => shape.interface = true,
             Material::Dielectric(_) | Material::RoughDielectric(_) => {}
+            Material::ThinDielectric(_) => {
+                return Err(format!(
+                    "{at}.material: a shape with a medium needs a surface light can enter: no material (an index-matched boundary) or a dielectric, got the thin-dielectric {:?} (a sheet of no thickness, not an interface between media: light passing it stays in the medium it came from)",
+                    materials.names[shape.material as usize]
+                ))
+            }
             _ => {
                 return Err(format!(
                     "{at}.material: a shape with a medium needs a surface light can enter: no material (an index-matched boundary) or a dielectric, got {:?}",

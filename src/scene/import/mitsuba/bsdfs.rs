@@ -4,7 +4,7 @@
 use super::*;
 use crate::scene::file::{
     Colour, ConductorFile, DielectricFile, GlossyFile, IorSpec, LambertianFile, MetalSpec,
-    MirrorFile,
+    MirrorFile, ThinDielectricFile,
 };
 use crate::scene::import::props::index_samples;
 
@@ -62,27 +62,13 @@ impl<'a> Converter<'a> {
         let t = match kind {
             "twosided" | "mask" | "bumpmap" | "normalmap" => return self.wrapper_bsdf(n, &p, kind),
             "diffuse" => self.diffuse(&p)?,
-            "thindielectric" => {
-                self.warn(n.diag(
-                    "thindielectric (a sheet with no thickness) is not supported yet; Mitsuba's default BSDF is used",
-                ))?;
-                for k in [
-                    "int_ior",
-                    "ext_ior",
-                    "specular_reflectance",
-                    "specular_transmittance",
-                ] {
-                    p.get(k);
-                }
-                self.finish(&p)?;
-                return Ok(None);
-            }
+            "thindielectric" => self.thin_dielectric(&p)?,
             "dielectric" | "roughdielectric" => self.dielectric(n, &p, kind)?,
             "conductor" | "roughconductor" => self.conductor(n, &p, kind)?,
             "plastic" | "roughplastic" => self.plastic(n, &p, kind)?,
             other => {
                 self.warn(n.diag(format!(
-                    "BSDF {other:?} is not supported (diffuse, dielectric, roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided are); Mitsuba's default BSDF (diffuse 0.5) is used"
+                    "BSDF {other:?} is not supported (diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, plastic, roughplastic, twosided are); Mitsuba's default BSDF (diffuse 0.5) is used"
                 )))?;
                 return Ok(None);
             }
@@ -169,6 +155,39 @@ impl<'a> Converter<'a> {
             }
             t
         })
+    }
+
+    /// `thindielectric`: heron's thin sheet of relative index int_ior / ext_ior (bk7
+    /// and air by default, read as the dielectric reads them). Its
+    /// `specular_reflectance` and `specular_transmittance` factors ("never to be
+    /// touched" for realism, says Mitsuba) are not heron's: a value other than 1 is
+    /// ignored with a warning.
+    pub(super) fn thin_dielectric(&mut self, p: &Props) -> Result<MaterialFile, Diagnostic> {
+        let ior = self.ior(p, "int_ior", "bk7")?;
+        let ext = self.ior(p, "ext_ior", "air")?;
+        for k in ["specular_reflectance", "specular_transmittance"] {
+            let Some(c) = p.get(k) else { continue };
+            let one = matches!(c.tag.as_str(), "float" | "spectrum" | "rgb")
+                && c.attr("value").and_then(|v| {
+                    let v: Vec<f64> = v
+                        .split([',', ' '])
+                        .filter(|x| !x.is_empty())
+                        .map(|x| x.trim().parse().unwrap_or(f64::NAN))
+                        .collect();
+                    (!v.is_empty()).then(|| v.iter().all(|&x| x == 1.0))
+                }) == Some(true);
+            if !one {
+                self.warn(c.diag(format!(
+                    "{k}: heron's thin dielectric has no such factor, ignored (1 is used)"
+                )))?;
+            }
+        }
+        Ok(MaterialFile::ThinDielectric(ThinDielectricFile {
+            ior,
+            // Air's 1.000277 is kept, as for the dielectric: the relative index is
+            // Mitsuba's.
+            outside_ior: Some(ext),
+        }))
     }
 
     pub(super) fn conductor(

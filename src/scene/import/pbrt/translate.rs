@@ -4,8 +4,9 @@
 use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
-    Colour, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec,
-    LambertianFile, MetalSpec, PointLightFile, SpotLightFile, UnitNumber,
+    Colour, ConductorFile, DielectricFile, DiffuseTransmissionFile, DirectionalLightFile,
+    GlossyFile, IorSpec, LambertianFile, MetalSpec, PointLightFile, SpotLightFile,
+    ThinDielectricFile, UnitNumber,
 };
 
 impl Conv {
@@ -153,48 +154,10 @@ impl Conv {
             // Not a material: the shape bounds a medium (`media.rs`).
             "interface" => return Ok(super::media::INTERFACE.to_string()),
             "diffuse" => lambertian(self.colour(path, p, "reflectance", 0.5)?),
-            "dielectric" | "thindielectric" => {
-                if ty == "thindielectric" {
-                    self.warn(self.diag(
-                        path,
-                        line,
-                        "thindielectric is not supported yet; rendered as a solid dielectric",
-                    ))?;
-                }
-                let named = |n: &str| IorSpec::Named(n.into());
-                let ior = match p.get("eta") {
-                    None => IorSpec::Constant(tidy(1.5)),
-                    Some(q) => match (q.ty.as_str(), q.nums.first(), q.strs.first()) {
-                        (_, Some(v), _) => IorSpec::Constant(tidy(*v)),
-                        ("spectrum", None, Some(n)) => match n.as_str() {
-                            "glass-BK7" => named("N-BK7"),
-                            "glass-F11" | "glass-SF11" => named("N-SF11"),
-                            "fused silica" | "glass-fused-silica" => named("fused-silica"),
-                            other => return Err(self.diag(path, q.line, format!("\"spectrum eta\": expected a number or one of glass-BK7, glass-F11 (heron's N-SF11), got {other:?}"))),
-                        },
-                        _ => return Err(self.diag(path, q.line, "\"eta\": expected a number or a named spectrum")),
-                    },
-                };
+            "dielectric" => {
+                let (ior, outside_ior) = self.eta(path, line, p)?;
                 let roughness = self.roughness(p);
                 p.get("remaproughness");
-                // pbrt's eta is the relative index inside / outside; below 1 (an air
-                // bubble in water, say) heron writes it as a unit index inside 1 / eta
-                // outside, the same relative index.
-                let (ior, outside_ior) = match ior {
-                    IorSpec::Constant(e) if e > 0.0 && e < 1.0 => (
-                        IorSpec::Constant(1.0),
-                        Some(IorSpec::Constant(tidy(1.0 / e))),
-                    ),
-                    IorSpec::Constant(e) if !(e > 0.0 && e.is_finite()) => {
-                        let at = p.get("eta").map_or(line, |q| q.line);
-                        return Err(self.diag(
-                            path,
-                            at,
-                            format!("\"eta\": expected a relative index > 0, got {e}"),
-                        ));
-                    }
-                    other => (other, None),
-                };
                 MaterialFile::Dielectric(DielectricFile {
                     ior,
                     fresnel: None,
@@ -202,6 +165,12 @@ impl Conv {
                     outside_ior,
                 })
             }
+            "thindielectric" => {
+                // pbrt-v4's ThinDielectricMaterial: smooth, with an index only.
+                let (ior, outside_ior) = self.eta(path, line, p)?;
+                MaterialFile::ThinDielectric(ThinDielectricFile { ior, outside_ior })
+            }
+            "diffusetransmission" => self.diffuse_transmission(path, line, p)?,
             "conductor" => {
                 let metal = match (p.get("eta"), p.get("k"), p.get("reflectance")) {
                     (None, None, None) => MetalSpec::Named("Cu".into()),
@@ -264,7 +233,7 @@ impl Conv {
                 for q in &p.0 {
                     q.used.set(true);
                 }
-                self.warn(self.diag(path, line, format!("material {other:?} is not supported (diffuse, dielectric, conductor, coateddiffuse are); a diffuse 0.5 is used")))?;
+                self.warn(self.diag(path, line, format!("material {other:?} is not supported (diffuse, dielectric, thindielectric, diffusetransmission, conductor, coateddiffuse are); a diffuse 0.5 is used")))?;
                 return Ok(self.default_material());
             }
         };
@@ -277,6 +246,97 @@ impl Conv {
         };
         self.materials.insert(key.clone(), t);
         Ok(key)
+    }
+
+    /// A dielectric's `eta` (default 1.5): a number, or a named glass spectrum read as
+    /// heron's catalogue glass (dispersive). pbrt's eta is the relative index inside /
+    /// outside; below 1 (an air bubble in water, say) heron writes it as a unit index
+    /// inside 1 / eta outside, the same relative index.
+    fn eta(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+    ) -> Result<(IorSpec, Option<IorSpec>), Diagnostic> {
+        let named = |n: &str| IorSpec::Named(n.into());
+        let ior = match p.get("eta") {
+            None => IorSpec::Constant(tidy(1.5)),
+            Some(q) => match (q.ty.as_str(), q.nums.first(), q.strs.first()) {
+                (_, Some(v), _) => IorSpec::Constant(tidy(*v)),
+                ("spectrum", None, Some(n)) => match n.as_str() {
+                    "glass-BK7" => named("N-BK7"),
+                    "glass-F11" | "glass-SF11" => named("N-SF11"),
+                    "fused silica" | "glass-fused-silica" => named("fused-silica"),
+                    other => return Err(self.diag(path, q.line, format!("\"spectrum eta\": expected a number or one of glass-BK7, glass-F11 (heron's N-SF11), got {other:?}"))),
+                },
+                _ => return Err(self.diag(path, q.line, "\"eta\": expected a number or a named spectrum")),
+            },
+        };
+        Ok(match ior {
+            IorSpec::Constant(e) if e > 0.0 && e < 1.0 => (
+                IorSpec::Constant(1.0),
+                Some(IorSpec::Constant(tidy(1.0 / e))),
+            ),
+            IorSpec::Constant(e) if !(e > 0.0 && e.is_finite()) => {
+                let at = p.get("eta").map_or(line, |q| q.line);
+                return Err(self.diag(
+                    path,
+                    at,
+                    format!("\"eta\": expected a relative index > 0, got {e}"),
+                ));
+            }
+            other => (other, None),
+        })
+    }
+
+    /// pbrt-v4's DiffuseTransmissionMaterial: `reflectance` and `transmittance` (0.25
+    /// each by default) times `scale`, each clamped to [0, 1] as pbrt does; where their
+    /// sum exceeds 1 (pbrt allows it, heron does not: energy conservation) both are
+    /// scaled down to sum to 1, with a warning.
+    fn diffuse_transmission(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+    ) -> Result<MaterialFile, Diagnostic> {
+        let k = p.float("scale").unwrap_or(1.0);
+        if !(k >= 0.0 && k.is_finite()) {
+            let at = p.get("scale").map_or(line, |q| q.line);
+            return Err(self.diag(
+                path,
+                at,
+                format!("\"scale\": expected a number ≥ 0, got {k}"),
+            ));
+        }
+        let r = scaled(self.colour(path, p, "reflectance", 0.25)?, k);
+        let t = scaled(self.colour(path, p, "transmittance", 0.25)?, k);
+        let clamp = |c: ColourValue| match c {
+            ColourValue::Grey(g) => ColourValue::Grey(g.clamp(0.0, 1.0)),
+            ColourValue::Rgb(rgb) => ColourValue::Rgb(rgb.map(|x| x.clamp(0.0, 1.0))),
+            other => {
+                let m = other.colour().max_value() as f64;
+                if m > 1.0 {
+                    scaled(other, 1.0 / m)
+                } else {
+                    other
+                }
+            }
+        };
+        let (r, t) = (clamp(r), clamp(t));
+        let sum = match (r.colour().rgb(), t.colour().rgb()) {
+            (Some(a), Some(b)) => (0..3).map(|i| (a[i] + b[i]) as f64).fold(0.0, f64::max),
+            _ => (r.colour().max_value() + t.colour().max_value()) as f64,
+        };
+        let (r, t) = if sum > 1.0 {
+            self.warn(self.diag(path, line, format!("diffusetransmission: reflectance + transmittance reaches {sum:.4} > 1 (pbrt-v4 allows it); both are scaled by {:.4} to conserve energy", 1.0 / sum)))?;
+            (scaled(r, 1.0 / sum), scaled(t, 1.0 / sum))
+        } else {
+            (r, t)
+        };
+        Ok(MaterialFile::DiffuseTransmission(DiffuseTransmissionFile {
+            reflectance: r.reflectance(),
+            transmittance: t.reflectance(),
+        }))
     }
 
     pub(super) fn default_material(&mut self) -> String {
