@@ -216,7 +216,7 @@ impl<'a> Converter<'a> {
                 .and_then(|m| self.materials.get(m))
                 .is_some_and(|m| matches!(m, MaterialFile::Dielectric(_)))
             {
-                Some("its BSDF is opaque, so light never enters it (a null or dielectric BSDF lets it in)".to_string())
+                Some("its BSDF does not let light into a medium (a null or dielectric BSDF does)".to_string())
             } else {
                 None
             };

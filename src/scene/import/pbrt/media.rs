@@ -142,7 +142,7 @@ impl Conv {
         } else if sd.area.is_some() {
             Some("heron's shapes around a medium do not emit")
         } else if opaque {
-            Some("its material is opaque, so light never enters it (interface or dielectric let it in)")
+            Some("its material does not let light into a medium (interface or dielectric do)")
         } else {
             None
         };
