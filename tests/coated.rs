@@ -55,12 +55,13 @@ fn wo_at(theta_deg: f32) -> Vec3 {
 
 const ANGLES: [f32; 4] = [0.0, 30.0, 60.0, 85.0];
 
-/// 10⁶ samples per test over 24 × 48 cells with the Bonferroni threshold 0.01/26: as in
+/// 10⁶ samples per test over 24 × 48 cells with the Bonferroni threshold 0.01/22: as in
 /// tests/bsdf.rs, a density wrong by 4% over a tenth of the mass, or by 1% over the
-/// whole lobe, is rejected. The file runs in ~6 s in release.
+/// whole lobe, is rejected. Measured in release on a shared 2-core machine: the smooth
+/// tests 6 s, the rough ones 15 s, the file 30 s (the tests run in parallel).
 const SAMPLES: usize = 1_000_000;
 const SMOOTH_TESTS: usize = 8;
-const ROUGH_TESTS: usize = 18;
+const ROUGH_TESTS: usize = 14;
 const CHI2_TESTS: usize = SMOOTH_TESTS + ROUGH_TESTS;
 
 /// `sample` against `pdf`; a delta sample is checked (weight E(μo)/P(specular) with
@@ -138,9 +139,13 @@ fn chi2_smooth_coat() {
 #[test]
 fn chi2_rough_coat() {
     let mut out = Vec::new();
-    for &(a, rho) in &[(0.1f32, 0.5f32), (0.3, 0.8), (0.7, 0.2)] {
+    for &(a, rho, angles) in &[
+        (0.1f32, 0.5f32, &ANGLES[..]),
+        (0.3, 0.8, &ANGLES[..]),
+        (0.7, 0.2, &[0.0f32, 85.0][..]),
+    ] {
         let m = coated(rho, Ior::Constant(1.49), a, 0.0, false);
-        for &t in &ANGLES {
+        for &t in angles {
             let name = format!("rough coat α = {a}, ρ = {rho}, θo = {t}°");
             out.push(coated_chi2(
                 &name,
@@ -154,14 +159,14 @@ fn chi2_rough_coat() {
     // The narrow lobe resolved in a cone about the mirror direction, and a dispersive
     // coat with its four lanes.
     let m = coated(0.5, Ior::Constant(1.49), 0.1, 0.0, false);
-    for &t in &[0.0f32, 30.0, 60.0] {
+    for &t in &[0.0f32, 60.0] {
         let wo = wo_at(t);
         let cone = Spherical::cone(Vec3::new(-wo.x, -wo.y, wo.z), 0.8);
         let name = format!("rough coat α = 0.1, θo = {t}°, cone about the mirror direction");
         out.push(coated_chi2(&name, &m, wo, &wl1(), &cone));
     }
     let d = coated(0.4, nsf11(), 0.2, 0.1, false);
-    for &t in &[20.0f32, 70.0, 0.0] {
+    for &t in &[20.0f32, 70.0] {
         let name = format!("rough coat N-SF11 α = 0.2, τ = 0.1, 4 lanes, θo = {t}°");
         out.push(coated_chi2(
             &name,
@@ -190,19 +195,21 @@ fn albedo<const N: usize>(m: &Material, wo: Vec3, wl: &SampledWavelengths<N>, la
     )
 }
 
-/// Smooth coat, white base, τ = 0: the albedo is 1 − 1.2e-6 at worst over these angles
-/// and indices (measured; K and T̄ come from a 4096-point quadrature in f64, the rest is
-/// f32), held to 2e-5.
+/// Smooth coat, white base, τ = 0: the albedo is 1 within 5.3e-7 (measured) over these
+/// angles and indices, the dispersive coat's lanes included (K and T̄ come from a
+/// quadrature in f64, the rest is f32), held to 2e-6.
 #[test]
 fn white_furnace_smooth_coat_is_exact() {
+    let mut worst = 0.0f64;
     for ior in [Ior::Constant(1.5), Ior::Constant(1.05), Ior::Constant(2.4)] {
         let m = coated(1.0, ior.clone(), 0.0, 0.0, false);
         let n = coated(1.0, ior.clone(), 0.0, 0.0, true);
         for &t in &[0.0f32, 30.0, 60.0, 80.0, 89.0] {
             for (name, m) in [("nonlinear", &m), ("linear", &n)] {
                 let a = albedo(m, wo_at(t), &wl1(), 0);
+                worst = worst.max((a - 1.0).abs());
                 assert!(
-                    (a - 1.0).abs() < 2e-5,
+                    (a - 1.0).abs() < 2e-6,
                     "η = {ior:?}, θo = {t}°, {name}: albedo {a}"
                 );
             }
@@ -212,18 +219,22 @@ fn white_furnace_smooth_coat_is_exact() {
     for &t in &[0.0f32, 45.0, 80.0] {
         for lane in 0..4 {
             let a = albedo(&m, wo_at(t), &wl4(), lane);
+            worst = worst.max((a - 1.0).abs());
             assert!(
-                (a - 1.0).abs() < 2e-5,
+                (a - 1.0).abs() < 2e-6,
                 "N-SF11, θo = {t}°, lane {lane}: albedo {a}"
             );
         }
     }
+    eprintln!("smooth coat white furnace: |albedo − 1| ≤ {worst:.2e}");
 }
 
-/// Rough coat, white base, τ = 0: the diffuse lobe returns what the tabulated E(μ) lets
-/// in, the glossy lobe loses its single-scattering deficit. Measured albedos (η = 1.49):
-/// α = 0.1: 0.9999–1.0000; α = 0.3: 0.996–1.000; α = 0.7: 0.97–0.995 (lowest at
-/// grazing θo); the table's error can lift a value above 1 by at most ~1e-4 here.
+/// Rough coat, white base, τ = 0: the albedo is E(μo) + (1 − E_table(μo)), the glossy
+/// lobe's true albedo plus what the tabulated one lets in (a rough coat's
+/// single-scattering deficit is counted as transmitted), so 1 up to the table's error
+/// and that of the quadrature of a narrow lobe. Measured (η = 1.49, θo ∈ {0, 30, 60,
+/// 80}°): α = 0.1: 1.00010–1.00025; α = 0.3: 0.99998–1.00000; α = 0.7:
+/// 0.99999–1.00004. Held to [0.999, 1 + 5e-4].
 #[test]
 fn white_furnace_rough_coat_is_at_most_one() {
     for &a in &[0.1f32, 0.3, 0.7] {
@@ -231,8 +242,8 @@ fn white_furnace_rough_coat_is_at_most_one() {
         for &t in &[0.0f32, 30.0, 60.0, 80.0] {
             let e = albedo(&m, wo_at(t), &wl1(), 0);
             eprintln!("rough coat α = {a}, θo = {t}°: white-furnace albedo {e:.5}");
-            assert!(e <= 1.0 + 3e-4, "α = {a}, θo = {t}°: albedo {e}");
-            assert!(e > 0.95, "α = {a}, θo = {t}°: albedo {e}");
+            assert!(e <= 1.0 + 5e-4, "α = {a}, θo = {t}°: albedo {e}");
+            assert!(e > 0.999, "α = {a}, θo = {t}°: albedo {e}");
         }
     }
 }
@@ -247,7 +258,7 @@ fn albedo_at_most_one_for_every_base_and_layer() {
                     for &t in &[0.0f32, 50.0, 85.0] {
                         let e = albedo(&m, wo_at(t), &wl1(), 0);
                         assert!(
-                            e <= 1.0 + 3e-4 && e >= 0.0,
+                            e <= 1.0 + 5e-4 && e >= 0.0,
                             "α {alpha} ρ {rho} τ {tau} linear {linear} θo {t}°: {e}"
                         );
                     }
@@ -357,3 +368,4 @@ fn smooth_diffuse_lobe_is_mitsubas_plastic() {
         }
     }
 }
+

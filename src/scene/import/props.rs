@@ -98,26 +98,6 @@ impl ColourValue {
             ColourValue::Blackbody { scale, .. } | ColourValue::Named { scale, .. } => *scale,
         }
     }
-
-    /// The colour times `k`.
-    pub fn scaled(&self, k: f64) -> ColourValue {
-        match self {
-            ColourValue::Grey(g) => ColourValue::Grey(g * k),
-            ColourValue::Rgb(c) => ColourValue::Rgb(c.map(|x| x * k)),
-            ColourValue::Samples { samples, scale } => ColourValue::Samples {
-                samples: samples.clone(),
-                scale: scale * k,
-            },
-            ColourValue::Blackbody { kelvin, scale } => ColourValue::Blackbody {
-                kelvin: *kelvin,
-                scale: scale * k,
-            },
-            ColourValue::Named { spectrum, scale } => ColourValue::Named {
-                spectrum,
-                scale: scale * k,
-            },
-        }
-    }
 }
 
 /// Mitsuba's tabulated spectrum (`value="λ:v, λ:v, …"` or a file's rows) as heron

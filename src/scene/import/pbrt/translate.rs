@@ -4,7 +4,7 @@
 use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
-    Colour, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec,
+    CoatedFile, Colour, ConductorFile, DielectricFile, DirectionalLightFile, IorSpec,
     LambertianFile, MetalSpec, PointLightFile, SpotLightFile, UnitNumber,
 };
 
@@ -121,6 +121,82 @@ impl Conv {
         }
     }
 
+    /// A material's `eta` (default 1.5): a number, or a named glass spectrum as heron's
+    /// catalogue glass.
+    fn eta(&self, path: &Path, p: &Params) -> Result<IorSpec, Diagnostic> {
+        let named = |n: &str| IorSpec::Named(n.into());
+        Ok(match p.get("eta") {
+            None => IorSpec::Constant(tidy(1.5)),
+            Some(q) => match (q.ty.as_str(), q.nums.first(), q.strs.first()) {
+                (_, Some(v), _) => IorSpec::Constant(tidy(*v)),
+                ("spectrum", None, Some(n)) => match n.as_str() {
+                    "glass-BK7" => named("N-BK7"),
+                    "glass-F11" | "glass-SF11" => named("N-SF11"),
+                    "fused silica" | "glass-fused-silica" => named("fused-silica"),
+                    other => return Err(self.diag(path, q.line, format!("\"spectrum eta\": expected a number or one of glass-BK7, glass-F11 (heron's N-SF11), got {other:?}"))),
+                },
+                _ => return Err(self.diag(path, q.line, "\"eta\": expected a number or a named spectrum")),
+            },
+        })
+    }
+
+    /// pbrt-v4's `coateddiffuse` as heron's coated material: its layered BxDF's
+    /// stochastic estimate becomes the closed form of src/bsdf/coated_diffuse.rs, whose
+    /// layer absorbs only (a scattering medium, `albedo` > 0, is approximated, with a
+    /// warning); `maxdepth` and `nsamples` steer pbrt's estimator and mean nothing here.
+    fn coated_diffuse(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+    ) -> Result<MaterialFile, Diagnostic> {
+        let rho = self.colour(path, p, "reflectance", 0.5)?;
+        let (u, v) = (p.float("uroughness"), p.float("vroughness"));
+        if p.get("roughness").is_none() {
+            if let (Some(u), Some(v)) = (u, v) {
+                if u != v {
+                    self.warn(self.diag(path, line, format!("coateddiffuse: anisotropic roughness (uroughness {u}, vroughness {v}); heron's coat is isotropic, their mean is used")))?;
+                }
+            }
+        }
+        let roughness = self.roughness(p);
+        p.get("remaproughness");
+        let ior = self.eta(path, p)?;
+        if let IorSpec::Constant(e) = ior {
+            if !(e >= 1.0 && e.is_finite()) {
+                let at = p.get("eta").map_or(line, |q| q.line);
+                return Err(self.diag(
+                    path,
+                    at,
+                    format!("coateddiffuse \"eta\": expected a coat index ≥ 1, got {e}"),
+                ));
+            }
+        }
+        let thickness = p.float("thickness").unwrap_or(0.01);
+        if !(thickness >= 0.0 && thickness.is_finite()) {
+            let at = p.get("thickness").map_or(line, |q| q.line);
+            return Err(self.diag(
+                path,
+                at,
+                format!("coateddiffuse \"thickness\": expected a number ≥ 0, got {thickness}"),
+            ));
+        }
+        let albedo = self.colour(path, p, "albedo", 0.0)?;
+        let g = p.float("g").unwrap_or(0.0);
+        if albedo.max() > 0.0 || g != 0.0 {
+            self.warn(self.diag(path, line, format!("coateddiffuse: the layer's scattering (albedo {}, g {g}) is not modelled; heron's layer only absorbs, with optical depth thickness = {thickness}", albedo.max())))?;
+        }
+        p.get("maxdepth");
+        p.get("nsamples");
+        Ok(MaterialFile::Coated(CoatedFile {
+            reflectance: rho.reflectance(),
+            ior: Some(ior),
+            roughness,
+            thickness: (thickness > 0.0).then_some(tidy(thickness)),
+            nonlinear: None,
+        }))
+    }
+
     /// A microfacet material's roughness: [`Self::alpha`] when above 0, at most 1.
     fn roughness(&mut self, p: &Params) -> Option<UnitNumber> {
         self.alpha(p)
@@ -159,20 +235,7 @@ impl Conv {
                         "thindielectric is not supported yet; rendered as a solid dielectric",
                     ))?;
                 }
-                let named = |n: &str| IorSpec::Named(n.into());
-                let ior = match p.get("eta") {
-                    None => IorSpec::Constant(tidy(1.5)),
-                    Some(q) => match (q.ty.as_str(), q.nums.first(), q.strs.first()) {
-                        (_, Some(v), _) => IorSpec::Constant(tidy(*v)),
-                        ("spectrum", None, Some(n)) => match n.as_str() {
-                            "glass-BK7" => named("N-BK7"),
-                            "glass-F11" | "glass-SF11" => named("N-SF11"),
-                            "fused silica" | "glass-fused-silica" => named("fused-silica"),
-                            other => return Err(self.diag(path, q.line, format!("\"spectrum eta\": expected a number or one of glass-BK7, glass-F11 (heron's N-SF11), got {other:?}"))),
-                        },
-                        _ => return Err(self.diag(path, q.line, "\"eta\": expected a number or a named spectrum")),
-                    },
-                };
+                let ior = self.eta(path, p)?;
                 let roughness = self.roughness(p);
                 p.get("remaproughness");
                 // pbrt's eta is the relative index inside / outside; below 1 (an air
@@ -241,23 +304,7 @@ impl Conv {
                 p.get("remaproughness");
                 MaterialFile::Conductor(ConductorFile { metal, roughness })
             }
-            "coateddiffuse" => {
-                let rho = self.colour(path, p, "reflectance", 0.5)?;
-                let a = self.alpha(p).unwrap_or(0.0).max(0.01);
-                let shininess = (2.0 / (a * a) - 2.0).max(1.0);
-                let eta = p.float("eta").unwrap_or(1.5);
-                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-                p.get("remaproughness");
-                p.get("thickness");
-                self.warn(self.diag(path, line, format!("coateddiffuse is mapped to heron's glossy (modified Phong): ρd = reflectance, ρs = {f0:.4} (Fresnel at normal incidence), shininess {shininess:.0}")))?;
-                MaterialFile::Glossy(GlossyFile {
-                    rho_d: rho.reflectance(),
-                    rho_s: schema::unit(f0),
-                    shininess: schema::positive(shininess),
-                    ior: None,
-                    fresnel: None,
-                })
-            }
+            "coateddiffuse" => self.coated_diffuse(path, line, p)?,
             other => {
                 for q in &p.0 {
                     q.used.set(true);
