@@ -229,12 +229,12 @@ fn white_furnace_smooth_coat_is_exact() {
     eprintln!("smooth coat white furnace: |albedo − 1| ≤ {worst:.2e}");
 }
 
-/// Rough coat, white base, τ = 0: the albedo is E(μo) + (1 − E_table(μo)), the glossy
-/// lobe's true albedo plus what the tabulated one lets in (a rough coat's
-/// single-scattering deficit is counted as transmitted), so 1 up to the table's error
-/// and that of the quadrature of a narrow lobe. Measured (η = 1.49, θo ∈ {0, 30, 60,
-/// 80}°): α = 0.1: 1.00010–1.00025; α = 0.3: 0.99998–1.00000; α = 0.7:
-/// 0.99999–1.00004. Held to [0.999, 1 + 5e-4].
+/// Rough coat, white base, τ = 0: the diffuse lobe lets in 1 − E(μ) and returns it with
+/// Mitsuba's round trip K, the single-scattering reflection albedo of the coat seen
+/// from inside (src/bsdf/coated_diffuse.rs), which loses the light the microfacets
+/// shadow at the grazing angles of total internal reflection: the albedo falls short
+/// of 1, more so the rougher the coat. Measured (η = 1.49, θo ∈ {0, 30, 60, 80}°):
+/// printed by the test (α = 0.1 at 0°: 0.933); held to [0.75, 1 + 5e-4].
 #[test]
 fn white_furnace_rough_coat_is_at_most_one() {
     for &a in &[0.1f32, 0.3, 0.7] {
@@ -243,7 +243,7 @@ fn white_furnace_rough_coat_is_at_most_one() {
             let e = albedo(&m, wo_at(t), &wl1(), 0);
             eprintln!("rough coat α = {a}, θo = {t}°: white-furnace albedo {e:.5}");
             assert!(e <= 1.0 + 5e-4, "α = {a}, θo = {t}°: albedo {e}");
-            assert!(e > 0.999, "α = {a}, θo = {t}°: albedo {e}");
+            assert!(e > 0.75, "α = {a}, θo = {t}°: albedo {e}");
         }
     }
 }
@@ -368,4 +368,3 @@ fn smooth_diffuse_lobe_is_mitsubas_plastic() {
         }
     }
 }
-

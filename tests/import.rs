@@ -1736,3 +1736,43 @@ fn a_mitsuba_bitmap_reflectance_converts_to_a_texture() {
     let t = imp.to_toml(&out);
     assert!(t.contains("texture = \"../tex/wood.png\""), "{t}");
 }
+
+/// pbrt-v4's `coateddiffuse` is heron's coated material: its reflectance, √-remapped
+/// roughness, eta and thickness (pbrt's default 0.01), a warning for anisotropy and
+/// for the scattering layer heron renders as absorbing only; the scene loads.
+#[test]
+fn pbrt_coateddiffuse_is_heron_coated() {
+    let quad = "Shape \"trianglemesh\" \"point3 P\" [ -4 -4 0  4 -4 0  4 4 0  -4 4 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n";
+    let text = format!(
+        "{PBRT_CAMERA}Material \"coateddiffuse\" \"rgb reflectance\" [ 0.6 0.2 0.1 ] \"float uroughness\" 0.04 \"float vroughness\" 0.16 \"float eta\" 1.6 \"rgb albedo\" [ 0.5 0.5 0.5 ]\n{quad}Material \"coateddiffuse\"\n{quad}"
+    );
+    let (_d, r) = import_pbrt(&text);
+    let imp = r.unwrap();
+    let t = imp.table();
+    assert_eq!(
+        get(&t, "materials.coateddiffuse-1.type").as_str(),
+        Some("coated")
+    );
+    assert_eq!(
+        v3(get(&t, "materials.coateddiffuse-1.reflectance")),
+        DVec3::new(0.6, 0.2, 0.1)
+    );
+    assert_eq!(f(get(&t, "materials.coateddiffuse-1.ior")), 1.6);
+    // The mean of u and v (0.1), remapped: α = √0.1.
+    assert!((f(get(&t, "materials.coateddiffuse-1.roughness")) - 0.1f64.sqrt()).abs() < 1e-9);
+    assert_eq!(f(get(&t, "materials.coateddiffuse-1.thickness")), 0.01);
+    // pbrt's defaults: reflectance 0.5, eta 1.5, smooth.
+    assert_eq!(f(get(&t, "materials.coateddiffuse-2.ior")), 1.5);
+    let smooth = t
+        .get("materials")
+        .and_then(|m| m.get("coateddiffuse-2"))
+        .and_then(|m| m.get("roughness"));
+    assert!(smooth.is_none(), "{smooth:?}");
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        w.iter().any(|m| m.contains("anisotropic roughness")),
+        "{w:#?}"
+    );
+    assert!(w.iter().any(|m| m.contains("scattering")), "{w:#?}");
+    load_imported(&imp).unwrap();
+}

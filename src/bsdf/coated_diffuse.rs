@@ -179,24 +179,32 @@ impl CoatedDiffuse {
         let geometry = distribution.map(|d| vndf_geometry(&d));
         for i in 0..n {
             let eta = lo + d_eta * i as f32;
-            let e_row: Option<Vec<f32>> = geometry.as_ref().map(|g| {
-                g.iter()
-                    .map(|row| {
-                        let s: f64 = row
-                            .iter()
-                            .map(|&(cos_m, w)| {
-                                w as f64 * fresnel_dielectric(cos_m, 1.0 / eta) as f64
-                            })
-                            .sum();
-                        (s / row.len().max(1) as f64) as f32
-                    })
-                    .collect()
-            });
+            // E(μ) per row of visible normals, with the relative index n_i/n_t the
+            // light meets: 1/η from outside, η from inside.
+            let albedo_rows = |eta_it: f32| {
+                geometry.as_ref().map(|g| {
+                    g.iter()
+                        .map(|row| {
+                            let s: f64 = row
+                                .iter()
+                                .map(|&(cos_m, w)| {
+                                    w as f64 * fresnel_dielectric(cos_m, eta_it) as f64
+                                })
+                                .sum();
+                            (s / row.len().max(1) as f64) as f32
+                        })
+                        .collect::<Vec<f32>>()
+                })
+            };
+            let e_row = albedo_rows(1.0 / eta);
             let e_of = |mu: f32| match &e_row {
                 Some(row) => lerp_table(row, mu),
                 None => fresnel_dielectric(mu, 1.0 / eta),
             };
-            let (k, tbar) = round_trip(eta, thickness, e_of);
+            let (mut k, tbar) = round_trip(eta, thickness, e_of);
+            if let Some(inside) = albedo_rows(eta) {
+                k = rough_round_trip(thickness, &inside);
+            }
             table.k.push(k);
             table.tbar.push(tbar);
             if let Some(row) = e_row {
@@ -449,6 +457,28 @@ fn round_trip(eta: f32, tau: f32, e_of: impl Fn(f32) -> f32) -> (f32, f32) {
             / N_QUAD as f64
     };
     ((tir + reflected / eta2) as f32, tbar as f32)
+}
+
+/// A rough coat's K: 2∫ E_in(μ') e^(−2τ/μ') μ' dμ' from the single-scattering
+/// reflection albedo `inside` of the coat seen from within (a table over μ'), by the
+/// midpoint rule in x = μ'², as Mitsuba 3's roughplastic.cpp (`m_internal_reflectance`).
+/// It is below the reciprocal 1 − (1 − Ē)/η² by the light the microfacets lose at the
+/// grazing internal angles of total reflection (single scattering only), which is what
+/// makes a rough coat's white furnace fall short of 1.
+fn rough_round_trip(tau: f32, inside: &[f32]) -> f32 {
+    let sum: f64 = (0..N_QUAD)
+        .map(|j| {
+            let x = (j as f64 + 0.5) / N_QUAD as f64;
+            let mu = x.sqrt();
+            let a = if tau == 0.0 {
+                1.0
+            } else {
+                (-2.0 * tau as f64 / mu).exp()
+            };
+            lerp_table(inside, mu as f32) as f64 * a
+        })
+        .sum();
+    (sum / N_QUAD as f64) as f32
 }
 
 /// For each μ of the E(μ) table, the visible normals of a stratified grid: (ωo·ωm, the
