@@ -26,8 +26,8 @@ use crate::colorimetry::{colour_of, Illuminant, StandardObserver};
 use crate::geometry::{Shape, ShapeKind};
 use crate::light::Light;
 use crate::scene::file::{
-    ConductorFile, DielectricFile, GlossyFile, IorSpec, MaterialFile, MeshFile, MetalSpec,
-    SceneFile, ShapeFile, ThinDielectricFile,
+    CoatedFile, ConductorFile, DielectricFile, GlossyFile, IorSpec, MaterialFile, MeshFile,
+    MetalSpec, SceneFile, ShapeFile, ThinDielectricFile,
 };
 use crate::scene::load::{self, SkyTables};
 use crate::spectrum::csv::SpectrumCsv;
@@ -155,6 +155,12 @@ fn check_material(m: &Material) {
             }
         }
         Material::Conductor(c) => metal(&c.ior),
+        Material::CoatedDiffuse(c) => {
+            reflectance("reflectance", &c.rho);
+            check_ior("ior", &c.ior);
+            assert!(c.thickness >= 0.0 && c.thickness.is_finite());
+            assert!(c.distribution.map_or(true, |d| d.alpha.is_finite()));
+        }
         Material::RoughConductor(c) => {
             metal(&c.ior);
             assert!(c.distribution.alpha.is_finite());
@@ -254,6 +260,7 @@ fn stays_in_folder(f: &SceneFile) -> bool {
                     .into_iter()
                     .chain(table(outside_ior.as_ref())),
             ),
+            MaterialFile::Coated(CoatedFile { ior, .. }) => files.extend(table(ior.as_ref())),
             MaterialFile::Conductor(ConductorFile {
                 metal: MetalSpec::Table(t),
                 ..

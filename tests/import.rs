@@ -272,12 +272,16 @@ fn bsdfs_convert_to_heron_materials_and_say_what_changes() {
     assert_eq!(get(t, "materials.mirror.type").as_str(), Some("mirror"));
     assert_eq!(f(get(t, "materials.brushed.roughness")), 0.3);
     assert_eq!(f(get(t, "materials.custom.metal.k")), 3.1);
-    // Plastic → glossy: ρs the Fresnel reflectance at normal incidence of 1.49 in air,
-    // the Phong exponent of Beckmann α = 0.1 (2/α² − 2 = 198).
-    let eta: f64 = 1.49 / 1.000277;
-    let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-    assert!((f(get(t, "materials.plastic.rho_s")) - f0).abs() < 1e-9);
-    assert!((f(get(t, "materials.plastic.shininess")) - 198.0).abs() < 1e-6);
+    // Plastic → coated: polypropylene's 1.49 relative to air, Mitsuba's α, and its
+    // default nonlinear = false.
+    assert_eq!(get(t, "materials.plastic.type").as_str(), Some("coated"));
+    assert!((f(get(t, "materials.plastic.ior")) - 1.49 / 1.000277).abs() < 1e-9);
+    assert_eq!(f(get(t, "materials.plastic.roughness")), 0.1);
+    assert_eq!(get(t, "materials.plastic.nonlinear").as_bool(), Some(false));
+    assert_eq!(
+        v3(get(t, "materials.plastic.reflectance")),
+        DVec3::splat(0.5)
+    );
     // A shape without a BSDF gets Mitsuba's default, diffuse 0.5.
     assert_eq!(
         get(t, "shapes.9.material").as_str(),
@@ -285,7 +289,7 @@ fn bsdfs_convert_to_heron_materials_and_say_what_changes() {
     );
     assert_eq!(f(get(t, "materials.mitsuba-default-diffuse.rho_d")), 0.5);
     // What changes is said, with the line: bk7's dispersion, Beckmann read as GGX on the
-    // rough conductor (Mitsuba's default distribution), plastic's mapping.
+    // rough conductor and the rough plastic (Mitsuba's default distribution).
     let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
     let has = |s: &str, line: u32| {
         imp.warnings
@@ -297,7 +301,11 @@ fn bsdfs_convert_to_heron_materials_and_say_what_changes() {
         has("distribution \"beckmann\" (Mitsuba's default)", 14),
         "{w:#?}"
     );
-    assert!(has("mapped to heron's glossy", 16), "{w:#?}");
+    assert!(
+        has("distribution \"beckmann\" (Mitsuba's default)", 16),
+        "{w:#?}"
+    );
+    assert!(!w.iter().any(|m| m.contains("glossy")), "{w:#?}");
     // The scene loads: every table is one heron renders.
     load_imported(&imp).unwrap();
 }
@@ -1812,5 +1820,45 @@ fn thin_dielectrics_and_diffuse_transmission_import_as_heron_s_sheets() {
         (12, 14),
         "{w:#?}"
     );
+    load_imported(&imp).unwrap();
+}
+
+/// pbrt-v4's `coateddiffuse` is heron's coated material: its reflectance, √-remapped
+/// roughness, eta and thickness (pbrt's default 0.01), a warning for anisotropy and
+/// for the scattering layer heron renders as absorbing only; the scene loads.
+#[test]
+fn pbrt_coateddiffuse_is_heron_coated() {
+    let quad = "Shape \"trianglemesh\" \"point3 P\" [ -4 -4 0  4 -4 0  4 4 0  -4 4 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n";
+    let text = format!(
+        "{PBRT_CAMERA}Material \"coateddiffuse\" \"rgb reflectance\" [ 0.6 0.2 0.1 ] \"float uroughness\" 0.04 \"float vroughness\" 0.16 \"float eta\" 1.6 \"rgb albedo\" [ 0.5 0.5 0.5 ]\n{quad}Material \"coateddiffuse\"\n{quad}"
+    );
+    let (_d, r) = import_pbrt(&text);
+    let imp = r.unwrap();
+    let t = imp.table();
+    assert_eq!(
+        get(&t, "materials.coateddiffuse-1.type").as_str(),
+        Some("coated")
+    );
+    assert_eq!(
+        v3(get(&t, "materials.coateddiffuse-1.reflectance")),
+        DVec3::new(0.6, 0.2, 0.1)
+    );
+    assert_eq!(f(get(&t, "materials.coateddiffuse-1.ior")), 1.6);
+    // The mean of u and v (0.1), remapped: α = √0.1.
+    assert!((f(get(&t, "materials.coateddiffuse-1.roughness")) - 0.1f64.sqrt()).abs() < 1e-9);
+    assert_eq!(f(get(&t, "materials.coateddiffuse-1.thickness")), 0.01);
+    // pbrt's defaults: reflectance 0.5, eta 1.5, smooth.
+    assert_eq!(f(get(&t, "materials.coateddiffuse-2.ior")), 1.5);
+    let smooth = t
+        .get("materials")
+        .and_then(|m| m.get("coateddiffuse-2"))
+        .and_then(|m| m.get("roughness"));
+    assert!(smooth.is_none(), "{smooth:?}");
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        w.iter().any(|m| m.contains("anisotropic roughness")),
+        "{w:#?}"
+    );
+    assert!(w.iter().any(|m| m.contains("scattering")), "{w:#?}");
     load_imported(&imp).unwrap();
 }

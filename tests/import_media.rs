@@ -177,7 +177,10 @@ fn mitsuba_media_heron_cannot_hold_are_warnings_at_their_line() {
         said(&imp, 7, "interior medium is ignored: a rectangle is open"),
         "{w:?}"
     );
-    assert!(said(&imp, 11, "its BSDF does not let light into a medium"), "{w:?}");
+    assert!(
+        said(&imp, 11, "its BSDF does not let light into a medium"),
+        "{w:?}"
+    );
     assert!(
         said(&imp, 14, "an exterior medium is not supported"),
         "{w:?}"
@@ -232,7 +235,10 @@ AttributeBegin\n  MediumInterface \"cloud\" \"\"\n  Material \"interface\"\n  Sh
         said(&imp, 23, "the outside medium \"water\" is not rendered"),
         "{w:?}"
     );
-    assert!(said(&imp, 29, "its material does not let light into a medium"), "{w:?}");
+    assert!(
+        said(&imp, 29, "its material does not let light into a medium"),
+        "{w:?}"
+    );
     assert_eq!(w.len(), 4, "{w:?}");
     let s = shapes(&imp);
     // The interface sphere around no medium, and the one in an unsupported medium, are

@@ -26,6 +26,7 @@
 //! A light-sampling and a BSDF-sampling strategy combined by MIS stay unbiased because
 //! both treat a given (ωo, ωi) the same way: `eval` ends the companions on a
 //! dispersive transmission exactly as `sample` does.
+pub mod coated_diffuse;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse_transmission;
@@ -43,6 +44,7 @@ pub mod texture;
 pub mod textured_diffuse;
 pub mod thin_dielectric;
 
+pub use coated_diffuse::CoatedDiffuse;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse_transmission::DiffuseTransmission;
@@ -380,6 +382,8 @@ pub enum Material {
     RoughDielectric(RoughDielectric),
     /// A diffuse reflector whose ρd is an image over the surface's uv.
     TexturedDiffuse(TexturedDiffuse),
+    /// A Lambertian base under a smooth or rough dielectric coat (plastic, paint).
+    CoatedDiffuse(CoatedDiffuse),
     /// A linear polariser sheet (light passes straight through).
     Polarizer(Polarizer),
     /// A linear retarder, a wave plate (light passes straight through).
@@ -403,6 +407,7 @@ macro_rules! dispatch {
             Material::Conductor($m) => $call,
             Material::RoughConductor($m) => $call,
             Material::RoughDielectric($m) => $call,
+            Material::CoatedDiffuse($m) => $call,
             Material::Polarizer($m) => $call,
             Material::Retarder($m) => $call,
             Material::ThinDielectric($m) => $call,

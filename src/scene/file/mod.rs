@@ -278,6 +278,7 @@ pub enum MaterialFile {
     Dielectric(DielectricFile),
     Glossy(GlossyFile),
     Conductor(ConductorFile),
+    Coated(CoatedFile),
     Polarizer(PolarizerFile),
     Retarder(RetarderFile),
     #[serde(rename = "thin-dielectric")]
@@ -295,6 +296,7 @@ impl MaterialFile {
         "dielectric",
         "glossy",
         "conductor",
+        "coated",
         "polarizer",
         "retarder",
         "thin-dielectric",
@@ -426,6 +428,30 @@ pub enum MetalSpec {
         n: Colour,
         k: Colour,
     },
+}
+
+/// A Lambertian base under a dielectric coat (src/bsdf/coated_diffuse.rs): plastic,
+/// paint, varnish.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoatedFile {
+    /// The base's reflectance ρ.
+    pub reflectance: Reflectance,
+    /// The coat's refractive index (relative to the outside), possibly dispersive;
+    /// default 1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ior: Option<IorSpec>,
+    /// The coat's GGX roughness α in [0, 1]; 0 (default) is a smooth coat.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<UnitNumber>,
+    /// Optical depth τ ≥ 0 of an absorbing layer between coat and base (pbrt-v4's
+    /// `thickness`); default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Count the base's repeated reflections under the coat as ρ/(1 − ρK) (default
+    /// true, physical); false is Mitsuba's plastic default, ρ/(1 − K).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nonlinear: Option<bool>,
 }
 
 /// The seed's modified Phong model, optionally over a refractive base (`ior`).

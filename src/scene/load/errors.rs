@@ -5,10 +5,10 @@
 //! messages show.
 use crate::error::HeronError;
 use crate::scene::file::{
-    show, ConductorFile, DielectricFile, DiffuseTransmissionFile, DirectionalLightFile, GlossyFile,
-    LambertianFile, LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile, PointLightFile,
-    PolarizerFile, QuadFile, RetarderFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile,
-    ThinDielectricFile, TriangleFile, WavesFile,
+    show, CoatedFile, ConductorFile, DielectricFile, DiffuseTransmissionFile, DirectionalLightFile,
+    GlossyFile, LambertianFile, LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile,
+    PointLightFile, PolarizerFile, QuadFile, RetarderFile, ShapeFile, SphereFile, SpotLightFile,
+    SunLightFile, ThinDielectricFile, TriangleFile, WavesFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -187,6 +187,7 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("materials", "dielectric") => check::<DielectricFile>(t),
         ("materials", "glossy") => check::<GlossyFile>(t),
         ("materials", "conductor") => check::<ConductorFile>(t),
+        ("materials", "coated") => check::<CoatedFile>(t),
         ("materials", "polarizer") => check::<PolarizerFile>(t),
         ("materials", "retarder") => check::<RetarderFile>(t),
         ("materials", "thin-dielectric") => check::<ThinDielectricFile>(t),

@@ -4,8 +4,9 @@
 use super::errors::key;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    Conductor, Dielectric, DiffuseTransmission, Glossy, ImageTexture, Lambertian, Material, Mirror,
-    Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse, ThinDielectric,
+    CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Glossy, ImageTexture, Lambertian,
+    Material, Mirror, Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse,
+    ThinDielectric,
 };
 use crate::scene::file::{DiffuseTransmissionFile, IorSpec, MaterialFile, MetalSpec, SceneFile};
 use crate::spectrum::ior::Ior;
@@ -251,6 +252,26 @@ fn build_material(
                     distribution: TrowbridgeReitz { alpha },
                 })
             }
+        }
+        MaterialFile::Coated(c) => {
+            let ior = match &c.ior {
+                Some(spec) => build_ior(&format!("{at}.ior"), spec, base_dir, inputs)?,
+                None => Ior::Constant(1.5),
+            };
+            let thickness = c.thickness.unwrap_or(0.0);
+            if !(thickness >= 0.0 && (thickness as f32).is_finite()) {
+                return Err(format!(
+                    "{at}.thickness: expected a finite optical depth >= 0, got {thickness}"
+                ));
+            }
+            let alpha = c.roughness.map_or(0.0, |r| r.get());
+            Material::CoatedDiffuse(CoatedDiffuse::new(
+                c.reflectance.spectrum(),
+                ior,
+                (alpha >= MIN_ALPHA).then_some(TrowbridgeReitz { alpha }),
+                thickness as f32,
+                !c.nonlinear.unwrap_or(true),
+            ))
         }
         MaterialFile::Glossy(g) => {
             if g.fresnel.is_some() && g.ior.is_none() {

@@ -216,7 +216,10 @@ impl<'a> Converter<'a> {
                 .and_then(|m| self.materials.get(m))
                 .is_some_and(|m| matches!(m, MaterialFile::Dielectric(_)))
             {
-                Some("its BSDF does not let light into a medium (a null or dielectric BSDF does)".to_string())
+                Some(
+                    "its BSDF does not let light into a medium (a null or dielectric BSDF does)"
+                        .to_string(),
+                )
             } else {
                 None
             };

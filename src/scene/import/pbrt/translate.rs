@@ -4,8 +4,8 @@
 use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
-    Colour, ConductorFile, DielectricFile, DiffuseTransmissionFile, DirectionalLightFile,
-    GlossyFile, IorSpec, LambertianFile, MetalSpec, PointLightFile, SpotLightFile,
+    CoatedFile, Colour, ConductorFile, DielectricFile, DiffuseTransmissionFile,
+    DirectionalLightFile, IorSpec, LambertianFile, MetalSpec, PointLightFile, SpotLightFile,
     ThinDielectricFile, UnitNumber,
 };
 
@@ -122,6 +122,64 @@ impl Conv {
         }
     }
 
+    /// pbrt-v4's `coateddiffuse` as heron's coated material: its layered BxDF's
+    /// stochastic estimate becomes the closed form of src/bsdf/coated_diffuse.rs, whose
+    /// layer absorbs only (a scattering medium, `albedo` > 0, is approximated, with a
+    /// warning); `maxdepth` and `nsamples` steer pbrt's estimator and mean nothing here.
+    fn coated_diffuse(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+    ) -> Result<MaterialFile, Diagnostic> {
+        let rho = self.colour(path, p, "reflectance", 0.5)?;
+        let (u, v) = (p.float("uroughness"), p.float("vroughness"));
+        if p.get("roughness").is_none() {
+            if let (Some(u), Some(v)) = (u, v) {
+                if u != v {
+                    self.warn(self.diag(path, line, format!("coateddiffuse: anisotropic roughness (uroughness {u}, vroughness {v}); heron's coat is isotropic, their mean is used")))?;
+                }
+            }
+        }
+        let roughness = self.roughness(p);
+        p.get("remaproughness");
+        let (ior, below_one) = self.eta(path, line, p)?;
+        if let (IorSpec::Constant(e), None) | (_, Some(IorSpec::Constant(e))) = (&ior, &below_one) {
+            let e = if below_one.is_some() { 1.0 / *e } else { *e };
+            if !(e >= 1.0 && e.is_finite()) {
+                let at = p.get("eta").map_or(line, |q| q.line);
+                return Err(self.diag(
+                    path,
+                    at,
+                    format!("coateddiffuse \"eta\": expected a coat index ≥ 1, got {e}"),
+                ));
+            }
+        }
+        let thickness = p.float("thickness").unwrap_or(0.01);
+        if !(thickness >= 0.0 && thickness.is_finite()) {
+            let at = p.get("thickness").map_or(line, |q| q.line);
+            return Err(self.diag(
+                path,
+                at,
+                format!("coateddiffuse \"thickness\": expected a number ≥ 0, got {thickness}"),
+            ));
+        }
+        let albedo = self.colour(path, p, "albedo", 0.0)?;
+        let g = p.float("g").unwrap_or(0.0);
+        if albedo.max() > 0.0 || g != 0.0 {
+            self.warn(self.diag(path, line, format!("coateddiffuse: the layer's scattering (albedo {}, g {g}) is not modelled; heron's layer only absorbs, with optical depth thickness = {thickness}", albedo.max())))?;
+        }
+        p.get("maxdepth");
+        p.get("nsamples");
+        Ok(MaterialFile::Coated(CoatedFile {
+            reflectance: rho.reflectance(),
+            ior: Some(ior),
+            roughness,
+            thickness: (thickness > 0.0).then_some(tidy(thickness)),
+            nonlinear: None,
+        }))
+    }
+
     /// A microfacet material's roughness: [`Self::alpha`] when above 0, at most 1.
     fn roughness(&mut self, p: &Params) -> Option<UnitNumber> {
         self.alpha(p)
@@ -212,23 +270,7 @@ impl Conv {
                 p.get("remaproughness");
                 MaterialFile::Conductor(ConductorFile { metal, roughness })
             }
-            "coateddiffuse" => {
-                let rho = self.colour(path, p, "reflectance", 0.5)?;
-                let a = self.alpha(p).unwrap_or(0.0).max(0.01);
-                let shininess = (2.0 / (a * a) - 2.0).max(1.0);
-                let eta = p.float("eta").unwrap_or(1.5);
-                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-                p.get("remaproughness");
-                p.get("thickness");
-                self.warn(self.diag(path, line, format!("coateddiffuse is mapped to heron's glossy (modified Phong): ρd = reflectance, ρs = {f0:.4} (Fresnel at normal incidence), shininess {shininess:.0}")))?;
-                MaterialFile::Glossy(GlossyFile {
-                    rho_d: rho.reflectance(),
-                    rho_s: schema::unit(f0),
-                    shininess: schema::positive(shininess),
-                    ior: None,
-                    fresnel: None,
-                })
-            }
+            "coateddiffuse" => self.coated_diffuse(path, line, p)?,
             other => {
                 for q in &p.0 {
                     q.used.set(true);
