@@ -38,7 +38,6 @@ pub mod polarizer;
 pub mod retarder;
 pub mod rough_conductor;
 pub mod rough_dielectric;
-pub mod texture;
 pub mod textured_diffuse;
 
 pub use conductor::Conductor;
@@ -51,7 +50,6 @@ pub use polarizer::Polarizer;
 pub use retarder::Retarder;
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
-pub use texture::ImageTexture;
 pub use textured_diffuse::TexturedDiffuse;
 
 use crate::math::Frame;
@@ -374,7 +372,7 @@ pub enum Material {
     RoughConductor(RoughConductor),
     /// A Trowbridge–Reitz (GGX) microfacet dielectric interface.
     RoughDielectric(RoughDielectric),
-    /// A diffuse reflector whose ρd is an image over the surface's uv.
+    /// A diffuse reflector whose ρd is a texture over the surface's uv.
     TexturedDiffuse(TexturedDiffuse),
     /// A linear polariser sheet (light passes straight through).
     Polarizer(Polarizer),

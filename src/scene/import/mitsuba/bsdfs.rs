@@ -4,7 +4,7 @@
 use super::*;
 use crate::scene::file::{
     Colour, ConductorFile, DielectricFile, GlossyFile, IorSpec, LambertianFile, MetalSpec,
-    MirrorFile,
+    MirrorFile, Textured,
 };
 use crate::scene::import::props::index_samples;
 
@@ -408,7 +408,7 @@ pub(super) fn mitsuba_ior(name: &str) -> Option<f64> {
 /// A diffuse material of reflectance `rho`.
 fn lambertian(rho: ColourValue) -> MaterialFile {
     MaterialFile::Lambertian(LambertianFile {
-        rho_d: Some(rho.reflectance()),
+        rho_d: Some(Textured::Value(rho.reflectance())),
         texture: None,
     })
 }

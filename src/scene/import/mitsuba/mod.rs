@@ -171,6 +171,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         materials: c.materials,
         shapes: c.shapes,
         lights: c.lights,
+        textures: Default::default(),
         sky: None,
         environment: c.environment,
     };

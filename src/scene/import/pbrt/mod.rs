@@ -215,6 +215,7 @@ impl Conv {
             materials: std::mem::take(&mut self.materials),
             shapes,
             lights: std::mem::take(&mut self.lights),
+            textures: Default::default(),
             sky: None,
             environment: self.environment.take(),
         };

@@ -5,7 +5,7 @@ use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
     Colour, ConductorFile, DielectricFile, DirectionalLightFile, GlossyFile, IorSpec,
-    LambertianFile, MetalSpec, PointLightFile, SpotLightFile, UnitNumber,
+    LambertianFile, MetalSpec, PointLightFile, SpotLightFile, Textured, UnitNumber,
 };
 
 impl Conv {
@@ -734,7 +734,7 @@ impl Conv {
 /// A diffuse material of reflectance `rho`.
 fn lambertian(rho: ColourValue) -> MaterialFile {
     MaterialFile::Lambertian(LambertianFile {
-        rho_d: Some(rho.reflectance()),
+        rho_d: Some(Textured::Value(rho.reflectance())),
         texture: None,
     })
 }
