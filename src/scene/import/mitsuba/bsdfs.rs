@@ -135,8 +135,11 @@ impl<'a> Converter<'a> {
                 texture: Some(file),
             }));
         }
-        let rho = self.colour(p, "reflectance", ColourValue::Grey(0.5))?;
-        Ok(lambertian(rho))
+        let rho = self.textured_reflectance(p, "reflectance", ColourValue::Grey(0.5))?;
+        Ok(MaterialFile::Lambertian(LambertianFile {
+            rho_d: Some(rho),
+            texture: None,
+        }))
     }
 
     pub(super) fn dielectric(

@@ -152,9 +152,10 @@ impl Conv {
             }
             "Import" => self.import(d),
             "WorldEnd" | "OptionBool" | "ColorSpace" | "Option" => Ok(()),
-            "Texture" | "MakeNamedMedium" | "MediumInterface" | "CoordinateSystem"
-            | "CoordSysTransform" | "Attribute" | "PixelFilter" | "Accelerator"
-            | "ActiveTransform" | "TransformTimes" => {
+            "Texture" => self.texture_directive(path, line, &d.st.strs, d.params()),
+            "MakeNamedMedium" | "MediumInterface" | "CoordinateSystem" | "CoordSysTransform"
+            | "Attribute" | "PixelFilter" | "Accelerator" | "ActiveTransform"
+            | "TransformTimes" => {
                 for q in &d.params().0 {
                     q.used.set(true);
                 }

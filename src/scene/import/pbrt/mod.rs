@@ -24,13 +24,14 @@ use super::schema::{self, tidy};
 use super::xml::Diagnostic;
 use crate::scene::file::{
     CameraFile, Emission, EnvironmentFile, LightFile, MaterialFile, RenderFile, SceneFile,
-    ShapeFile,
+    ShapeFile, TextureFile,
 };
 use glam::{DMat4, DVec3};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 mod directives;
+mod textures;
 mod tokens;
 mod translate;
 
@@ -126,6 +127,11 @@ struct Conv {
     strict: bool,
     warnings: Vec<Diagnostic>,
     materials: BTreeMap<String, MaterialFile>,
+    /// `[textures]` from `Texture` directives (textures.rs).
+    textures: BTreeMap<String, TextureFile>,
+    /// The table of each texture by (float, pbrt name): pbrt's float and spectrum
+    /// textures have names of their own.
+    texture_names: HashMap<(bool, String), String>,
     named: HashMap<String, String>,
     shapes: Vec<Slot>,
     lights: Vec<LightFile>,
@@ -169,6 +175,8 @@ impl Conv {
             strict,
             warnings: Vec::new(),
             materials: BTreeMap::new(),
+            textures: BTreeMap::new(),
+            texture_names: HashMap::new(),
             named: HashMap::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
@@ -215,7 +223,7 @@ impl Conv {
             materials: std::mem::take(&mut self.materials),
             shapes,
             lights: std::mem::take(&mut self.lights),
-            textures: Default::default(),
+            textures: std::mem::take(&mut self.textures),
             sky: None,
             environment: self.environment.take(),
         };

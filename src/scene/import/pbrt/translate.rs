@@ -150,7 +150,10 @@ impl Conv {
         name: Option<&str>,
     ) -> Result<String, Diagnostic> {
         let t = match ty {
-            "diffuse" => lambertian(self.colour(path, p, "reflectance", 0.5)?),
+            "diffuse" => MaterialFile::Lambertian(LambertianFile {
+                rho_d: Some(self.textured(path, p, "reflectance", 0.5)?),
+                texture: None,
+            }),
             "dielectric" | "thindielectric" => {
                 if ty == "thindielectric" {
                     self.warn(self.diag(
