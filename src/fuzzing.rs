@@ -138,8 +138,12 @@ fn check_material(m: &Material) {
     match m {
         Material::Lambertian(l) => reflectance("rho_d", &l.rho_d),
         Material::TexturedDiffuse(t) => {
-            let (w, h) = t.texture.size();
-            assert!(w >= 1 && h >= 1);
+            for n in t.texture().nodes() {
+                if let crate::texture::Node::Image { image, .. } = n {
+                    let (w, h) = image.size();
+                    assert!(w >= 1 && h >= 1);
+                }
+            }
         }
         Material::Mirror(mi) => reflectance("rho_s", &mi.rho_s),
         Material::Dielectric(d) => dielectric(d),

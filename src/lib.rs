@@ -36,6 +36,7 @@ pub mod settings;
 pub mod sky;
 pub mod spectrum;
 pub mod stress;
+pub mod texture;
 pub mod trace;
 
 pub use error::{HeronError, Result};

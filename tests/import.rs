@@ -484,7 +484,7 @@ fn obj_and_ply_meshes_take_the_transform() {
 fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
     let body = r#"
     <shape type="sphere">
-        <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf>
+        <bsdf type="diffuse"><texture type="mesh_attribute" name="reflectance"/></bsdf>
     </shape>
     <emitter type="sunsky"/>
     <shape type="cylinder"/>
@@ -498,7 +498,13 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
         .map(|w| (w.line, w.message.as_str()))
         .collect();
     let has = |line: u32, s: &str| lines.iter().any(|(l, m)| *l == line && m.contains(s));
-    assert!(has(9, "textures other than a bitmap"), "{lines:#?}");
+    assert!(
+        has(
+            9,
+            "texture \"mesh_attribute\" is not supported (bitmap and checkerboard are)"
+        ),
+        "{lines:#?}"
+    );
     assert!(has(11, "emitter \"sunsky\" is not supported"), "{lines:#?}");
     assert!(has(12, "shape \"cylinder\" is not supported"), "{lines:#?}");
     assert!(has(13, "parameter \"nonsense\""), "{lines:#?}");
@@ -512,7 +518,7 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
     let (_d, r) = import_with(&scene(body), &strict);
     let e = r.unwrap_err().to_string();
     assert!(
-        e.contains("scene.xml: line 9: ") && e.contains("textures"),
+        e.contains("scene.xml: line 9: ") && e.contains("mesh_attribute"),
         "{e}"
     );
 }
@@ -897,7 +903,7 @@ fn pbrt_errors_and_warnings_name_the_line() {
         assert!(e.contains(&format!("scene.pbrt: line {line}: ")) && e.contains(want), "{e}");
     }
     let (_d, r) = import_pbrt(&format!(
-        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"\nShape \"cylinder\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
+        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"fbm\"\nShape \"cylinder\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
     ));
     let imp = r.unwrap();
     let has = |line: u32, s: &str| {
@@ -905,7 +911,11 @@ fn pbrt_errors_and_warnings_name_the_line() {
             .iter()
             .any(|w| w.line == line && w.message.contains(s))
     };
-    assert!(has(6, "Texture is not supported"), "{:?}", imp.warnings);
+    assert!(
+        has(6, "Texture \"wood\": class \"fbm\" is not supported"),
+        "{:?}",
+        imp.warnings
+    );
     assert!(
         has(7, "Shape \"cylinder\" is not supported"),
         "{:?}",
@@ -1698,8 +1708,8 @@ fn a_pbrt_spectral_film_sets_heron_s_spectral_bins() {
 }
 
 /// Mitsuba's `bitmap` as a diffuse reflectance (nested or by `ref`) becomes a textured
-/// `lambertian`, its file relative to the converted TOML; settings heron does not share
-/// warn.
+/// `lambertian`, its file relative to the converted TOML (a bitmap with `to_uv`, a
+/// `[textures]` table with the transform); settings heron does not share warn.
 #[test]
 fn a_mitsuba_bitmap_reflectance_converts_to_a_texture() {
     let dir = tempfile::tempdir().unwrap();
@@ -1721,20 +1731,92 @@ fn a_mitsuba_bitmap_reflectance_converts_to_a_texture() {
         .values()
         .filter_map(|m| m.get("texture").and_then(|t| t.as_str()))
         .collect();
-    assert_eq!(textured, ["tex/wood.png", "tex/wood.png"]);
+    assert_eq!(textured, ["tex/wood.png"]);
+    assert_eq!(
+        get(&t, "textures.texture.to_uv").to_string(),
+        "[[2.0, 0.0, 0.0], [0.0, 1.0, 0.0]]"
+    );
     let has = |s: &str| imp.warnings.iter().any(|w| w.message.contains(s));
     assert!(
         has("wrap_mode \"mirror\": heron's textures are repeat"),
         "{:?}",
         imp.warnings
     );
-    assert!(has("to_uv is not supported"), "{:?}", imp.warnings);
+    assert!(!has("to_uv"), "{:?}", imp.warnings);
     let s = load_imported(&imp).unwrap();
     assert!(s.materials.iter().all(|m| m.is_textured()));
     let out = dir.path().join("out");
     std::fs::create_dir_all(&out).unwrap();
     let t = imp.to_toml(&out);
     assert!(t.contains("texture = \"../tex/wood.png\""), "{t}");
+    assert!(t.contains("file = \"../tex/wood.png\""), "{t}");
+}
+
+/// Mitsuba's `checkerboard` (colours or nested textures, `to_uv`) and pbrt-v4's
+/// `Texture` directives of each kind become `[textures]` tables, their uv mappings
+/// rewritten as heron's `to_uv` (pbrt's image v flipped, its checkerboard halved).
+#[test]
+fn checkerboards_and_pbrt_textures_convert_to_texture_tables() {
+    let body = r#"
+    <shape type="sphere"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance">
+        <rgb name="color0" value="0.9, 0.1, 0.1"/>
+        <texture type="checkerboard" name="color1"/>
+        <transform name="to_uv"><scale x="4" y="2"/><translate x="0.5" y="0.25"/></transform>
+    </texture></bsdf></shape>"#;
+    let (_d, r) = import_text(&scene(body));
+    let imp = r.unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    let t = imp.table();
+    // The nested texture is converted first: "texture", its parent "texture-2".
+    assert_eq!(
+        get(&t, "textures.texture-2.to_uv").to_string(),
+        "[[4.0, 0.0, 0.5], [0.0, 2.0, 0.25]]"
+    );
+    assert_eq!(
+        get(&t, "textures.texture-2.color1.texture").as_str(),
+        Some("texture")
+    );
+    // Mitsuba's defaults, 0.4 and 0.2.
+    assert_eq!(get(&t, "textures.texture.color0").as_float(), Some(0.4));
+    assert_eq!(get(&t, "textures.texture.color1").as_float(), Some(0.2));
+    load_imported(&imp).unwrap();
+
+    let (_d, r) = import_pbrt(&format!(
+        "{PBRT_CAMERA}Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"w.png\" \"float uscale\" 2 \"float vdelta\" 0.25 \"string encoding\" \"gamma 2.2\" \"float scale\" 0.5 \"bool invert\" \"true\"
+Texture \"c\" \"spectrum\" \"checkerboard\" \"float uscale\" 8 \"float vscale\" 4 \"rgb tex2\" [ 0.1 0.2 0.3 ] \"texture tex1\" \"img\"
+Texture \"amt\" \"float\" \"checkerboard\" \"float tex1\" 0.25
+Texture \"s\" \"spectrum\" \"scale\" \"texture tex\" \"c\" \"float scale\" 2
+Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"s\" \"rgb tex2\" [ 1 1 1 ] \"texture amount\" \"amt\"
+Material \"diffuse\" \"texture reflectance\" \"m\"
+Shape \"sphere\"
+"
+    ));
+    let imp = r.unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    let t = imp.table();
+    let s = |k: &str| get(&t, k).to_string();
+    assert_eq!(
+        s("textures.img.to_uv"),
+        "[[2.0, 0.0, 0.0], [0.0, -1.0, 0.75]]"
+    );
+    assert_eq!(s("textures.img.encoding"), "\"gamma 2.2\"");
+    assert_eq!(s("textures.img.scale"), "0.5");
+    assert_eq!(s("textures.img.invert"), "true");
+    assert_eq!(s("textures.c.to_uv"), "[[4.0, 0.0, 0.0], [0.0, 2.0, 0.0]]");
+    assert_eq!(s("textures.c.color0.texture"), "\"img\"");
+    assert_eq!(s("textures.c.color1"), "[0.1, 0.2, 0.3]");
+    let amt = get(&t, "textures").get("amt (float)").unwrap();
+    assert_eq!(amt["color0"].to_string(), "0.25");
+    assert_eq!(amt["color1"].to_string(), "0.0");
+    assert_eq!(s("textures.s.scale"), "2.0");
+    assert_eq!(s("textures.m.amount.texture"), "\"amt (float)\"");
+    let m = get(&t, "materials")
+        .as_table()
+        .unwrap()
+        .values()
+        .next()
+        .unwrap();
+    assert_eq!(m.get("rho_d").unwrap().to_string(), "{ texture = \"m\" }");
 }
 
 /// Mitsuba 3's `thindielectric` and pbrt-v4's `thindielectric` and

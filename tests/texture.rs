@@ -1,5 +1,5 @@
 //! Image textures of reflectance (`type = "lambertian"` with `texture = "file"`,
-//! src/bsdf/texture.rs): a textured square facing the camera under a uniform white
+//! src/texture/image.rs): a textured square facing the camera under a uniform white
 //! environment sends back ρ(uv) times the environment (it sees nothing but the sky), so
 //! the image is the texture itself, texel for texel, under every integrator that sees
 //! the environment; the layout of uv on a quad and a sphere; the loader's errors.
@@ -161,7 +161,7 @@ fn texture_errors_name_the_material_and_the_file() {
         ),
         (
             "type = \"lambertian\"",
-            "materials.m: expected rho_d (a reflectance) or texture (an image file)",
+            "materials.m: expected rho_d (a reflectance or { texture = \"NAME\" }) or texture (a [textures] table or an image file)",
         ),
         (
             "type = \"lambertian\"\ntexture = \"nope.png\"",

@@ -40,7 +40,6 @@ pub mod polarizer;
 pub mod retarder;
 pub mod rough_conductor;
 pub mod rough_dielectric;
-pub mod texture;
 pub mod textured_diffuse;
 pub mod thin_dielectric;
 
@@ -56,7 +55,6 @@ pub use polarizer::Polarizer;
 pub use retarder::Retarder;
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
-pub use texture::ImageTexture;
 pub use textured_diffuse::TexturedDiffuse;
 pub use thin_dielectric::ThinDielectric;
 
@@ -380,7 +378,7 @@ pub enum Material {
     RoughConductor(RoughConductor),
     /// A Trowbridge–Reitz (GGX) microfacet dielectric interface.
     RoughDielectric(RoughDielectric),
-    /// A diffuse reflector whose ρd is an image over the surface's uv.
+    /// A diffuse reflector whose ρd is a texture over the surface's uv.
     TexturedDiffuse(TexturedDiffuse),
     /// A Lambertian base under a smooth or rough dielectric coat (plastic, paint).
     CoatedDiffuse(CoatedDiffuse),

@@ -400,7 +400,7 @@ impl Serialize for Resolution {
 }
 
 /// `{ key = value }`, the one-key tables of the leaves' table forms.
-pub(super) fn one_key<S: Serializer, T: Serialize + ?Sized>(
+pub(crate) fn one_key<S: Serializer, T: Serialize + ?Sized>(
     s: S,
     key: &str,
     value: &T,

@@ -66,6 +66,7 @@ mod colour;
 mod leaves;
 mod metal;
 mod show;
+mod texture;
 
 pub use coefficient::Coefficient;
 pub use colour::{Colour, Emission, Reflectance};
@@ -74,6 +75,10 @@ pub use leaves::{
 };
 pub(crate) use show::fmt_f32;
 pub use show::show;
+pub use texture::{
+    CheckerboardFile, ImageTextureFile, MixTextureFile, ScaleTextureFile, TextureFile, Textured,
+    UvMatrix,
+};
 
 /// Largest accepted image width or height.
 pub const MAX_RESOLUTION: u32 = 16384;
@@ -92,6 +97,10 @@ pub struct SceneFile {
     /// scene lists materials sorted by name (the order of this map).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub materials: BTreeMap<String, MaterialFile>,
+    /// Textures by name (`[textures.NAME]`), which materials' keys name with
+    /// `{ texture = "NAME" }`.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub textures: BTreeMap<String, TextureFile>,
     #[serde(default)]
     pub shapes: Vec<ShapeFile>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -366,12 +375,12 @@ pub struct RetarderFile {
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LambertianFile {
-    /// ρd; or, instead, `texture`.
+    /// ρd: a reflectance or `{ texture = "NAME" }`; or, instead, `texture`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rho_d: Option<Reflectance>,
-    /// An image of ρd over the surface's uv (src/bsdf/texture.rs), relative to the scene
-    /// file: PNG (sRGB-decoded), OpenEXR or Radiance HDR (linear); linear sRGB,
-    /// components clamped to [0, 1].
+    pub rho_d: Option<Textured<Reflectance>>,
+    /// ρd over the surface's uv: the name of a `[textures]` table, or else an image file
+    /// (src/texture/image.rs), relative to the scene file: PNG or JPEG (sRGB-decoded),
+    /// OpenEXR, Radiance HDR or PFM (linear); linear sRGB, components clamped to [0, 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub texture: Option<String>,
 }
@@ -925,6 +934,7 @@ mod tests {
         assert_eq!(serde_tags::<MaterialFile>(), MaterialFile::NAMES);
         assert_eq!(serde_tags::<ShapeFile>(), ShapeFile::NAMES);
         assert_eq!(serde_tags::<LightFile>(), LightFile::NAMES);
+        assert_eq!(serde_tags::<TextureFile>(), TextureFile::NAMES);
         // Each shape type's entry reports its own name.
         for (name, keys) in [
             ("sphere", "center = [0, 0, 0]\nradius = 1"),

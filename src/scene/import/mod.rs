@@ -17,7 +17,7 @@ pub use mitsuba::{DISK_SEGMENTS, UNBOUNDED_DEPTH};
 pub use xml::Diagnostic;
 
 use crate::error::{HeronError, Result};
-use crate::scene::file::{LambertianFile, MaterialFile, SceneFile, ShapeFile};
+use crate::scene::file::{LambertianFile, MaterialFile, SceneFile, ShapeFile, TextureFile};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -149,6 +149,11 @@ impl Imported {
             }) = m
             {
                 rebase(t);
+            }
+        }
+        for t in scene.textures.values_mut() {
+            if let TextureFile::Image(i) = t {
+                rebase(&mut i.file);
             }
         }
         if let Some(e) = &mut scene.environment {

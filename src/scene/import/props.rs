@@ -448,7 +448,7 @@ impl<'a> Props<'a> {
                 }
             }
             "texture" | "ref" => Err(ColourError::Unsupported(
-                n.diag("textures other than a bitmap as a diffuse reflectance are not supported by heron's import yet"),
+                n.diag("textures other than a bitmap or checkerboard as a diffuse reflectance are not supported by heron's import yet"),
             )),
             _ => Err(bad(format!("expected <rgb name=\"{name}\" value=\"…\"/>"))),
         }

@@ -5,10 +5,11 @@
 //! messages show.
 use crate::error::HeronError;
 use crate::scene::file::{
-    show, CoatedFile, ConductorFile, DielectricFile, DiffuseTransmissionFile, DirectionalLightFile,
-    GlossyFile, LambertianFile, LightFile, MaterialFile, MeshFile, MirrorFile, PlaneFile,
-    PointLightFile, PolarizerFile, QuadFile, RetarderFile, ShapeFile, SphereFile, SpotLightFile,
-    SunLightFile, ThinDielectricFile, TriangleFile, WavesFile,
+    show, CheckerboardFile, CoatedFile, ConductorFile, DielectricFile, DiffuseTransmissionFile,
+    DirectionalLightFile, GlossyFile, ImageTextureFile, LambertianFile, LightFile, MaterialFile,
+    MeshFile, MirrorFile, MixTextureFile, PlaneFile, PointLightFile, PolarizerFile, QuadFile,
+    RetarderFile, ScaleTextureFile, ShapeFile, SphereFile, SpotLightFile, SunLightFile,
+    TextureFile, ThinDielectricFile, TriangleFile, WavesFile,
 };
 use glam::Vec3;
 use serde::de::DeserializeOwned;
@@ -156,6 +157,7 @@ fn tagged_item(path: &[Seg]) -> Option<&'static [&'static str]> {
         [Seg::Key(c), Seg::Key(_)] if c == "materials" => Some(MaterialFile::NAMES),
         [Seg::Key(c), Seg::Index(_)] if c == "shapes" => Some(ShapeFile::NAMES),
         [Seg::Key(c), Seg::Index(_)] if c == "lights" => Some(LightFile::NAMES),
+        [Seg::Key(c), Seg::Key(_)] if c == "textures" => Some(TextureFile::NAMES),
         _ => None,
     }
 }
@@ -202,6 +204,10 @@ fn refine(table: &toml::Table, path: &[Seg]) -> Option<(Vec<Seg>, String)> {
         ("lights", "directional") => check::<DirectionalLightFile>(t),
         ("lights", "sun") => check::<SunLightFile>(t),
         ("lights", "spot") => check::<SpotLightFile>(t),
+        ("textures", "image") => check::<ImageTextureFile>(t),
+        ("textures", "checkerboard") => check::<CheckerboardFile>(t),
+        ("textures", "scale") => check::<ScaleTextureFile>(t),
+        ("textures", "mix") => check::<MixTextureFile>(t),
         _ => None,
     }?;
     let mut full = item_path.to_vec();

@@ -19,6 +19,41 @@ const EXTENSIONS: &str = ".exr, .hdr, .pfm, .png, .jpg or .jpeg";
 /// Reads `path` by its extension (`.exr`, `.hdr`, `.pfm`, `.png`, `.jpg`, `.jpeg`, in any
 /// case). The error names the file and what was wrong with it.
 pub fn read_rgb(path: &Path) -> Result<RgbImage, String> {
+    read_rgb_encoded(path, Encoding::Srgb)
+}
+
+/// How an 8- or 16-bit image's (PNG's, JPEG's) values become linear (pbrt-v4's
+/// `ColorEncoding`: `sRGB`, `linear`, `gamma g`); OpenEXR, HDR and PFM are linear.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Encoding {
+    Srgb,
+    Linear,
+    /// value^g.
+    Gamma(f32),
+}
+
+impl Encoding {
+    /// `"srgb"`, `"linear"` or `"gamma G"` (G > 0), as a scene file writes it.
+    pub fn parse(s: &str) -> Result<Encoding, String> {
+        let bad = || format!("expected \"srgb\", \"linear\" or \"gamma G\" with G > 0, got {s:?}");
+        match s {
+            "srgb" => Ok(Encoding::Srgb),
+            "linear" => Ok(Encoding::Linear),
+            _ => {
+                let g = s.strip_prefix("gamma ").ok_or_else(bad)?;
+                let g: f32 = g.trim().parse().map_err(|_| bad())?;
+                if g.is_finite() && g > 0.0 {
+                    Ok(Encoding::Gamma(g))
+                } else {
+                    Err(bad())
+                }
+            }
+        }
+    }
+}
+
+/// [`read_rgb`] with a PNG's or JPEG's values decoded by `encoding`.
+pub fn read_rgb_encoded(path: &Path, encoding: Encoding) -> Result<RgbImage, String> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -28,7 +63,12 @@ pub fn read_rgb(path: &Path) -> Result<RgbImage, String> {
     let img = match ext.as_str() {
         "exr" => read_exr(path).map_err(|e| format!("{shown}: {e}"))?,
         "hdr" | "png" | "jpg" | "jpeg" => {
-            read_with_image(path, ext != "hdr").map_err(|e| format!("{shown}: {e}"))?
+            let encoding = if ext == "hdr" {
+                Encoding::Linear
+            } else {
+                encoding
+            };
+            read_with_image(path, encoding).map_err(|e| format!("{shown}: {e}"))?
         }
         "pfm" => std::fs::read(path)
             .map_err(|e| format!("cannot open it: {e}"))
@@ -100,7 +140,7 @@ fn read_exr(path: &Path) -> Result<RgbImage, String> {
     Ok(image.layer_data.channel_data.pixels)
 }
 
-fn read_with_image(path: &Path, srgb: bool) -> Result<RgbImage, String> {
+fn read_with_image(path: &Path, encoding: Encoding) -> Result<RgbImage, String> {
     let reader = image::ImageReader::open(path)
         .map_err(|e| format!("cannot open it: {e}"))?
         .with_guessed_format()
@@ -114,10 +154,10 @@ fn read_with_image(path: &Path, srgb: bool) -> Result<RgbImage, String> {
         .pixels()
         .map(|p| {
             let c = [p.0[0], p.0[1], p.0[2]];
-            if srgb {
-                c.map(srgb_decode)
-            } else {
-                c
+            match encoding {
+                Encoding::Srgb => c.map(srgb_decode),
+                Encoding::Linear => c,
+                Encoding::Gamma(g) => c.map(|v| v.powf(g)),
             }
         })
         .collect();

@@ -2,13 +2,15 @@
 //! metals' complex indices read from the catalogue, formulas or tables), the two materials
 //! the loader adds for shapes that name none, and the lookup of a material by name.
 use super::errors::key;
+use super::textures::Textures;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Glossy, ImageTexture, Lambertian,
-    Material, Mirror, Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse,
-    ThinDielectric,
+    CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Glossy, Lambertian, Material,
+    Mirror, Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse, ThinDielectric,
 };
-use crate::scene::file::{DiffuseTransmissionFile, IorSpec, MaterialFile, MetalSpec, SceneFile};
+use crate::scene::file::{
+    DiffuseTransmissionFile, IorSpec, MaterialFile, MetalSpec, SceneFile, Textured,
+};
 use crate::spectrum::ior::Ior;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::DenseSpectrum;
@@ -41,11 +43,13 @@ impl Materials {
     ) -> Result<Materials, String> {
         let mut list = Vec::with_capacity(file.materials.len());
         let mut names = Vec::with_capacity(file.materials.len());
+        let mut textures = Textures::new(&file.textures, base_dir);
         for (name, m) in &file.materials {
             list.push(build_material(
                 &key("materials", name),
                 m,
                 base_dir,
+                &mut textures,
                 inputs,
             )?);
             names.push(name.clone());
@@ -181,25 +185,25 @@ fn build_material(
     at: &str,
     m: &MaterialFile,
     base_dir: &Path,
+    textures: &mut Textures,
     inputs: &mut Vec<String>,
 ) -> std::result::Result<Material, String> {
     Ok(match m {
         MaterialFile::Lambertian(l) => match (&l.rho_d, &l.texture) {
-            (Some(rho), None) => Material::Lambertian(Lambertian {
+            (Some(Textured::Value(rho)), None) => Material::Lambertian(Lambertian {
                 rho_d: rho.spectrum(),
             }),
-            (None, Some(file)) => {
-                let img = super::image::read_rgb(&base_dir.join(file))
-                    .map_err(|e| format!("{at}.texture: {e}"))?;
-                inputs.push(file.clone());
-                Material::TexturedDiffuse(TexturedDiffuse {
-                    texture: std::sync::Arc::new(ImageTexture::new(
-                        img.width,
-                        img.height,
-                        &img.pixels,
-                    )),
-                })
-            }
+            (Some(Textured::Texture(name)), None) => Material::TexturedDiffuse(
+                TexturedDiffuse::new(textures.tree(&format!("{at}.rho_d"), name, inputs)?),
+            ),
+            // `texture` names a [textures] table, or else (as before tables) a file.
+            (None, Some(t)) => Material::TexturedDiffuse(TexturedDiffuse::new(
+                if textures.has(t) {
+                    textures.tree(&format!("{at}.texture"), t, inputs)?
+                } else {
+                    textures.image_file(&format!("{at}.texture"), t, inputs)?
+                },
+            )),
             (Some(_), Some(_)) => {
                 return Err(format!(
                     "{at}: expected rho_d or texture, not both (the texture is the reflectance)"
@@ -207,7 +211,7 @@ fn build_material(
             }
             (None, None) => {
                 return Err(format!(
-                    "{at}: expected rho_d (a reflectance) or texture (an image file)"
+                    "{at}: expected rho_d (a reflectance or {{ texture = \"NAME\" }}) or texture (a [textures] table or an image file)"
                 ))
             }
         },

@@ -41,6 +41,7 @@ mod media;
 mod settings;
 mod shapes;
 mod sky;
+mod textures;
 
 pub use materials::ior_from_value;
 pub use media::MEDIUM_DEFAULT_NODES;

@@ -4,7 +4,7 @@
 use super::*;
 use crate::scene::file::{
     CoatedFile, Colour, ConductorFile, DielectricFile, IorSpec, LambertianFile, MetalSpec,
-    MirrorFile, ThinDielectricFile,
+    MirrorFile, Textured, ThinDielectricFile,
 };
 use crate::scene::import::props::index_samples;
 
@@ -121,8 +121,11 @@ impl<'a> Converter<'a> {
                 texture: Some(file),
             }));
         }
-        let rho = self.colour(p, "reflectance", ColourValue::Grey(0.5))?;
-        Ok(lambertian(rho))
+        let rho = self.textured_reflectance(p, "reflectance", ColourValue::Grey(0.5))?;
+        Ok(MaterialFile::Lambertian(LambertianFile {
+            rho_d: Some(rho),
+            texture: None,
+        }))
     }
 
     pub(super) fn dielectric(
@@ -431,7 +434,7 @@ pub(super) fn mitsuba_ior(name: &str) -> Option<f64> {
 /// A diffuse material of reflectance `rho`.
 fn lambertian(rho: ColourValue) -> MaterialFile {
     MaterialFile::Lambertian(LambertianFile {
-        rho_d: Some(rho.reflectance()),
+        rho_d: Some(Textured::Value(rho.reflectance())),
         texture: None,
     })
 }

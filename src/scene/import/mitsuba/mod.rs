@@ -10,7 +10,7 @@ use super::schema;
 use super::xml::{Diagnostic, Node};
 use crate::scene::file::{
     CameraFile, Emission, EnvironmentFile, LightFile, MaterialFile, RenderFile, SceneFile,
-    ShapeFile,
+    ShapeFile, TextureFile,
 };
 use glam::{DMat4, DVec3};
 use std::collections::{BTreeMap, HashMap};
@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 mod bsdfs;
 mod media;
 mod shapes;
+mod textures;
 
 /// A triangle fan of this many triangles stands for a `disk` (area 0.9996 of the disk).
 pub const DISK_SEGMENTS: usize = 128;
@@ -83,6 +84,10 @@ struct Converter<'a> {
     ids: HashMap<&'a str, &'a Node>,
     warnings: Vec<Diagnostic>,
     materials: BTreeMap<String, MaterialFile>,
+    /// `[textures]`, from `bitmap` and `checkerboard` elements (textures.rs).
+    textures: BTreeMap<String, TextureFile>,
+    /// Table name of each converted texture element (shared through `ref`).
+    texture_of: HashMap<*const Node, String>,
     /// Material name of each converted BSDF element (shared through `ref`).
     material_of: HashMap<*const Node, String>,
     default_material: Option<String>,
@@ -115,6 +120,8 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         ids,
         warnings: Vec::new(),
         materials: BTreeMap::new(),
+        textures: BTreeMap::new(),
+        texture_of: HashMap::new(),
         material_of: HashMap::new(),
         default_material: None,
         shapes: Vec::new(),
@@ -173,6 +180,7 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
         materials: c.materials,
         shapes: c.shapes,
         lights: c.lights,
+        textures: c.textures,
         sky: None,
         environment: c.environment,
     };
@@ -248,54 +256,6 @@ impl<'a> Converter<'a> {
             .get(id)
             .copied()
             .ok_or_else(|| n.diag(format!("no element has the id {id:?}")))
-    }
-
-    /// The image file of parameter `name` when it is a `bitmap` texture (nested or by
-    /// `ref`), relative to the top-level file's folder, as heron's `texture` reads it
-    /// (bilinear, repeating, 8-bit images sRGB-decoded: Mitsuba's defaults). Its other
-    /// settings warn where heron differs.
-    fn bitmap(&mut self, p: &Props<'a>, name: &str) -> Result<Option<String>, Diagnostic> {
-        let Some(n) = p
-            .node
-            .children
-            .iter()
-            .find(|c| c.attr("name") == Some(name))
-        else {
-            return Ok(None);
-        };
-        let t = self.resolve(n)?;
-        if t.tag != "texture" || t.attr("type") != Some("bitmap") {
-            return Ok(None);
-        }
-        p.get(name);
-        let tp = self.props(t);
-        let Some(file) = tp.string("filename")? else {
-            return Err(t.diag("expected <string name=\"filename\" value=\"…\"/>"));
-        };
-        let rel = relative_to(&self.find(t, file), &self.base);
-        for (key, default) in [("filter_type", "bilinear"), ("wrap_mode", "repeat")] {
-            if let Some(v) = tp.string(key)? {
-                if v != default {
-                    self.warn(t.diag(format!(
-                        "{key} {v:?}: heron's textures are {default}, which is used"
-                    )))?;
-                }
-            }
-        }
-        if tp.boolean("raw")? == Some(true) {
-            self.warn(t.diag(
-                "raw: heron decodes an 8-bit image's sRGB curve regardless (Mitsuba's spectral variants refuse a raw reflectance)",
-            ))?;
-        }
-        if let Some(m) = tp.transform("to_uv")? {
-            if m != DMat4::IDENTITY {
-                self.warn(t.diag("to_uv is not supported, ignored: the texture is not moved"))?;
-            }
-        }
-        for w in tp.unread() {
-            self.warn(w)?;
-        }
-        Ok(Some(rel.to_string_lossy().replace('\\', "/")))
     }
 
     /// A colour, or `default` when absent; unsupported forms warn and use `default`.

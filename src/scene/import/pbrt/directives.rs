@@ -157,7 +157,8 @@ impl Conv {
                 self.medium_interface(&d.st.strs);
                 Ok(())
             }
-            "Texture" | "CoordinateSystem" | "CoordSysTransform" | "Attribute" | "PixelFilter"
+            "Texture" => self.texture_directive(path, line, &d.st.strs, d.params()),
+            "CoordinateSystem" | "CoordSysTransform" | "Attribute" | "PixelFilter"
             | "Accelerator" | "ActiveTransform" | "TransformTimes" => {
                 for q in &d.params().0 {
                     q.used.set(true);

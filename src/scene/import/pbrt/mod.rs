@@ -24,7 +24,7 @@ use super::schema::{self, tidy};
 use super::xml::Diagnostic;
 use crate::scene::file::{
     CameraFile, Emission, EnvironmentFile, LightFile, MaterialFile, RenderFile, SceneFile,
-    ShapeFile,
+    ShapeFile, TextureFile,
 };
 use glam::{DMat4, DVec3};
 use std::collections::{BTreeMap, HashMap};
@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 
 mod directives;
 mod media;
+mod textures;
 mod tokens;
 mod translate;
 
@@ -133,6 +134,11 @@ struct Conv {
     strict: bool,
     warnings: Vec<Diagnostic>,
     materials: BTreeMap<String, MaterialFile>,
+    /// `[textures]` from `Texture` directives (textures.rs).
+    textures: BTreeMap<String, TextureFile>,
+    /// The table of each texture by (float, pbrt name): pbrt's float and spectrum
+    /// textures have names of their own.
+    texture_names: HashMap<(bool, String), String>,
     named: HashMap<String, String>,
     /// `MakeNamedMedium`s by name (None: a type heron does not have).
     media: HashMap<String, Option<crate::scene::file::MediumFile>>,
@@ -180,6 +186,8 @@ impl Conv {
             strict,
             warnings: Vec::new(),
             materials: BTreeMap::new(),
+            textures: BTreeMap::new(),
+            texture_names: HashMap::new(),
             named: HashMap::new(),
             media: HashMap::new(),
             outside_warned: std::collections::HashSet::new(),
@@ -230,6 +238,7 @@ impl Conv {
             materials: std::mem::take(&mut self.materials),
             shapes,
             lights: std::mem::take(&mut self.lights),
+            textures: std::mem::take(&mut self.textures),
             sky: None,
             environment: self.environment.take(),
         };

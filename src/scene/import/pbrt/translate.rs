@@ -6,7 +6,7 @@ use super::*;
 use crate::scene::file::{
     CoatedFile, Colour, ConductorFile, DielectricFile, DiffuseTransmissionFile,
     DirectionalLightFile, IorSpec, LambertianFile, MetalSpec, PointLightFile, SpotLightFile,
-    ThinDielectricFile, UnitNumber,
+    Textured, ThinDielectricFile, UnitNumber,
 };
 
 impl Conv {
@@ -211,7 +211,10 @@ impl Conv {
         let t = match ty {
             // Not a material: the shape bounds a medium (`media.rs`).
             "interface" => return Ok(super::media::INTERFACE.to_string()),
-            "diffuse" => lambertian(self.colour(path, p, "reflectance", 0.5)?),
+            "diffuse" => MaterialFile::Lambertian(LambertianFile {
+                rho_d: Some(self.textured(path, p, "reflectance", 0.5)?),
+                texture: None,
+            }),
             "dielectric" => {
                 let (ior, outside_ior) = self.eta(path, line, p)?;
                 let roughness = self.roughness(p);
@@ -880,7 +883,7 @@ fn faces_closed(kind: &str, faces: &[Vec<usize>]) -> bool {
 /// A diffuse material of reflectance `rho`.
 fn lambertian(rho: ColourValue) -> MaterialFile {
     MaterialFile::Lambertian(LambertianFile {
-        rho_d: Some(rho.reflectance()),
+        rho_d: Some(Textured::Value(rho.reflectance())),
         texture: None,
     })
 }

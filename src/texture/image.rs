@@ -1,5 +1,5 @@
 //! An image texture of reflectance over a surface's uv (Mitsuba 3 `bitmap`, pbrt-v4
-//! `imagemap`), for [`super::TexturedDiffuse`].
+//! `imagemap`), a leaf of a [`super::Texture`].
 //!
 //! Each texel's linear sRGB (clamped to [0, 1]) is uplifted once, when the scene is
 //! loaded, to its Jakob–Hanika sigmoid (the fitted table's trilinear lookup, without the
