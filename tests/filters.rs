@@ -481,3 +481,86 @@ fn keys_flag_provenance_and_refusals() {
         &["--filter", "sigma"],
     );
 }
+
+/// Mitsuba 3's `<rfilter>` and pbrt-v4's `PixelFilter` become `[render] filter`: each
+/// format's default (a Gaussian) when none is named, its kinds exactly, Lanczos as
+/// Catmull–Rom with a warning, and the box with light tracing, with a warning.
+#[test]
+fn importers_read_the_formats_filters() {
+    use heron::scene::import::{import_scene, ImportOptions};
+    let d = tempfile::tempdir().unwrap();
+    let gauss = |radius, stddev| PixelFilter::Gaussian { radius, stddev };
+    let mitchell = |b, c| PixelFilter::Mitchell { radius: 2.0, b, c };
+    let xml = |rfilter: &str, integrator: &str| {
+        format!(
+            r#"<scene version="3.0.0">
+    <integrator type="{integrator}"/>
+    <sensor type="perspective"><float name="fov" value="45"/>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/>{rfilter}</film>
+    </sensor>
+    <shape type="sphere"/>
+</scene>
+"#
+        )
+    };
+    let pbrt = |filter: &str, integrator: &str| {
+        format!(
+            "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nFilm \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n{filter}\nIntegrator \"{integrator}\"\nWorldBegin\nShape \"sphere\"\n"
+        )
+    };
+    let cases: Vec<(String, &str, PixelFilter, Option<&str>)> = vec![
+        (xml("", "path"), "xml", gauss(2.0, 0.5), None),
+        (
+            xml(r#"<rfilter type="gaussian"><float name="stddev" value="0.25"/></rfilter>"#, "path"),
+            "xml",
+            gauss(1.0, 0.25),
+            None,
+        ),
+        (xml(r#"<rfilter type="tent"/>"#, "path"), "xml", PixelFilter::Tent { radius: 1.0 }, None),
+        (xml(r#"<rfilter type="box"/>"#, "path"), "xml", PixelFilter::BOX, None),
+        (
+            xml(r#"<rfilter type="mitchell"><float name="B" value="0.5"/><float name="C" value="0.25"/></rfilter>"#, "path"),
+            "xml",
+            mitchell(0.5, 0.25),
+            None,
+        ),
+        (xml(r#"<rfilter type="catmullrom"/>"#, "path"), "xml", mitchell(0.0, 0.5), None),
+        (xml(r#"<rfilter type="lanczos"/>"#, "path"), "xml", mitchell(0.0, 0.5), Some("lanczos")),
+        (xml("", "ptracer"), "xml", PixelFilter::BOX, Some("read as heron's box")),
+        (pbrt("", "path"), "pbrt", gauss(1.5, 0.5), None),
+        (pbrt("PixelFilter \"triangle\"", "path"), "pbrt", PixelFilter::Tent { radius: 2.0 }, None),
+        (pbrt("PixelFilter \"box\"", "path"), "pbrt", PixelFilter::BOX, None),
+        (
+            pbrt("PixelFilter \"gaussian\" \"float sigma\" 0.3 \"float xradius\" 1 \"float yradius\" 1", "path"),
+            "pbrt",
+            gauss(1.0, 0.3),
+            None,
+        ),
+        (pbrt("PixelFilter \"mitchell\"", "path"), "pbrt", mitchell(1.0 / 3.0, 1.0 / 3.0), None),
+        (pbrt("PixelFilter \"lanczos\"", "path"), "pbrt", PixelFilter::Mitchell { radius: 4.0, b: 0.0, c: 0.5 }, Some("windowed sinc")),
+        (pbrt("", "bdpt"), "pbrt", PixelFilter::BOX, Some("read as heron's box")),
+    ];
+    for (k, (text, ext, want, warn)) in cases.into_iter().enumerate() {
+        let p = write_file(d.path(), &format!("s{k}.{ext}"), &text);
+        let imp = import_scene(&p, &ImportOptions::default()).unwrap();
+        let scene = heron::scene::load::load_imported(&imp).unwrap();
+        assert_eq!(scene.settings.filter, want, "case {k}: {text}");
+        let filter_warnings: Vec<_> = imp
+            .warnings
+            .iter()
+            .filter(|w| {
+                w.message.contains("filter")
+                    || w.message.contains("lanczos")
+                    || w.message.contains("sinc")
+            })
+            .collect();
+        match warn {
+            None => assert!(filter_warnings.is_empty(), "case {k}: {filter_warnings:?}"),
+            Some(w) => assert!(
+                filter_warnings.iter().any(|x| x.message.contains(w)),
+                "case {k}: {:?}",
+                imp.warnings
+            ),
+        }
+    }
+}

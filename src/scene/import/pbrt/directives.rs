@@ -108,6 +108,7 @@ impl Conv {
             | "ConcatTransform" => self.transform(d),
             "Camera" => self.camera(d),
             "Film" => self.film(d),
+            "PixelFilter" => self.pixel_filter(path, line, d.name(), d.params()),
             "Sampler" => {
                 let p = d.params();
                 if let Some(n) = p.float("pixelsamples") {
@@ -153,8 +154,8 @@ impl Conv {
             "Import" => self.import(d),
             "WorldEnd" | "OptionBool" | "ColorSpace" | "Option" => Ok(()),
             "Texture" | "MakeNamedMedium" | "MediumInterface" | "CoordinateSystem"
-            | "CoordSysTransform" | "Attribute" | "PixelFilter" | "Accelerator"
-            | "ActiveTransform" | "TransformTimes" => {
+            | "CoordSysTransform" | "Attribute" | "Accelerator" | "ActiveTransform"
+            | "TransformTimes" => {
                 for q in &d.params().0 {
                     q.used.set(true);
                 }
