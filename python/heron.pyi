@@ -82,6 +82,7 @@ class Scene:
         polarization: Optional[bool] = None,
         polarizer: Optional[float] = None,
         hide_emitters: Optional[bool] = None,
+        filter: Optional[str] = None,
     ) -> "RenderResult":
         """Renders the scene with ``heron render``'s options and defaults.
 
@@ -99,7 +100,9 @@ class Scene:
         polarizer puts an analyser at that many degrees in front of the camera
         (``--polarizer``, over the scene's ``[camera] polarizer``); hide_emitters=True
         makes emitters seen directly by the camera black (``--hide-emitters``; None
-        keeps the scene's ``[render] hide_emitters``).
+        keeps the scene's ``[render] hide_emitters``); filter is the pixel
+        reconstruction filter (``--filter``, e.g. "gaussian" or
+        "mitchell:b=0,c=0.5"; None keeps the scene's ``[render] filter``).
         The GIL is released while
         rendering; Ctrl-C stops the render within a row of a tile and raises
         KeyboardInterrupt.

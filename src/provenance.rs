@@ -102,6 +102,11 @@ pub const POLARIZATION_KEYS: [&str; 2] = ["polarization", "polarizer"];
 /// other setting then differs from this render's in it, and is refused.
 pub const HIDE_EMITTERS_KEYS: [&str; 1] = ["hideEmitters"];
 
+/// The key written last only for a reconstruction filter other than the default box
+/// (`[render] filter`), e.g. `gaussian radius=1.5 stddev=0.5`, so that other EXRs keep
+/// their bytes; a checkpoint or shard of another filter is refused.
+pub const FILTER_KEYS: [&str; 1] = ["filter"];
+
 impl Provenance {
     /// The provenance a film's settings key holds (`FilmKey::provenance`: every entry
     /// but spp), with `spp` samples per pixel: what `heron merge` writes, the same as the
@@ -115,6 +120,7 @@ impl Provenance {
             .chain(SPPM_KEYS.iter().filter(|k| key.contains_key(**k)))
             .chain(POLARIZATION_KEYS.iter().filter(|k| key.contains_key(**k)))
             .chain(HIDE_EMITTERS_KEYS.iter().filter(|k| key.contains_key(**k)))
+            .chain(FILTER_KEYS.iter().filter(|k| key.contains_key(**k)))
             .map(|&k| {
                 Some((
                     k,
@@ -186,6 +192,9 @@ impl Provenance {
         }
         if settings.hide_emitters {
             p.0.push(("hideEmitters", "true".to_string()));
+        }
+        if !settings.filter.is_default() {
+            p.0.push(("filter", settings.filter.describe()));
         }
         p
     }

@@ -7,6 +7,9 @@
 //! layer (`WavelengthSampler::sample` in `spectrum`, `RayOffset::of` in `geometry`, the
 //! kernels in `integrator`).
 
+mod filter;
+pub use filter::{FilterParams, PixelFilter, MAX_FILTER_RADIUS};
+
 /// The integrators a scene or the CLI can choose.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum IntegratorKind {
@@ -475,6 +478,10 @@ pub struct RenderSettings {
     /// (background, environment map, sky, the sun's disk). Light reaching the camera
     /// through any scattering event, and all lighting of surfaces, are unchanged.
     pub hide_emitters: bool,
+    /// The pixel reconstruction filter (`[render] filter`, `--filter`): camera samples
+    /// are drawn from it and weighted by f/p (filter importance sampling), so that each
+    /// pixel's plain mean estimates ∫ f L / ∫ f. Default: the box of radius 0.5.
+    pub filter: PixelFilter,
 }
 
 impl Default for RenderSettings {
@@ -502,6 +509,7 @@ impl Default for RenderSettings {
             polarization: false,
             polarizer: None,
             hide_emitters: false,
+            filter: PixelFilter::BOX,
         }
     }
 }
@@ -585,6 +593,8 @@ pub struct SettingsArgs<'a> {
     pub polarizer: Option<f64>,
     /// `--hide-emitters` (true hides them; a scene's `true` stays on without it).
     pub hide_emitters: Option<bool>,
+    /// `--filter` (`PixelFilter::parse`'s syntax).
+    pub filter: Option<&'a str>,
 }
 
 impl SettingsArgs<'_> {
@@ -683,6 +693,9 @@ impl RenderSettings {
         }
         if let Some(h) = a.hide_emitters {
             s.hide_emitters = h;
+        }
+        if let Some(f) = a.filter {
+            s.filter = PixelFilter::parse(f).map_err(|e| format!("--filter: {e}"))?;
         }
         *self = s;
         Ok(())

@@ -369,7 +369,7 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("", "[materials.x]\ntype = \"mirror\"\nior = 1.5\n",
      &["unknown key \"ior\" at materials.x (expected one of type, rho_s)"]),
     ("", "[render]\nsamples = 4\n",
-     &["unknown key \"samples\" at render (expected one of spp, max_depth, epsilon, seed, integrator, rr_depth, light_sampler, offset, medium_nee, sun_guide, sppm_photons, sppm_alpha, sppm_radius, spectral_bins, polarization, hide_emitters)"]),
+     &["unknown key \"samples\" at render (expected one of spp, max_depth, epsilon, seed, integrator, rr_depth, light_sampler, offset, medium_nee, sun_guide, sppm_photons, sppm_alpha, sppm_radius, spectral_bins, polarization, hide_emitters, filter, filter_radius, filter_stddev, filter_b, filter_c)"]),
     ("backgroun = 1\n", "", &["unknown key \"backgroun\" at the top level", "background"]),
     ("", "[camera.extra]\nx = 1\n", &["unknown key \"extra\" at camera (expected one of eye, "]),
     ("", "[materials.x]\ntype = \"lambertian\"\nrho_d = { spectrum = \"E\", scal = 1 }\n",

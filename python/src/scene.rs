@@ -33,6 +33,7 @@ const RENAMES: &[(&str, &str)] = &[
     ("--polarization", "polarization"),
     ("--polarizer", "polarizer"),
     ("--hide-emitters", "hide_emitters"),
+    ("--filter", "filter"),
     ("--variance", "variance"),
 ];
 
@@ -184,12 +185,14 @@ impl Scene {
     /// units, 0: automatic) are `heron render --sppm-photons`, `--sppm-alpha`,
     /// `--sppm-radius`. hide_emitters=True makes emitters seen directly by the camera
     /// black (`heron render --hide-emitters`; None keeps the scene's `[render]
-    /// hide_emitters`).
+    /// hide_emitters`). filter is the pixel reconstruction filter in `heron render
+    /// --filter`'s syntax, e.g. "gaussian" or "mitchell:b=0,c=0.5" (None keeps the
+    /// scene's `[render] filter`, default a box of radius 0.5).
     ///
     /// The GIL is released while rendering. Ctrl-C (KeyboardInterrupt, or an exception
     /// from any other signal handler) abandons the render within a row of a tile and is
     /// raised here; the partial image is discarded.
-    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None, polarization=None, polarizer=None, hide_emitters=None))]
+    #[pyo3(signature = (spp=None, seed=None, lanes=8, integrator=None, wavelengths="visible", threads=0, spectral_bins=None, sampler=None, max_depth=None, offset=None, variance=false, packets=None, medium_nee=None, sun_guide=None, sppm_photons=None, sppm_alpha=None, sppm_radius=None, polarization=None, polarizer=None, hide_emitters=None, filter=None))]
     fn render(
         &self,
         py: Python<'_>,
@@ -213,6 +216,7 @@ impl Scene {
         polarization: Option<bool>,
         polarizer: Option<f64>,
         hide_emitters: Option<bool>,
+        filter: Option<&str>,
     ) -> PyResult<RenderResult> {
         guard(|| {
             // The settings' rules are the CLI's (RenderSettings::apply); the messages name
@@ -244,6 +248,7 @@ impl Scene {
                     polarization,
                     polarizer,
                     hide_emitters,
+                    filter,
                 },
                 variance,
                 threads: threads as usize,

@@ -13,6 +13,7 @@
 //! real lens prescription and camera rays come from [`Camera::ray`]; the pinhole's
 //! importance functions above are for the pinhole only (light tracing and BDPT refuse
 //! a lens camera).
+pub mod filter;
 pub mod lens;
 
 use crate::geometry::Ray;

@@ -102,6 +102,12 @@ pub(crate) struct RenderArgs {
     /// scene's [render] hide_emitters).
     #[arg(long)]
     hide_emitters: bool,
+    /// The pixel reconstruction filter: box, tent (or triangle), gaussian or mitchell,
+    /// optionally with parameters, e.g. gaussian:radius=1.5,stddev=0.5 or
+    /// mitchell:b=0.333,c=0.333 (default: the scene's [render] filter, else a box of
+    /// radius 0.5). Camera samples are drawn from the filter and weighted by f/p.
+    #[arg(long, value_name = "NAME[:radius=R,stddev=S,b=B,c=C]")]
+    filter: Option<String>,
     /// Add N spectral channels (equal bins over 360–830 nm, the layout of Fichet et al.
     /// 2021, readable by colour.read_spectral_image_Fichet2021).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=470))]
@@ -284,6 +290,7 @@ fn settings_args(args: &RenderArgs) -> SettingsArgs<'_> {
         polarization: args.polarization.then_some(true),
         polarizer: args.polarizer,
         hide_emitters: args.hide_emitters.then_some(true),
+        filter: args.filter.as_deref(),
     }
 }
 

@@ -25,6 +25,8 @@ pub trait SampleValue<const N: usize>: Copy {
     fn stokes_fixed(&self, wl: &SampledWavelengths<N>) -> Option<[i128; 9]>;
     /// S1, S2, S3 (zero for radiance).
     fn stokes_components(&self) -> [SampledSpectrum<N>; 3];
+    /// `self` times `w` (a reconstruction filter's sample weight).
+    fn scaled(&self, w: f32) -> Self;
 }
 
 impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
@@ -54,6 +56,10 @@ impl<const N: usize> SampleValue<N> for SampledSpectrum<N> {
     #[inline(always)]
     fn stokes_components(&self) -> [SampledSpectrum<N>; 3] {
         [SampledSpectrum::zero(); 3]
+    }
+    #[inline]
+    fn scaled(&self, w: f32) -> Self {
+        *self * w
     }
 }
 
@@ -93,6 +99,10 @@ impl<const N: usize> SampleValue<N> for StokesSpectrum<N> {
     #[inline]
     fn stokes_components(&self) -> [SampledSpectrum<N>; 3] {
         std::array::from_fn(|k| self.component(k + 1))
+    }
+    #[inline]
+    fn scaled(&self, w: f32) -> Self {
+        StokesSpectrum(self.0.map(|v| v * w))
     }
 }
 

@@ -117,6 +117,26 @@ pub fn check_camera(scene: &Scene, settings: &RenderSettings) -> Result<(), Stri
     if let (true, Support::No(why)) = (settings.polarization, caps.polarization) {
         return Err(format!("integrator {}: {why}", kind.name()));
     }
+    check_filter(settings)
+}
+
+/// Light tracing reaches the film through the camera's importance at the one point a
+/// path lands on (and BDPT's t = 1 strategy likewise): the sample belongs to the
+/// pixel it lands in, a box filter. A wider filter would have to splat each such
+/// sample into its neighbours, weighted by f, while the camera-ray strategies weight by
+/// f/p; that is not implemented, so the combination is refused rather than rendering
+/// an image filtered one way by some strategies and another by the rest.
+fn check_filter(settings: &RenderSettings) -> Result<(), String> {
+    use crate::settings::IntegratorKind::{Bdpt, LightTrace};
+    let kind = settings.integrator;
+    if matches!(kind, LightTrace | Bdpt) && !settings.filter.is_default() {
+        return Err(format!(
+            "filter {:?} with integrator {}: light paths reach the film through the camera's importance at one point (a box filter), and splatting them through a wider filter is not implemented; use filter = \"box\" (radius 0.5) with {}, or integrator = \"path\", \"whitted\" or \"sppm\" with this filter",
+            settings.filter.name(),
+            kind.name(),
+            kind.name()
+        ));
+    }
     Ok(())
 }
 

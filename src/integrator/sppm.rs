@@ -703,6 +703,7 @@ pub fn iteration<const N: usize>(
     let mut vps: Vec<Option<VisiblePoint<N>>> = vec![None; npix];
     let mut length = vec![0.0f32; npix];
     let base = Sampler::new(settings.sampler, settings.seed, w, h, settings.spp);
+    let filter = crate::camera::filter::Filter::new(&settings.filter);
     let camera_counters = l
         .par_chunks_mut(w as usize)
         .zip(vps.par_chunks_mut(w as usize))
@@ -717,14 +718,19 @@ pub fn iteration<const N: usize>(
             for x in 0..w as usize {
                 sampler.start_pixel_sample(x as u32, y as u32, k);
                 let j = sampler.get_pixel_2d();
-                let ray = cam.ray(
-                    x as f32 + j.x,
-                    y as f32 + j.y,
-                    || sampler.get_2d(),
-                    wl.lambda[0],
-                );
+                let (fx, fy, weight) = filter.film_point(x as u32, y as u32, j);
+                let ray = cam.ray(fx, fy, || sampler.get_2d(), wl.lambda[0]);
                 if let Some(ray) = ray {
-                    let p = camera_path(ctx, ray, &wl, &mut sampler, &mut counters);
+                    let mut p = camera_path(ctx, ray, &wl, &mut sampler, &mut counters);
+                    // The filter's weight f/(p ∫f) scales all the pixel's light: what
+                    // the camera path saw and what its visible point gathers (the
+                    // photons' flux is linear in the point's throughput).
+                    if weight != 1.0 {
+                        p.l *= weight;
+                        if let Some(vp) = &mut p.vp {
+                            vp.beta *= weight;
+                        }
+                    }
                     (l_row[x], vp_row[x], len_row[x]) = (p.l, p.vp, p.length);
                 }
             }

@@ -3,6 +3,7 @@
 //! integrator (`programs::Whole`), or the steps of a step integrator with its shadow
 //! rays in packets too (`programs::Steps`, `--packets paths`).
 use super::*;
+use crate::camera::filter::Filter;
 
 /// A lane's pixel sample: where it is (tile coordinates and sample index), its
 /// wavelengths, the ray it traces next and what the program keeps of it.
@@ -12,6 +13,8 @@ pub(super) struct Lane<const N: usize, S> {
     pub ray: Ray,
     /// Whether `ray` is the camera ray (not yet traced).
     pub camera: bool,
+    /// The reconstruction filter's weight of the camera sample (1 for a box).
+    pub weight: f32,
     pub state: S,
 }
 
@@ -146,6 +149,7 @@ pub(super) fn render_tile<const N: usize, const VARIANCE: bool, P: Program<N>>(
         opts.settings.spp,
     );
     let mut samplers: [Sampler; PACKET] = std::array::from_fn(|_| base.clone());
+    let filter = Filter::new(&opts.settings.filter);
     let mut lanes: [Option<Lane<N, P::State>>; PACKET] = std::array::from_fn(|_| None);
     let mut queries = [RayQuery {
         origin: cam.eye,
@@ -172,15 +176,17 @@ pub(super) fn render_tile<const N: usize, const VARIANCE: bool, P: Program<N>>(
                 let sampler = &mut samplers[k];
                 sampler.start_pixel_sample(px, py, s);
                 let j = sampler.get_pixel_2d();
+                let (fx, fy, weight) = filter.film_point(px, py, j);
                 let wl = SampledWavelengths::sample(opts.settings.wavelengths, sampler.get_1d());
                 let u = || sampler.get_2d();
-                match cam.ray(px as f32 + j.x, py as f32 + j.y, u, wl.lambda[0]) {
+                match cam.ray(fx, fy, u, wl.lambda[0]) {
                     Some(c) => {
                         lanes[k] = Some(Lane {
                             pixel: (x, y, s),
                             wl,
                             ray: c.ray,
                             camera: true,
+                            weight,
                             state: program.begin(&c),
                         })
                     }
@@ -220,7 +226,11 @@ pub(super) fn render_tile<const N: usize, const VARIANCE: bool, P: Program<N>>(
         program.settle(ctx, &lanes, &mut queries, &mut counters);
         for (k, slot) in lanes.iter_mut().enumerate() {
             let Some(lane) = slot else { continue };
-            if let Some(l) = program.finish(k, lane, going & (1 << k) != 0) {
+            if let Some(mut l) = program.finish(k, lane, going & (1 << k) != 0) {
+                // The filter's weight f/(p ∫f) (filter importance sampling); a box's is 1.
+                if lane.weight != 1.0 {
+                    l = l.scaled(lane.weight);
+                }
                 sums.add::<N, VARIANCE, P::Value>(lane.pixel, &l, &lane.wl);
                 *slot = None;
             }

@@ -276,6 +276,22 @@ pub struct RenderFile {
     /// `--hide-emitters` turns it on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hide_emitters: Option<bool>,
+    /// The pixel reconstruction filter: box (default), tent, gaussian or mitchell.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter: Option<String>,
+    /// The filter's radius in pixels (default per filter: box 0.5, tent 2, gaussian
+    /// 3 filter_stddev, mitchell 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_radius: Option<f64>,
+    /// The Gaussian's standard deviation in pixels (default 0.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_stddev: Option<f64>,
+    /// Mitchell–Netravali's B (default 1/3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_b: Option<f64>,
+    /// Mitchell–Netravali's C (default 1/3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_c: Option<f64>,
 }
 
 /// `[materials.NAME]`, tagged by `type`.

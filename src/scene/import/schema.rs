@@ -211,3 +211,26 @@ pub fn triangle_mesh(tris: &[[DVec3; 3]]) -> ShapeFile {
     }
     shape
 }
+
+/// heron's light tracing and BDPT refuse a filter other than the default box
+/// (`integrator::capabilities::check_filter`): an imported scene that asks for one of
+/// them keeps the box filter. Returns the warning to give when a filter was dropped.
+pub fn box_for_light_paths(render: &mut Option<crate::scene::file::RenderFile>) -> Option<String> {
+    let r = render.as_mut()?;
+    let light_paths = matches!(r.integrator.as_deref(), Some("lighttrace" | "bdpt"));
+    let filter = r.filter.clone()?;
+    if !light_paths || filter == "box" && r.filter_radius.map_or(true, |x| x == 0.5) {
+        return None;
+    }
+    (
+        r.filter,
+        r.filter_radius,
+        r.filter_stddev,
+        r.filter_b,
+        r.filter_c,
+    ) = (None, None, None, None, None);
+    Some(format!(
+        "the {filter} pixel filter is read as heron's box: heron's {} reaches the film at one point per light path and has no other filter",
+        r.integrator.as_deref().unwrap_or_default()
+    ))
+}

@@ -2,8 +2,8 @@
 //! `RenderSettings::default()`.
 use crate::scene::file::RenderFile;
 use crate::settings::{
-    parse_sppm_alpha, parse_sppm_photons, parse_sppm_radius, parse_sun_guide, IntegratorKind,
-    LightSamplerKind, MediumNee, OffsetMode, RenderSettings,
+    parse_sppm_alpha, parse_sppm_photons, parse_sppm_radius, parse_sun_guide, FilterParams,
+    IntegratorKind, LightSamplerKind, MediumNee, OffsetMode, PixelFilter, RenderSettings,
 };
 
 /// The settings of the `[render]` table `r` (defaults without one).
@@ -69,6 +69,26 @@ pub(super) fn render_settings(r: Option<&RenderFile>) -> Result<RenderSettings, 
     }
     if let Some(h) = r.hide_emitters {
         settings.hide_emitters = h;
+    }
+    let params = FilterParams {
+        radius: r.filter_radius,
+        stddev: r.filter_stddev,
+        b: r.filter_b,
+        c: r.filter_c,
+    };
+    let given = params.radius.is_some()
+        || params.stddev.is_some()
+        || params.b.is_some()
+        || params.c.is_some();
+    if r.filter.is_some() || given {
+        let name = r.filter.as_deref().unwrap_or("box");
+        settings.filter = PixelFilter::from_parts(name, params, &|k| {
+            if k.is_empty() {
+                "render.filter".to_string()
+            } else {
+                format!("render.filter_{k}")
+            }
+        })?;
     }
     Ok(settings)
 }

@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 
 mod bsdfs;
 mod media;
+mod rfilter;
 mod shapes;
 mod textures;
 
@@ -173,6 +174,13 @@ pub fn convert(root: &Node, path: &Path, strict: bool) -> Result<Converted, Diag
                 .into(),
         });
     };
+    if let Some(m) = schema::box_for_light_paths(&mut c.render) {
+        c.warn(Diagnostic {
+            file: path.to_path_buf(),
+            line: root.line,
+            message: m,
+        })?;
+    }
     let scene = SceneFile {
         background: c.background,
         camera,
@@ -480,19 +488,7 @@ impl<'a> Converter<'a> {
             schema::count(k, v).map_err(|m| f.diag(m))?;
         }
         let filters = p.objects(&["rfilter"]);
-        match filters.first() {
-            None => self.warn(f.diag(
-                "no rfilter: Mitsuba's default is a Gaussian, heron's pixels are box-filtered",
-            ))?,
-            Some(r) => {
-                let r = self.resolve(r)?;
-                if Self::plugin(r)? != "box" {
-                    self.warn(
-                        r.diag("heron's pixels are box-filtered; this filter is read as box"),
-                    )?;
-                }
-            }
-        }
+        self.rfilter(filters.first().copied())?;
         // What only changes the file's encoding is accepted as is.
         for k in ["pixel_format", "component_format", "file_format", "banner"] {
             p.get(k);

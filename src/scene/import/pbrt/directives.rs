@@ -108,6 +108,7 @@ impl Conv {
             | "ConcatTransform" => self.transform(d),
             "Camera" => self.camera(d),
             "Film" => self.film(d),
+            "PixelFilter" => self.pixel_filter(path, line, d.name(), d.params()),
             "Sampler" => {
                 let p = d.params();
                 if let Some(n) = p.float("pixelsamples") {
@@ -158,8 +159,8 @@ impl Conv {
                 Ok(())
             }
             "Texture" => self.texture_directive(path, line, &d.st.strs, d.params()),
-            "CoordinateSystem" | "CoordSysTransform" | "Attribute" | "PixelFilter"
-            | "Accelerator" | "ActiveTransform" | "TransformTimes" => {
+            "CoordinateSystem" | "CoordSysTransform" | "Attribute" | "Accelerator"
+            | "ActiveTransform" | "TransformTimes" => {
                 for q in &d.params().0 {
                     q.used.set(true);
                 }

@@ -31,6 +31,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 mod directives;
+mod filter;
 mod media;
 mod textures;
 mod tokens;
@@ -231,6 +232,10 @@ impl Conv {
         }
         let shapes = self.instantiate()?;
         self.finish_camera(path)?;
+        self.default_filter();
+        if let Some(m) = schema::box_for_light_paths(&mut self.render) {
+            self.warn(self.diag(path, 1, m))?;
+        }
         let scene = SceneFile {
             background: self.background.take(),
             camera: self.camera.take().expect("finish_camera sets it"),
