@@ -27,17 +27,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 /// A scene around `body` with a sensor, so that the body's elements are what is tested.
 fn scene(body: &str) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-    <sensor type="perspective">
-        <float name="fov" value="45"/>
-        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="20"/><rfilter type="box"/></film>
-    </sensor>
-{body}
-</scene>
-"#
-    )
+    common::scenes::mitsuba_around(body)
 }
 
 fn import_text(text: &str) -> (tempfile::TempDir, heron::error::Result<Imported>) {

@@ -5,6 +5,8 @@
 //! an open or opaque shape, other medium types) is a warning at its line, and the
 //! converted scenes load. The images are held to Mitsuba's in
 //! tests/python/test_mitsuba_media.py.
+mod common;
+
 use heron::medium::Medium;
 use heron::scene::import::{import_scene, ImportOptions, Imported};
 use heron::scene::load::load_imported;
@@ -20,17 +22,7 @@ fn import(name: &str, text: &str) -> (tempfile::TempDir, heron::error::Result<Im
 }
 
 fn mitsuba(body: &str) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-    <sensor type="perspective">
-        <float name="fov" value="45"/>
-        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="20"/><rfilter type="box"/></film>
-    </sensor>
-{body}
-</scene>
-"#
-    )
+    common::scenes::mitsuba_around(body)
 }
 
 const PBRT_CAMERA: &str = "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\nFilm \"rgb\" \"integer xresolution\" [ 40 ] \"integer yresolution\" [ 20 ]\nWorldBegin\n";

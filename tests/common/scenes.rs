@@ -90,3 +90,19 @@ emission = {{ spectrum = "E", scale = 20.0 }}
 "#
     )
 }
+
+/// A Mitsuba 3 scene around `body` with a 40 × 20 box-filtered sensor looking at the
+/// origin from +z, so that the body's elements are what an import test tests.
+pub fn mitsuba_around(body: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="45"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="20"/><rfilter type="box"/></film>
+    </sensor>
+{body}
+</scene>
+"#
+    )
+}

@@ -234,3 +234,25 @@ pub fn box_for_light_paths(render: &mut Option<crate::scene::file::RenderFile>) 
         r.integrator.as_deref().unwrap_or_default()
     ))
 }
+
+/// A Henyey–Greenstein medium of coefficients σ_a, σ_s (per scene unit) and mean
+/// cosine g: what both importers make of a homogeneous medium.
+pub fn hg_medium(
+    sigma_a: crate::scene::file::Coefficient,
+    sigma_s: crate::scene::file::Coefficient,
+    g: f64,
+) -> crate::scene::file::MediumFile {
+    crate::scene::file::MediumFile {
+        kind: "henyey-greenstein".into(),
+        radius_mm: None,
+        drops: None,
+        number_density: None,
+        liquid_water_content: None,
+        absorption: None,
+        lambda_step: None,
+        forward_cutoff: None,
+        sigma_a: Some(sigma_a),
+        sigma_s: Some(sigma_s),
+        g: Some(g as f32),
+    }
+}

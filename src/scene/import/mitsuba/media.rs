@@ -47,19 +47,7 @@ impl<'a> Converter<'a> {
         let g = self.phase(&p)?;
         self.finish(&p)?;
         let (sigma_a, sigma_s) = split(&sigma_t, &albedo, scale);
-        Ok(Some(MediumFile {
-            kind: "henyey-greenstein".into(),
-            radius_mm: None,
-            drops: None,
-            number_density: None,
-            liquid_water_content: None,
-            absorption: None,
-            lambda_step: None,
-            forward_cutoff: None,
-            sigma_a: Some(sigma_a),
-            sigma_s: Some(sigma_s),
-            g: Some(g as f32),
-        }))
+        Ok(Some(schema::hg_medium(sigma_a, sigma_s, g)))
     }
 
     /// A medium's `sigma_t` or `albedo`: a number, `<rgb>` or `<spectrum>` pairs, ≥ 0

@@ -75,19 +75,7 @@ impl Conv {
         }
         self.media.insert(
             name.to_string(),
-            Some(MediumFile {
-                kind: "henyey-greenstein".into(),
-                radius_mm: None,
-                drops: None,
-                number_density: None,
-                liquid_water_content: None,
-                absorption: None,
-                lambda_step: None,
-                forward_cutoff: None,
-                sigma_a: Some(sigma_a),
-                sigma_s: Some(sigma_s),
-                g: Some(g as f32),
-            }),
+            Some(schema::hg_medium(sigma_a, sigma_s, g)),
         );
         Ok(())
     }
