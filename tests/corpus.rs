@@ -82,6 +82,7 @@ fn the_corpus_of_scenes_from_the_wild_imports_and_renders() {
             "eta: the table covers 400–700 nm; heron holds its end values",
             "k: the table covers 400–700 nm; heron holds its end values",
             "distribution \"beckmann\" (Mitsuba's default): heron's microfacets are GGX",
+            "roughplastic: heron's rough coat lets in all it does not reflect",
         ],
     );
     check(
