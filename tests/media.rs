@@ -327,6 +327,115 @@ fn medium_coefficients_take_numbers_rgb_and_samples() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// E_n(x) = ∫₁^∞ e^{−xt} t^{−n} dt, by the midpoint rule on t = 1/μ, μ ∈ (0, 1]:
+/// E_n(x) = ∫₀¹ μ^{n−2} e^{−x/μ} dμ.
+fn exponential_integral(n: i32, x: f64) -> f64 {
+    let steps = 200_000;
+    (0..steps)
+        .map(|i| {
+            let mu = (i as f64 + 0.5) / steps as f64;
+            mu.powi(n - 2) * (-x / mu).exp()
+        })
+        .sum::<f64>()
+        / steps as f64
+}
+
+#[test]
+fn a_sheet_inside_a_medium_leaves_the_path_in_it() {
+    // The absorbing slab of `slab_transmittance_is_exponential`, cut in half by a sheet
+    // of no thickness at z = −0.75. A sheet is not the boundary of a volume: a path that
+    // passes it is still in the slab's medium, and so is a light sample drawn through it.
+    // Once, the path tracer took crossing any surface against its normal as entering
+    // that shape's (here: no) medium, so the slab's far half went unattenuated.
+    let dir = temp_dir("sheet-in-slab");
+    write_box(&dir, "slab.obj", [-50.0, -50.0, -1.5], [50.0, 50.0, 0.0]);
+    let sigma_a = 0.8f64;
+    let scene = |material: &str| {
+        load_in(
+            &dir,
+            &format!(
+                r#"
+background = 1.0
+[camera]
+eye = [0.0, 0.0, 2.0]
+look_at = [0.0, 0.0, 0.0]
+d = 4.0
+resolution = [32, 32]
+[render]
+max_depth = 8
+[materials.sheet]
+{material}
+[[shapes]]
+type = "mesh"
+file = "slab.obj"
+medium = {{ type = "henyey-greenstein", sigma_a = {sigma_a}, sigma_s = 0.0 }}
+[[shapes]]
+type = "quad"
+origin = [-40.0, -40.0, -0.75]
+edge1 = [80.0, 0.0, 0.0]
+edge2 = [0.0, 80.0, 0.0]
+material = "sheet"
+"#
+            ),
+        )
+    };
+    // exp(−σ_a d / cos θ) per pixel direction, as the slab test (4 × 4 points a pixel).
+    let mean_over_pixels = |f: &dyn Fn(f64) -> f64| {
+        let cam = &scene(
+            r#"type = "thin-dielectric"
+ior = 1.0"#,
+        )
+        .camera;
+        let mut sum = 0.0;
+        for y in 0..32 {
+            for x in 0..32 {
+                for sy in 0..4 {
+                    for sx in 0..4 {
+                        let w = cam.direction(
+                            x as f32 + (sx as f32 + 0.5) / 4.0,
+                            y as f32 + (sy as f32 + 0.5) / 4.0,
+                        );
+                        sum += f(-w.z as f64);
+                    }
+                }
+            }
+        }
+        sum / (32 * 32 * 16) as f64
+    };
+    // An index-1 sheet reflects nothing and lets everything through: the slab as if
+    // the sheet were not there.
+    let clear = mean_over_pixels(&|cos| (-sigma_a * 1.5 / cos).exp());
+    let invisible = scene(
+        r#"type = "thin-dielectric"
+ior = 1.0"#,
+    );
+    assert_mean(
+        &run(&invisible, 256),
+        clear,
+        0.005,
+        "index-1 sheet in a slab",
+    );
+    // A diffuse transmitter (τ = 1) at the middle: the camera's ray is absorbed over the
+    // near half, exp(−σ_a 0.75 / cos θ_v); the sheet then sends on what reaches it from
+    // below, the uniform sky through the far half at every angle of a cosine-weighted
+    // hemisphere, ∫ 2μ exp(−σ_a 0.75 / μ) dμ = 2 E₃(0.6). Light samples (next-event
+    // estimation through the sheet) and the continuation both must see the far half.
+    let near = mean_over_pixels(&|cos| (-sigma_a * 0.75 / cos).exp());
+    let diffuse = near * 2.0 * exponential_integral(3, sigma_a * 0.75);
+    let paper = scene(
+        r#"type = "diffuse-transmission"
+reflectance = 0.0
+transmittance = 1.0"#,
+    );
+    assert_mean(
+        &run(&paper, 256),
+        diffuse,
+        0.005,
+        "diffuse transmitter in a slab",
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn slab_transmittance_is_exponential() {
     // A purely absorbing slab (σ_s = 0) of thickness d = 1.5 seen straight through, in

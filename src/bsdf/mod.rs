@@ -511,4 +511,20 @@ impl Material {
             _ => 1.0,
         }
     }
+
+    /// Whether light this material transmits stays on the side it came from as far as
+    /// volumes go: a sheet of no thickness (thin dielectric, diffuse transmitter,
+    /// polariser, retarder) is not the boundary of a volume, so a path passing it stays
+    /// in the medium it was in. Only a dielectric (smooth, rough, or a glossy material's
+    /// refractive base) encloses a volume light enters.
+    #[inline]
+    pub fn is_sheet(&self) -> bool {
+        matches!(
+            self,
+            Material::ThinDielectric(_)
+                | Material::DiffuseTransmission(_)
+                | Material::Polarizer(_)
+                | Material::Retarder(_)
+        )
+    }
 }

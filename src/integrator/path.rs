@@ -715,8 +715,9 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
     };
     t.scattered(at, bs.flags);
     *ray = ctx.offset.spawn(&it.spawn_point(), wi);
-    if on(K, MEDIA) && bs.is_transmission() {
-        // Through a dielectric around a medium (a glass of milk) into or out of it.
+    if on(K, MEDIA) && bs.is_transmission() && !material.is_sheet() {
+        // Through a dielectric around a medium (a glass of milk) into or out of it; a
+        // sheet inside a medium leaves the path in it.
         s.medium = if ray.dir.dot(it.n_outward) < 0.0 {
             scene.shapes[hit.geom_id as usize].medium
         } else {
@@ -787,7 +788,10 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>, 
             .map(|c| (c, ls.wi, wi_local, cl.index));
     }
     // Through media: the transmittance of the shadow ray (None: blocked).
-    let from = if ls.wi.dot(it.n_outward) < 0.0 {
+    let from = if v.material.is_sheet() {
+        // Past a sheet the light is in the medium the path is in.
+        s.medium
+    } else if ls.wi.dot(it.n_outward) < 0.0 {
         ctx.scene.shapes[v.geom as usize].medium
     } else {
         medium_outside(s.medium, ctx.scene, v.geom)
