@@ -20,4 +20,4 @@ HERON_EMBREE4_LIB="$embree4_lib" CARGO_TARGET_DIR="$PWD/target/embree4" \
     --test bench_limit --test packets
 
 # pytest exits 5 when it collects nothing; any non-zero exit fails this script.
-HERON_BIN="$PWD/target/release/heron" .venv/bin/python -m pytest tests/python -q
+HERON_BIN="$PWD/target/release/heron" .venv/bin/python -m pytest tests/python -q --durations=15
