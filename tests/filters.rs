@@ -562,5 +562,10 @@ fn importers_read_the_formats_filters() {
                 imp.warnings
             ),
         }
+        // The light-path warning points at the pbrt file's Integrator directive (line 5).
+        if ext == "pbrt" && warn == Some("read as heron's box") {
+            let at: Vec<u32> = filter_warnings.iter().map(|w| w.line).collect();
+            assert_eq!(at, [5], "case {k}: {filter_warnings:?}");
+        }
     }
 }

@@ -318,6 +318,7 @@ impl Conv {
             }
         };
         self.render().integrator = Some(kind.into());
+        self.integrator_at = Some((path.to_path_buf(), line));
         let depth = p.float("maxdepth").unwrap_or(5.0) as i64;
         if depth < 1 {
             return Err(self.diag(

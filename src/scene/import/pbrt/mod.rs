@@ -155,6 +155,8 @@ struct Conv {
     resolution: (u32, u32),
     /// `[render]`, made by the first key set.
     render: Option<RenderFile>,
+    /// Where the `Integrator` directive is (for a warning about its filter).
+    integrator_at: Option<(PathBuf, u32)>,
     g: Graphics,
     stack: Vec<Pushed>,
     n_material: usize,
@@ -200,6 +202,7 @@ impl Conv {
             camera_from_world: None,
             resolution: (1280, 720),
             render: None,
+            integrator_at: None,
             g: Graphics {
                 ctm: DMat4::IDENTITY,
                 material: None,
@@ -234,7 +237,9 @@ impl Conv {
         self.finish_camera(path)?;
         self.default_filter();
         if let Some(m) = schema::box_for_light_paths(&mut self.render) {
-            self.warn(self.diag(path, 1, m))?;
+            // A light-path integrator was named, so its directive's place is known.
+            let (file, line) = self.integrator_at.clone().unwrap_or((path.into(), 1));
+            self.warn(self.diag(&file, line, m))?;
         }
         let scene = SceneFile {
             background: self.background.take(),
