@@ -608,7 +608,7 @@ fn bad_cameras() {
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 0, 0]\nresolution = [4, 4]\n",
          "camera.up: expected a non-zero vector"),
         ("eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\nfov = 40\n",
-         "unknown key \"fov\" at camera (expected one of eye, look_at, up, d, resolution, type, lens, surface, film_diagonal, film_distance, focus_distance, focus_wavelength, mm_per_unit, f_number, polarizer, pupil, film_offset)"),
+         "unknown key \"fov\" at camera (expected one of eye, look_at, up, d, resolution, type, height, lens, surface, film_diagonal, film_distance, focus_distance, focus_wavelength, mm_per_unit, f_number, polarizer, pupil, film_offset)"),
     ];
     for (cam, want) in cases {
         let (_, msg) = dir.err(&format!("[camera]\n{cam}"));

@@ -72,6 +72,7 @@ pub fn pinhole(
         d: Some(positive(d)),
         resolution: Resolution { width, height },
         kind: None,
+        height: None,
         lens: None,
         surface: None,
         film_diagonal: None,

@@ -151,7 +151,8 @@ struct Conv {
     /// `[environment]` from an image `infinite` light.
     environment: Option<EnvironmentFile>,
     camera: Option<CameraFile>,
-    camera_from_world: Option<(DMat4, u32, PathBuf, f64)>,
+    /// The `Camera` directive: its CTM, line and file, and its projection.
+    camera_from_world: Option<(DMat4, u32, PathBuf, Projection)>,
     resolution: (u32, u32),
     /// `[render]`, made by the first key set.
     render: Option<RenderFile>,
@@ -350,4 +351,18 @@ fn scaled(c: ColourValue, k: f64) -> ColourValue {
             scale: tidy(scale * k),
         },
     }
+}
+
+/// What a `Camera` directive projects with: pbrt-v4's `perspective` (its `fov`,
+/// degrees across the shorter image axis) or `orthographic` (its `screenwindow`
+/// [x0, x1, y0, y1] in camera space, or the default made from `frameaspectratio`).
+#[derive(Clone, Debug)]
+pub(super) enum Projection {
+    Perspective {
+        fov: f64,
+    },
+    Orthographic {
+        window: Option<[f64; 4]>,
+        frame: Option<f64>,
+    },
 }

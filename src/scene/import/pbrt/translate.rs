@@ -838,8 +838,12 @@ impl Conv {
     }
 
     pub(super) fn finish_camera(&mut self, path: &Path) -> Result<(), Diagnostic> {
-        let Some((cfw, line, file, fov)) = self.camera_from_world.clone() else {
-            return Err(self.diag(path, 1, "expected a Camera \"perspective\" directive"));
+        let Some((cfw, line, file, projection)) = self.camera_from_world.clone() else {
+            return Err(self.diag(
+                path,
+                1,
+                "expected a Camera \"perspective\" or \"orthographic\" directive",
+            ));
         };
         let wfc = cfw.inverse();
         let eye = wfc.transform_point3(DVec3::ZERO);
@@ -852,11 +856,60 @@ impl Conv {
         }
         let (w, h) = self.resolution;
         let aspect = w as f64 / h as f64;
+        let fov = match projection {
+            Projection::Perspective { fov } => fov,
+            Projection::Orthographic { window, frame } => {
+                let cam = self.orthographic_camera(&wfc, (&file, line), window, frame)?;
+                self.camera = Some(cam);
+                return Ok(());
+            }
+        };
         // pbrt's fov spans the shorter image axis.
         let t = (0.5 * fov.to_radians()).tan();
         let tan_y = if aspect >= 1.0 { t } else { t / aspect };
         self.camera = Some(schema::pinhole(eye, look, up, 0.5 / tan_y, (w, h)));
         Ok(())
+    }
+
+    /// pbrt-v4's orthographic camera: rays along camera +z from the screen window's
+    /// point at z = 0 (camera space is screen space for x and y). By default the window
+    /// spans [-1, 1] on the shorter axis of `frameaspectratio` (the image's aspect
+    /// ratio unless given). heron's image plane is centred at its eye and has square
+    /// pixels: an off-centre window moves the eye to the window's centre; a window whose
+    /// shape is not the image's keeps its height, with a warning.
+    fn orthographic_camera(
+        &mut self,
+        wfc: &DMat4,
+        (file, line): (&Path, u32),
+        window: Option<[f64; 4]>,
+        frame: Option<f64>,
+    ) -> Result<CameraFile, Diagnostic> {
+        let (w, h) = self.resolution;
+        let aspect = w as f64 / h as f64;
+        let [x0, x1, y0, y1] = window.unwrap_or_else(|| {
+            let f = frame.unwrap_or(aspect);
+            if f > 1.0 {
+                [-f, f, -1.0, 1.0]
+            } else {
+                [-1.0, 1.0, -1.0 / f, 1.0 / f]
+            }
+        });
+        let shape = (x1 - x0) / (y1 - y0);
+        if (shape - aspect).abs() > 1e-6 * aspect {
+            self.warn(self.diag(file, line, format!("Camera \"orthographic\": the screen window is {} x {} and the image's aspect ratio {aspect}; heron's pixels are square, so the window keeps its height and its width is {}", x1 - x0, y1 - y0, (y1 - y0) * aspect)))?;
+        }
+        let centre = DVec3::new(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0);
+        // The camera-from-world transform may scale (pbrt warns and goes on): the
+        // window is measured in camera space, so its height is scaled to the world's.
+        let sy = wfc.transform_vector3(DVec3::Y).length();
+        let eye = wfc.transform_point3(centre);
+        let look = eye + wfc.transform_vector3(DVec3::Z);
+        let up = wfc.transform_vector3(DVec3::Y);
+        let mut cam = schema::pinhole(eye, look, up, 1.0, (w, h));
+        cam.d = None;
+        cam.kind = Some("orthographic".into());
+        cam.height = Some(schema::positive((y1 - y0) * sy));
+        Ok(cam)
     }
 }
 
