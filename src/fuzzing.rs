@@ -423,6 +423,7 @@ fn mesh_entry(file: &str) -> MeshFile {
         scale: None,
         translate: None,
         transform: None,
+        uv: None,
         flip_tex_coords: None,
         emission: None,
         two_sided: None,

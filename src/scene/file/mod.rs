@@ -742,6 +742,10 @@ pub struct MeshFile {
     /// `scale` and `translate`: Mitsuba's `to_world`, as `heron convert` writes it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<Vec<Vec<f64>>>,
+    /// The texture coordinates (u, v) of each of `vertices`, for a mesh written in the
+    /// scene (a file's come from the file); used as given unless `flip_tex_coords`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uv: Option<Vec<[f64; 2]>>,
     /// Use the file's texture coordinates (u, v) as (u, 1 − v): default true for OBJ
     /// (whose images start at the bottom row), false for PLY and serialized meshes, as
     /// Mitsuba 3 reads them.

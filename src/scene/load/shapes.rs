@@ -479,6 +479,11 @@ fn build_mesh(
 /// or None for a mesh file.
 fn inline_mesh(at: &str, m: &MeshFile) -> std::result::Result<Option<Vec<obj::ObjGroup>>, String> {
     let (vertices, triangles) = match (&m.vertices, &m.triangles) {
+        (None, None) if m.uv.is_some() => {
+            return Err(format!(
+                "{at}.uv: applies to a mesh written in the scene (vertices and triangles); a mesh file's texture coordinates come from the file"
+            ))
+        }
         (None, None) => return Ok(None),
         (Some(v), Some(t)) => (v, t),
         (Some(_), None) => {
@@ -515,11 +520,28 @@ fn inline_mesh(at: &str, m: &MeshFile) -> std::result::Result<Option<Vec<obj::Ob
             ));
         }
     }
+    let uvs = match &m.uv {
+        None => Vec::new(),
+        Some(uv) if uv.len() == vertices.len() && uv.iter().flatten().all(|x| x.is_finite()) => {
+            let at = |k: u32| {
+                let [u, v] = uv[k as usize];
+                Vec2::new(u as f32, v as f32)
+            };
+            triangles.iter().map(|t| t.map(at)).collect()
+        }
+        Some(uv) => {
+            return Err(format!(
+                "{at}.uv: expected one finite [u, v] per vertex ({}), got {} pairs",
+                vertices.len(),
+                uv.len()
+            ))
+        }
+    };
     Ok(Some(vec![obj::ObjGroup {
         name: String::new(),
         positions: vertices.iter().map(|p| p.get()).collect(),
         indices: triangles.clone(),
-        uvs: Vec::new(),
+        uvs,
     }]))
 }
 
@@ -626,9 +648,10 @@ pub(crate) fn shapes_of_groups(
     // Mitsuba 3's readers: an OBJ's v is flipped (its images start at the bottom row,
     // heron's uv at the top), a PLY's and a serialized mesh's are not (`flip_tex_coords`,
     // src/shapes/obj.cpp and ply.cpp; serialized.cpp has no flip).
+    // A mesh written in the scene (no file) keeps its uv as given.
     let flip = m
         .flip_tex_coords
-        .unwrap_or(MeshFormat::of(mesh_path) == MeshFormat::Obj);
+        .unwrap_or(!m.file.is_empty() && MeshFormat::of(mesh_path) == MeshFormat::Obj);
     // The triangles per material, in the order the materials first appear.
     let mut parts: Vec<Part> = Vec::new();
     let mut any_triangle = false;

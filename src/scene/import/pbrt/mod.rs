@@ -74,6 +74,12 @@ enum Geom {
         inner: f64,
         phi_max: f64,
     },
+    /// pbrt-v4's `cylinder` (the open side from z = zmin to zmax), as triangles.
+    Cylinder {
+        radius: f64,
+        z: (f64, f64),
+        phi_max: f64,
+    },
 }
 
 /// A `Shape` with the graphics state current at it (pbrt-v4's `ShapeSceneEntity`: the

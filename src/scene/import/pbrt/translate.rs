@@ -681,14 +681,42 @@ impl Conv {
                     phi_max: phi_max.to_radians(),
                 }
             }
+            "cylinder" => self.cylinder(path, line, p)?,
             other => {
                 for q in &p.0 {
                     q.used.set(true);
                 }
-                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, disk, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
+                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, disk, cylinder, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
                 return Ok(None);
             }
         }))
+    }
+
+    /// pbrt-v4's `cylinder` (`Cylinder::Create`, shapes.cpp): `radius` (default 1),
+    /// `zmin` (−1), `zmax` (1), `phimax` (360 degrees); zmin and zmax in either order,
+    /// as pbrt orders them.
+    fn cylinder(&mut self, path: &Path, line: u32, p: &Params) -> Result<Geom, Diagnostic> {
+        let radius = p.float("radius").unwrap_or(1.0);
+        let (z0, z1) = (
+            p.float("zmin").unwrap_or(-1.0),
+            p.float("zmax").unwrap_or(1.0),
+        );
+        let phi_max = p.float("phimax").unwrap_or(360.0);
+        if !(radius > 0.0 && radius.is_finite() && z0 != z1 && (z0 - z1).is_finite()) {
+            return Err(self.diag(path, line, format!("Shape \"cylinder\": expected a positive radius and finite zmin != zmax, got radius {radius}, zmin {z0}, zmax {z1}")));
+        }
+        if !(phi_max > 0.0 && phi_max <= 360.0) {
+            return Err(self.diag(
+                path,
+                line,
+                format!("Shape \"cylinder\": expected phimax in (0, 360] degrees, got {phi_max}"),
+            ));
+        }
+        Ok(Geom::Cylinder {
+            radius,
+            z: (z0.min(z1), z0.max(z1)),
+            phi_max: phi_max.to_radians(),
+        })
     }
 
     /// The heron shape tables of `sd` placed by its CTM, or for an `ObjectInstance`
@@ -720,7 +748,7 @@ impl Conv {
         let flip = sd.reverse ^ (m.determinant() < 0.0);
         let closed = match &sd.geom {
             Geom::Sphere { .. } | Geom::Ply { .. } => true,
-            Geom::Disk { .. } => false,
+            Geom::Disk { .. } | Geom::Cylinder { .. } => false,
             Geom::Mesh { kind, faces, .. } => faces_closed(kind, faces),
         };
         let medium = self.interior(sd, closed, &file, line, &ctx)?;
@@ -814,6 +842,10 @@ impl Conv {
                 entries.extend(schema::disk(
                     &m, *radius, *inner, *height, *phi_max, flip, segs,
                 ));
+            }
+            Geom::Cylinder { radius, z, phi_max } => {
+                let segs = crate::scene::import::DISK_SEGMENTS;
+                entries.push(schema::cylinder(&m, *radius, *z, *phi_max, flip, segs));
             }
             Geom::Ply { file: f } => {
                 if flip {
