@@ -718,8 +718,6 @@ fn mesh_errors_name_the_mesh_file_and_the_key_path() {
         (None, &["shapes[1].file: cannot read the mesh file"]),
         (Some("v 0 0 0\nv 1 0 0\nv 1 1 0\n"),
          &["shapes[1].file: expected a mesh with at least one triangle"]),
-        (Some("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
-         &["shapes[1].file: expected a mesh with at least one triangle of non-zero area"]),
         (Some("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 4\n"),
          &["shapes[1].file: line 4: face vertex index 4 out of range (the file has 3 vertices)"]),
         (Some("v 0 0 0\nv 1 0 0\nv 1 1 0\nf -4 -2 -1\n"),
