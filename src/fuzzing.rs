@@ -343,6 +343,7 @@ pub fn ply(data: &[u8]) -> Outcome {
         }
     }
     let entry = mesh_entry("fuzz.ply");
+    let mut warnings = Vec::new();
     match load::shapes_of_groups(
         groups,
         Path::new("fuzz.toml"),
@@ -351,7 +352,10 @@ pub fn ply(data: &[u8]) -> Outcome {
         &entry,
         &BTreeMap::new(),
         Some(0),
+        &mut warnings,
     ) {
+        // A mesh of zero-area triangles only is dropped with a warning.
+        Ok(shapes) if shapes.is_empty() => rejected(&warnings.join("; ")),
         Ok(shapes) => {
             shapes.iter().for_each(|s| check_shape(s, 1));
             Outcome::Accepted
@@ -423,6 +427,7 @@ fn mesh_entry(file: &str) -> MeshFile {
         scale: None,
         translate: None,
         transform: None,
+        uv: None,
         flip_tex_coords: None,
         emission: None,
         two_sided: None,
@@ -437,6 +442,7 @@ pub fn obj(data: &[u8]) -> Outcome {
         return Outcome::Skipped;
     };
     let entry = mesh_entry("fuzz.obj");
+    let mut warnings = Vec::new();
     let shapes = match load::mesh_shapes(
         text,
         Path::new("fuzz.toml"),
@@ -445,7 +451,10 @@ pub fn obj(data: &[u8]) -> Outcome {
         &entry,
         &BTreeMap::new(),
         Some(0),
+        &mut warnings,
     ) {
+        // A mesh of zero-area triangles only is dropped with a warning.
+        Ok(s) if s.is_empty() => return rejected(&warnings.join("; ")),
         Ok(s) => s,
         Err(e) => return rejected(&e.to_string()),
     };

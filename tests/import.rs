@@ -477,7 +477,7 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
         <bsdf type="diffuse"><texture type="mesh_attribute" name="reflectance"/></bsdf>
     </shape>
     <emitter type="sunsky"/>
-    <shape type="cylinder"/>
+    <shape type="bsplinecurve"/>
     <shape type="sphere"><float name="nonsense" value="1"/></shape>
 "#;
     let (_d, r) = import_text(&scene(body));
@@ -496,7 +496,10 @@ fn unsupported_input_is_named_with_its_line_and_strict_makes_it_an_error() {
         "{lines:#?}"
     );
     assert!(has(11, "emitter \"sunsky\" is not supported"), "{lines:#?}");
-    assert!(has(12, "shape \"cylinder\" is not supported"), "{lines:#?}");
+    assert!(
+        has(12, "shape \"bsplinecurve\" is not supported"),
+        "{lines:#?}"
+    );
     assert!(has(13, "parameter \"nonsense\""), "{lines:#?}");
     assert!(imp.warnings[0]
         .to_string()
@@ -907,7 +910,7 @@ fn pbrt_errors_and_warnings_name_the_line() {
         assert!(e.contains(&format!("scene.pbrt: line {line}: ")) && e.contains(want), "{e}");
     }
     let (_d, r) = import_pbrt(&format!(
-        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"fbm\"\nShape \"cylinder\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
+        "{PBRT_CAMERA}Texture \"wood\" \"spectrum\" \"fbm\"\nShape \"curve\"\nShape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"
     ));
     let imp = r.unwrap();
     let has = |line: u32, s: &str| {
@@ -921,7 +924,7 @@ fn pbrt_errors_and_warnings_name_the_line() {
         imp.warnings
     );
     assert!(
-        has(7, "Shape \"cylinder\" is not supported"),
+        has(7, "Shape \"curve\" is not supported"),
         "{:?}",
         imp.warnings
     );

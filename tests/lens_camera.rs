@@ -294,7 +294,7 @@ fn bad_lens_cameras_are_one_line_errors() {
     ];
     let want = [
         "camera.lens: ",
-        "camera.type: expected \"pinhole\" or \"lens\", got \"fisheye\"",
+        "camera.type: expected \"pinhole\", \"lens\" or \"orthographic\", got \"fisheye\"",
         "camera.d: the pinhole's camera constant",
         "camera.focus_distance: the lens cannot focus on a point 10 mm in front of the film",
         "camera.pupil: expected one of bounds, rear-element, got \"everywhere\"",

@@ -13,6 +13,13 @@
 //! real lens prescription and camera rays come from [`Camera::ray`]; the pinhole's
 //! importance functions above are for the pinhole only (light tracing and BDPT refuse
 //! a lens camera).
+//!
+//! An orthographic camera ([`Projection::Orthographic`], `[camera] type =
+//! "orthographic"`) sends parallel rays along its axis from an image plane of a given
+//! height in scene units centred at the eye (pbrt-v4 `OrthographicCamera`, Mitsuba 3
+//! `orthographic.cpp`). Its importance is a delta in direction, so no light path can
+//! reach it by a connection (pbrt-v4 leaves its `SampleWi` unimplemented): light tracing
+//! and BDPT refuse it too, and the importance functions are the pinhole's only.
 pub mod filter;
 pub mod lens;
 
@@ -52,6 +59,17 @@ pub const D_MIN: f32 = 1e-6;
 /// aspect/d² that the light-tracing integrators divide by goes to zero.
 pub const D_MAX: f32 = 1e6;
 
+/// How camera rays leave the image plane: through the eye, or parallel to the axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// The seed's pinhole: rays from the eye through an image plane of height 1 at d
+    /// (and a lens camera's film, which [`Camera::lens`] carries).
+    Perspective,
+    /// Rays parallel to the axis, from the point of an image plane of `height` scene
+    /// units (its width height·aspect) centred at the eye, perpendicular to the axis.
+    Orthographic { height: f32 },
+}
+
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub eye: Vec3,
@@ -67,6 +85,8 @@ pub struct Camera {
     v: Vec3,
     /// The lens in front of the film; None for the seed's pinhole.
     pub lens: Option<Arc<lens::LensCamera>>,
+    /// Perspective (the pinhole and the lens) or orthographic.
+    pub projection: Projection,
     /// An ideal linear analyser in front of the camera (`[camera] polarizer`), its
     /// transmission axis this many radians from the image's horizontal, counter-clockwise
     /// as the photographer sees it; read by polarised transport only.
@@ -116,8 +136,22 @@ impl Camera {
             b2,
             v,
             lens: None,
+            projection: Projection::Perspective,
             polarizer: None,
         })
+    }
+
+    /// This camera made orthographic, its image plane `height` scene units high
+    /// (finite and positive, checked by the loader).
+    pub fn orthographic(mut self, height: f32) -> Camera {
+        self.projection = Projection::Orthographic { height };
+        self
+    }
+
+    /// Whether light paths can reach the camera by a connection (its importance is not
+    /// a delta in direction and [`Camera::sample_wi`] holds): the pinhole only.
+    pub fn connectable(&self) -> bool {
+        self.lens.is_none() && self.projection == Projection::Perspective
     }
 
     /// The Stokes frame of light arriving at the camera along −`dir` (`dir` the camera
@@ -144,14 +178,15 @@ impl Camera {
     pub fn resized(&self, width: u32, height: u32) -> Result<Camera, String> {
         let mut c = Camera::new(self.eye, self.look_at, self.up, self.d, width, height)?;
         c.lens = self.lens.clone();
+        c.projection = self.projection;
         c.polarizer = self.polarizer;
         Ok(c)
     }
 
     /// The camera ray through film position (x, y) in pixels ((0, 0) at the top-left
     /// corner) at the hero wavelength `lambda_nm`; None when the lens stops it (the
-    /// sample then adds 0). The pinhole draws nothing from `u`; the lens draws its
-    /// point on the rear element.
+    /// sample then adds 0). The pinhole and the orthographic camera draw nothing from
+    /// `u`; the lens draws its point on the rear element.
     #[inline]
     pub fn ray(
         &self,
@@ -161,8 +196,12 @@ impl Camera {
         lambda_nm: f32,
     ) -> Option<CameraRay> {
         let Some(lens) = &self.lens else {
+            let (origin, dir) = match self.projection {
+                Projection::Perspective => (self.eye, self.pinhole_direction(x, y)),
+                Projection::Orthographic { height } => (self.plane_point(x, y, height), self.v),
+            };
             return Some(CameraRay {
-                ray: Ray::new(self.eye, self.direction(x, y), 0.0, f32::INFINITY),
+                ray: Ray::new(origin, dir, 0.0, f32::INFINITY),
                 weight: 1.0,
                 hero_only: false,
             });
@@ -206,15 +245,46 @@ impl Camera {
         (-(d.z as f32) * self.v + d.x as f32 * self.b1 + d.y as f32 * self.b2).normalize()
     }
 
+    /// The orthographic camera's ray origin for film position (x, y) in pixels: the
+    /// point of the image plane [-aspect/2, aspect/2] × [-1/2, 1/2] · `height` centred at
+    /// the eye (the image's top-left corner at (0, 0), as for the pinhole).
+    #[inline]
+    fn plane_point(&self, x: f32, y: f32, height: f32) -> Vec3 {
+        let aspect = self.width as f32 / self.height as f32;
+        let u = (x / self.width as f32 - 0.5) * aspect * height;
+        let w = (0.5 - y / self.height as f32) * height;
+        self.eye + u * self.b1 + w * self.b2
+    }
+
     /// Unit direction of the ray through film position (x, y) in pixels, (0, 0) at the
     /// top-left corner. The image plane spans [-aspect/2, aspect/2] × [-1/2, 1/2] at
-    /// distance d, as in the course framework.
+    /// distance d, as in the course framework. The orthographic camera's rays all point
+    /// along its axis.
     #[inline]
     pub fn direction(&self, x: f32, y: f32) -> Vec3 {
+        match self.projection {
+            Projection::Perspective => self.pinhole_direction(x, y),
+            Projection::Orthographic { .. } => self.v,
+        }
+    }
+
+    /// The pinhole's [`Camera::direction`].
+    #[inline]
+    fn pinhole_direction(&self, x: f32, y: f32) -> Vec3 {
         let aspect = self.width as f32 / self.height as f32;
         let u = (x / self.width as f32 - 0.5) * aspect;
         let w = 0.5 - y / self.height as f32;
         (u * self.b1 + w * self.b2 + self.d * self.v).normalize()
+    }
+
+    /// The side of one pixel on the orthographic camera's image plane (scene units), the
+    /// same at every distance; None for the perspective cameras (see
+    /// [`Camera::pixel_angle`]). Photon mapping sizes its first gather radii by it.
+    pub fn pixel_size(&self) -> Option<f32> {
+        match self.projection {
+            Projection::Perspective => None,
+            Projection::Orthographic { height } => Some(height / self.height as f32),
+        }
     }
 
     /// The angle (radians) one pixel subtends at the centre of the image: 1/(d·height)

@@ -140,7 +140,11 @@ pub(crate) fn load_any_scene(
     for w in &imported.warnings {
         eprintln!("warning: {w}");
     }
-    Ok(heron::scene::load::load_imported(&imported)?)
+    let scene = heron::scene::load::load_imported(&imported)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
 }
 
 pub(crate) fn parse_vec3(s: &str) -> std::result::Result<[f32; 3], String> {

@@ -21,6 +21,8 @@ pub enum Support {
 pub struct Capabilities {
     /// The lens camera (`camera.type = "lens"`).
     pub lens: Support,
+    /// The orthographic camera (`camera.type = "orthographic"`).
+    pub orthographic: Support,
     /// Participating media (a shape's medium).
     pub media: bool,
     /// Polarised transport (`polarization = true`).
@@ -47,6 +49,9 @@ pub struct Capabilities {
 
 /// Why light tracing and BDPT cannot render through the lens camera.
 pub(crate) const LENS_NEEDS_WE: &str = "the lens camera (camera.type = \"lens\") has no importance function We and no connection to the film yet, which light tracing and BDPT need to reach the camera from the lights; use integrator = \"path\" or \"whitted\"";
+
+/// Why light tracing and BDPT cannot render through the orthographic camera.
+pub(crate) const ORTHOGRAPHIC_NEEDS_WE: &str = "the orthographic camera (camera.type = \"orthographic\") sees along one direction only (its importance is a delta), so no light path can connect to it; use integrator = \"path\", \"sppm\" or \"whitted\"";
 
 /// The kernel flags integrator `kind` needs for a scene with `features`: the flags it
 /// is specialised on, or every flag for an integrator with one general kernel.
@@ -98,6 +103,11 @@ pub fn check_camera(scene: &Scene, settings: &RenderSettings) -> Result<(), Stri
     let kind = settings.integrator;
     let caps = capabilities(kind);
     if let (Some(_), Support::No(why)) = (&scene.camera.lens, caps.lens) {
+        return Err(format!("integrator {}: {why}", kind.name()));
+    }
+    if let (crate::camera::Projection::Orthographic { .. }, Support::No(why)) =
+        (scene.camera.projection, caps.orthographic)
+    {
         return Err(format!("integrator {}: {why}", kind.name()));
     }
     if !settings.polarization {

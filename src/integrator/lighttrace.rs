@@ -19,7 +19,7 @@
 //!
 //! Random numbers: light choice (1D), the emitted ray's position (2D) and direction
 //! (2D), then per bounce the lobe (1D), the direction (2D) and the roulette (1D).
-use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE};
+use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE, ORTHOGRAPHIC_NEEDS_WE};
 use super::toolkit::{next_hit, pixel_of, roulette, unoccluded, Connection, LightPathStart};
 use super::transport::{LightEvent, Transport};
 use super::{Context, Integrator, PixelIntegrator, TraceCounters};
@@ -39,6 +39,7 @@ pub struct LightTracer;
 impl Integrator for LightTracer {
     const CAPABILITIES: Capabilities = Capabilities {
         lens: Support::No(LENS_NEEDS_WE),
+        orthographic: Support::No(ORTHOGRAPHIC_NEEDS_WE),
         media: false,
         polarization: Support::Yes,
         variance: Support::Yes,

@@ -102,6 +102,7 @@ pub struct PathTracer;
 impl Integrator for PathTracer {
     const CAPABILITIES: Capabilities = Capabilities {
         lens: Support::Yes,
+        orthographic: Support::Yes,
         media: true,
         polarization: Support::Yes,
         variance: Support::Yes,

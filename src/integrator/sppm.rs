@@ -739,12 +739,16 @@ pub fn iteration<const N: usize>(
         .reduce(TraceCounters::default, sum);
 
     // A pixel's first visible point sets its radius: the scene's, or a few pixel
-    // footprints at the distance the camera path travelled.
+    // footprints at the distance the camera path travelled (an orthographic pixel's
+    // footprint is the same at every distance).
     let footprint = cam.pixel_angle();
+    let pixel_size = cam.pixel_size();
     for i in 0..npix {
         if vps[i].is_some() && pixels.r2[i] == 0.0 {
             let r = if settings.sppm.radius > 0.0 {
                 settings.sppm.radius
+            } else if let Some(s) = pixel_size {
+                crate::settings::SppmSettings::RADIUS_PIXELS * s
             } else {
                 crate::settings::SppmSettings::RADIUS_PIXELS * footprint * length[i]
             };
@@ -832,6 +836,7 @@ pub struct PhotonMapping;
 impl Integrator for PhotonMapping {
     const CAPABILITIES: Capabilities = Capabilities {
         lens: Support::Yes,
+        orthographic: Support::Yes,
         media: false,
         polarization: Support::No(
             "polarised transport (polarization = true) is implemented for integrator = \"path\", \"whitted\", \"lighttrace\" and \"bdpt\"; photon mapping's photons carry no Stokes vectors",

@@ -41,6 +41,7 @@ pub struct Whitted;
 impl Integrator for Whitted {
     const CAPABILITIES: Capabilities = Capabilities {
         lens: Support::Yes,
+        orthographic: Support::Yes,
         media: false,
         polarization: Support::Yes,
         variance: Support::Yes,

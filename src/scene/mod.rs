@@ -62,6 +62,10 @@ pub struct Scene {
     /// The direction toward the most powerful sun, if the scene has one (the guide of
     /// phase sampling in media, `RenderSettings::sun_guide`).
     pub sun_toward: Option<glam::Vec3>,
+    /// What the loader changed and says (one line each, naming the file): zero-area
+    /// triangles of a mesh dropped, a mesh left with none dropped. `load::load_scene`
+    /// and `heron render` print them; an importer's own warnings come before them.
+    pub warnings: Vec<String>,
 }
 
 /// What a scene is made of before its derived parts (the environment light, the list of
@@ -144,6 +148,7 @@ impl Scene {
             material_names: p.material_names,
             lights,
             light_polarization: Vec::new(),
+            warnings: Vec::new(),
             environment,
             infinite_lights,
             background: p.background,

@@ -30,7 +30,7 @@
 //! bounce), then per camera bounce lobe 1D and direction 2D, then for each (s = 1, t)
 //! connection the light choice 1D and point 2D. Subpaths are at most [`MAX_VERTICES`]
 //! vertices long (so `max_depth` is capped at 22 here), held on the stack.
-use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE};
+use super::capabilities::{Capabilities, Support, LENS_NEEDS_WE, ORTHOGRAPHIC_NEEDS_WE};
 use super::polarized::{non_delta, Beam, Chain};
 use super::toolkit::{next_hit, pixel_of, unoccluded, Connection, LightPathStart, Vertex as Event};
 use super::transport::Transport;
@@ -334,6 +334,7 @@ pub struct Bidirectional;
 impl Integrator for Bidirectional {
     const CAPABILITIES: Capabilities = Capabilities {
         lens: Support::No(LENS_NEEDS_WE),
+        orthographic: Support::No(ORTHOGRAPHIC_NEEDS_WE),
         media: false,
         polarization: Support::Yes,
         variance: Support::Yes,

@@ -165,7 +165,8 @@ pub struct SkyFile {
 }
 
 /// `[camera]`: the seed's pinhole camera, or (`type = "lens"`) a film behind a lens
-/// prescription (`lens = "file"` or `[[camera.surface]]` tables).
+/// prescription (`lens = "file"` or `[[camera.surface]]` tables), or (`type =
+/// "orthographic"`) parallel rays from an image plane `height` scene units high.
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraFile {
@@ -179,9 +180,13 @@ pub struct CameraFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub d: Option<PositiveNumber>,
     pub resolution: Resolution,
-    /// "pinhole" (the default) or "lens".
+    /// "pinhole" (the default), "lens" or "orthographic".
     #[serde(default, rename = "type", skip_serializing_if = "Option::is_none")]
     pub kind: Option<String>,
+    /// The orthographic camera's image plane: its height in scene units (its width
+    /// height × the image's aspect ratio). Orthographic only, required.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<PositiveNumber>,
     /// The lens: a prescription file (heron's TOML or pbrt-v4's `.dat`), relative to
     /// the scene file …
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -737,6 +742,10 @@ pub struct MeshFile {
     /// `scale` and `translate`: Mitsuba's `to_world`, as `heron convert` writes it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<Vec<Vec<f64>>>,
+    /// The texture coordinates (u, v) of each of `vertices`, for a mesh written in the
+    /// scene (a file's come from the file); used as given unless `flip_tex_coords`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uv: Option<Vec<[f64; 2]>>,
     /// Use the file's texture coordinates (u, v) as (u, 1 − v): default true for OBJ
     /// (whose images start at the bottom row), false for PLY and serialized meshes, as
     /// Mitsuba 3 reads them.

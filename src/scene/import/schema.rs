@@ -72,6 +72,7 @@ pub fn pinhole(
         d: Some(positive(d)),
         resolution: Resolution { width, height },
         kind: None,
+        height: None,
         lens: None,
         surface: None,
         film_diagonal: None,
@@ -144,6 +145,68 @@ pub fn disk(
     out
 }
 
+/// The side of a cylinder (open: no caps) as one mesh entry of `segments` quads per
+/// full turn (fewer for a partial one of `phi_max` radians), each split in two: the
+/// surface (r cos φ, r sin φ, z), z from `z0` to `z1`, of the object space `m` maps to
+/// the world (pbrt-v4's and Mitsuba 3's `cylinder`). Its uv is (φ/φmax, (z − z0)/(z1 −
+/// z0)), the parametrisation both formats give their cylinders (pbrt-v4 `Cylinder`,
+/// Mitsuba 3 src/shapes/cylinder.cpp); the seam's vertices are doubled so u runs to 1.
+/// The triangles face outward (the formats' normal); `swap` turns them inward (a
+/// flipped normal, or a mirroring `m`). 128 segments have 0.9999 of the side's area
+/// (128 sin(π/128)/π).
+pub fn cylinder(
+    m: &DMat4,
+    radius: f64,
+    (z0, z1): (f64, f64),
+    phi_max: f64,
+    swap: bool,
+    segments: usize,
+) -> ShapeFile {
+    let n = ((segments as f64 * phi_max / std::f64::consts::TAU).ceil() as usize).max(1);
+    let mut vertices = Vec::with_capacity(2 * (n + 1));
+    let mut uv = Vec::with_capacity(2 * (n + 1));
+    for i in 0..=n {
+        let u = i as f64 / n as f64;
+        let (sin, cos) = (phi_max * u).sin_cos();
+        for (z, v) in [(z0, 0.0), (z1, 1.0)] {
+            vertices.push(point(m.transform_point3(DVec3::new(
+                radius * cos,
+                radius * sin,
+                z,
+            ))));
+            uv.push([tidy(u), v]);
+        }
+    }
+    let mut triangles = Vec::with_capacity(2 * n);
+    for i in 0..n as u32 {
+        // a, b at z0 and d, c at z1: (b − a) × (c − a) points away from the axis.
+        let (a, d, b, c) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+        for t in [[a, b, c], [a, c, d]] {
+            triangles.push(if swap { [t[0], t[2], t[1]] } else { t });
+        }
+    }
+    let mut shape = mesh(String::new(), DMat4::IDENTITY, None);
+    if let ShapeFile::Mesh(mf) = &mut shape {
+        mf.vertices = Some(vertices);
+        mf.triangles = Some(triangles);
+        mf.uv = Some(uv);
+    }
+    shape
+}
+
+/// Mitsuba 3's `coordinate_system` (include/mitsuba/core/vector.h; Duff et al. 2017,
+/// "Building an orthonormal basis, revisited"): the frame's s and t about unit `n`,
+/// which a `cylinder`'s `p0`/`p1` turn its local x and y into.
+pub fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
 pub fn quad(origin: DVec3, edge1: DVec3, edge2: DVec3) -> ShapeFile {
     ShapeFile::Quad(QuadFile {
         origin: point(origin),
@@ -169,6 +232,7 @@ pub fn mesh(file: String, transform: DMat4, flip_tex_coords: Option<bool>) -> Sh
         scale: None,
         translate: None,
         transform: (transform != DMat4::IDENTITY).then(|| rows(transform)),
+        uv: None,
         flip_tex_coords,
         emission: None,
         two_sided: None,

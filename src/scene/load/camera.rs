@@ -1,5 +1,6 @@
-//! The `[camera]` table to the seed's pinhole [`Camera`], or to a film behind a lens
-//! prescription ([`crate::camera::lens`]).
+//! The `[camera]` table to the seed's pinhole [`Camera`], to a film behind a lens
+//! prescription ([`crate::camera::lens`]), or to an orthographic camera
+//! ([`crate::camera::Projection`]).
 use super::errors::fmt_points;
 use crate::camera::lens::{paraxial, Focus, LensCamera, LensSettings, LensSystem, PupilSampling};
 use crate::camera::{Camera, D_MAX, D_MIN};
@@ -24,8 +25,14 @@ pub(super) fn build_camera(
             fmt_points(&[c.look_at.get()])
         ));
     }
+    let orthographic = c.kind.as_deref() == Some("orthographic");
+    if let (false, Some(_)) = (orthographic, c.height) {
+        return Err(
+            "camera.height: the orthographic camera's image plane height; set camera.type = \"orthographic\" to use it".into(),
+        );
+    }
     let lens = match c.kind.as_deref() {
-        None | Some("pinhole") => {
+        None | Some("pinhole") | Some("orthographic") => {
             let lens_keys = [
                 ("lens", c.lens.is_some()),
                 ("surface", c.surface.is_some()),
@@ -48,9 +55,22 @@ pub(super) fn build_camera(
         Some("lens") => Some(build_lens(c, base_dir, inputs)?),
         Some(other) => {
             return Err(format!(
-                "camera.type: expected \"pinhole\" or \"lens\", got {other:?}"
+                "camera.type: expected \"pinhole\", \"lens\" or \"orthographic\", got {other:?}"
             ))
         }
+    };
+    let height = match (orthographic, c.height, c.d) {
+        (true, _, Some(_)) => {
+            return Err(
+                "camera.d: the pinhole's camera constant; an orthographic camera's view is set by camera.height (the image plane's height in scene units)".into(),
+            )
+        }
+        (true, None, _) => {
+            return Err(
+                "camera.height: an orthographic camera needs its image plane's height in scene units (a positive number)".into(),
+            )
+        }
+        (_, h, _) => h.map(|h| h.get()),
     };
     let d = match (&lens, c.d) {
         (Some(_), Some(_)) => {
@@ -91,9 +111,10 @@ pub(super) fn build_camera(
             ))
         }
     };
-    Ok(match lens {
-        Some(l) => cam.with_lens(l),
-        None => cam,
+    Ok(match (lens, height) {
+        (Some(l), _) => cam.with_lens(l),
+        (None, Some(h)) => cam.orthographic(h),
+        (None, None) => cam,
     })
 }
 

@@ -63,11 +63,19 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
         for w in &imported.warnings {
             eprintln!("heron: warning: {w}");
         }
-        return load_imported(&imported);
+        let scene = load_imported(&imported)?;
+        for w in &scene.warnings {
+            eprintln!("heron: warning: {w}");
+        }
+        return Ok(scene);
     }
     let text = std::fs::read_to_string(path)
         .map_err(|e| scene_error(path, format!("cannot read the scene file: {e}")))?;
-    load_scene_from_str(&text, path)
+    let scene = load_scene_from_str(&text, path)?;
+    for w in &scene.warnings {
+        eprintln!("heron: warning: {w}");
+    }
+    Ok(scene)
 }
 
 /// The scene of a converted file ([`super::import`]); its errors name the source
@@ -133,8 +141,15 @@ pub(crate) fn build(
     let mut inputs: Vec<String> = Vec::new();
     let materials = materials::Materials::build(&file, &base_dir, &mut inputs).map_err(err)?;
     let plans = media::plan_media(&file.shapes).map_err(err)?;
-    let (mut shapes, entry) =
-        shapes::build_shapes(path, &base_dir, &file.shapes, &materials, &mut inputs)?;
+    let mut warnings: Vec<String> = Vec::new();
+    let (mut shapes, entry) = shapes::build_shapes(
+        path,
+        &base_dir,
+        &file.shapes,
+        &materials,
+        &mut inputs,
+        &mut warnings,
+    )?;
     let media = media::assign_media(
         &file.shapes,
         &entry,
@@ -197,5 +212,6 @@ pub(crate) fn build(
         media,
     });
     scene.light_polarization = light_polarization;
+    scene.warnings = warnings;
     Ok(scene)
 }

@@ -25,6 +25,7 @@ pub(super) fn build_shapes(
     entries: &[ShapeFile],
     materials: &Materials,
     inputs: &mut Vec<String>,
+    warnings: &mut Vec<String>,
 ) -> Result<(Vec<Shape>, Vec<usize>)> {
     let err = |m: String| scene_error(path, m);
     // The material of a simple shape: named, or black for a pure emitter, or the
@@ -82,7 +83,8 @@ pub(super) fn build_shapes(
                     (None, Some(_)) => Some(materials.boundary),
                     (None, None) => None,
                 };
-                shapes.extend(build_mesh(path, base_dir, &at, m, materials, fallback)?);
+                let mesh = build_mesh(path, base_dir, &at, m, materials, fallback, warnings)?;
+                shapes.extend(mesh);
                 if !m.file.is_empty() {
                     inputs.push(m.file.clone());
                 }
@@ -392,6 +394,7 @@ fn build_mesh(
     m: &MeshFile,
     materials: &Materials,
     emitter_material: Option<u32>,
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<Shape>> {
     let lookup = |at: String, name: &str| {
         materials
@@ -417,6 +420,7 @@ fn build_mesh(
             m,
             &group_material,
             default_material,
+            warnings,
         );
     }
     if m.file.trim().is_empty() {
@@ -461,6 +465,7 @@ fn build_mesh(
             m,
             &group_material,
             default_material,
+            warnings,
         );
     }
     let text = std::fs::read_to_string(&mesh_path).map_err(read_error)?;
@@ -472,6 +477,7 @@ fn build_mesh(
         m,
         &group_material,
         default_material,
+        warnings,
     )
 }
 
@@ -479,6 +485,11 @@ fn build_mesh(
 /// or None for a mesh file.
 fn inline_mesh(at: &str, m: &MeshFile) -> std::result::Result<Option<Vec<obj::ObjGroup>>, String> {
     let (vertices, triangles) = match (&m.vertices, &m.triangles) {
+        (None, None) if m.uv.is_some() => {
+            return Err(format!(
+                "{at}.uv: applies to a mesh written in the scene (vertices and triangles); a mesh file's texture coordinates come from the file"
+            ))
+        }
         (None, None) => return Ok(None),
         (Some(v), Some(t)) => (v, t),
         (Some(_), None) => {
@@ -515,11 +526,28 @@ fn inline_mesh(at: &str, m: &MeshFile) -> std::result::Result<Option<Vec<obj::Ob
             ));
         }
     }
+    let uvs = match &m.uv {
+        None => Vec::new(),
+        Some(uv) if uv.len() == vertices.len() && uv.iter().flatten().all(|x| x.is_finite()) => {
+            let at = |k: u32| {
+                let [u, v] = uv[k as usize];
+                Vec2::new(u as f32, v as f32)
+            };
+            triangles.iter().map(|t| t.map(at)).collect()
+        }
+        Some(uv) => {
+            return Err(format!(
+                "{at}.uv: expected one finite [u, v] per vertex ({}), got {} pairs",
+                vertices.len(),
+                uv.len()
+            ))
+        }
+    };
     Ok(Some(vec![obj::ObjGroup {
         name: String::new(),
         positions: vertices.iter().map(|p| p.get()).collect(),
         indices: triangles.clone(),
-        uvs: Vec::new(),
+        uvs,
     }]))
 }
 
@@ -582,6 +610,7 @@ fn mesh_transform(
 
 /// The shapes of mesh entry `m` (at key path `at`) from the text of its OBJ file
 /// `mesh_path`, with the materials of its groups already looked up.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn mesh_shapes(
     text: &str,
     scene_path: &Path,
@@ -590,6 +619,7 @@ pub(crate) fn mesh_shapes(
     m: &MeshFile,
     group_material: &BTreeMap<&str, u32>,
     default_material: Option<u32>,
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<Shape>> {
     let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
     let groups = obj::parse_obj(text).map_err(merr)?;
@@ -601,11 +631,17 @@ pub(crate) fn mesh_shapes(
         m,
         group_material,
         default_material,
+        warnings,
     )
 }
 
 /// The shapes of mesh entry `m` from its file's groups (OBJ objects and groups, or the
-/// one group of a PLY file or of a serialized file's shape).
+/// one group of a PLY file or of a serialized file's shape). Triangles of zero area
+/// (never hit, and no area to emit from) are dropped with one warning per entry in
+/// `warnings`; a mesh left with none is dropped (no shapes) with a warning, as pbrt-v4
+/// and Mitsuba 3 load such files (issue 38: one degenerate mesh among hundreds once
+/// rejected the whole scene).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn shapes_of_groups(
     groups: Vec<obj::ObjGroup>,
     scene_path: &Path,
@@ -614,6 +650,7 @@ pub(crate) fn shapes_of_groups(
     m: &MeshFile,
     group_material: &BTreeMap<&str, u32>,
     default_material: Option<u32>,
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<Shape>> {
     let merr = |msg: String| scene_error(mesh_path, format!("{at}.file: {msg}"));
     let transform = mesh_transform(at, &m.transform).map_err(|msg| scene_error(scene_path, msg))?;
@@ -626,12 +663,13 @@ pub(crate) fn shapes_of_groups(
     // Mitsuba 3's readers: an OBJ's v is flipped (its images start at the bottom row,
     // heron's uv at the top), a PLY's and a serialized mesh's are not (`flip_tex_coords`,
     // src/shapes/obj.cpp and ply.cpp; serialized.cpp has no flip).
+    // A mesh written in the scene (no file) keeps its uv as given.
     let flip = m
         .flip_tex_coords
-        .unwrap_or(MeshFormat::of(mesh_path) == MeshFormat::Obj);
+        .unwrap_or(!m.file.is_empty() && MeshFormat::of(mesh_path) == MeshFormat::Obj);
     // The triangles per material, in the order the materials first appear.
     let mut parts: Vec<Part> = Vec::new();
-    let mut any_triangle = false;
+    let (mut kept, mut dropped) = (0usize, 0usize);
     for g in &groups {
         if g.indices.is_empty() {
             continue;
@@ -662,9 +700,10 @@ pub(crate) fn shapes_of_groups(
                 .map_err(merr)?;
             // Zero-area triangles are never hit; they are dropped.
             if is_degenerate(p[0], p[1], p[2]) {
+                dropped += 1;
                 continue;
             }
-            any_triangle = true;
+            kept += 1;
             let uv = part.textured.then(|| {
                 let t = g.uvs[k];
                 if flip {
@@ -676,9 +715,20 @@ pub(crate) fn shapes_of_groups(
             part.push(p, uv);
         }
     }
-    if !any_triangle {
+    if kept + dropped == 0 {
         return Err(merr(
-            "expected a mesh with at least one triangle of non-zero area, got none".into(),
+            "expected a mesh with at least one triangle, got none".into(),
+        ));
+    }
+    if dropped > 0 {
+        let what = if kept == 0 {
+            "no triangle is left, the mesh is dropped".to_string()
+        } else {
+            format!("{kept} kept")
+        };
+        warnings.push(format!(
+            "{}: {at}: {dropped} triangle(s) of zero area dropped ({what})",
+            mesh_path.display()
         ));
     }
     Ok(parts

@@ -193,7 +193,7 @@ impl<'a> Converter<'a> {
         medium: &mut Option<MediumFile>,
     ) -> Result<Option<Option<String>>, Diagnostic> {
         if medium.is_some() {
-            let why = if matches!(kind, "rectangle" | "disk") {
+            let why = if matches!(kind, "rectangle" | "disk" | "cylinder") {
                 Some(format!("a {kind} is open, and heron's media fill closed shapes (a sphere, a cube or a closed mesh)"))
             } else if emission.is_some() {
                 Some("heron's shapes around a medium do not emit".to_string())

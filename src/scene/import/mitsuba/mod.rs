@@ -369,11 +369,12 @@ impl<'a> Converter<'a> {
             );
         }
         let kind = Self::plugin(n)?;
-        if kind != "perspective" && kind != "thinlens" {
+        if !matches!(kind, "perspective" | "thinlens" | "orthographic") {
             return Err(n.diag(format!(
-                "expected a perspective sensor (or thinlens, rendered as a pinhole), got {kind:?}"
+                "expected a perspective or orthographic sensor (or thinlens, rendered as a pinhole), got {kind:?}"
             )));
         }
+        let orthographic = kind == "orthographic";
         let p = self.props(n);
         let to_world = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         if to_world.determinant() < 0.0 {
@@ -387,7 +388,13 @@ impl<'a> Converter<'a> {
             }
             self.warn(n.diag("thinlens is rendered as a pinhole: depth of field is lost"))?;
         }
-        for k in ["near_clip", "far_clip"] {
+        // The orthographic camera's rays start on the near plane, which heron keeps.
+        let clips: &[&str] = if orthographic {
+            &["far_clip"]
+        } else {
+            &["near_clip", "far_clip"]
+        };
+        for &k in clips {
             if p.get(k).is_some() {
                 self.warn(n.diag(format!(
                     "{k}: heron's camera has no clipping planes, ignored"
@@ -405,6 +412,10 @@ impl<'a> Converter<'a> {
             }
         }
         let aspect = width as f64 / height as f64;
+        if orthographic {
+            self.camera = Some(self.orthographic(n, &p, &to_world, (width, height))?);
+            return self.finish(&p);
+        }
         let tan_y = self.tan_half_fov_y(n, &p, aspect)?;
         let eye = to_world.transform_point3(DVec3::ZERO);
         let look = to_world.transform_point3(DVec3::Z);
@@ -414,6 +425,48 @@ impl<'a> Converter<'a> {
         cam.d = cam.d.filter(|d| d.0.is_finite());
         self.camera = Some(cam);
         self.finish(&p)
+    }
+
+    /// Mitsuba 3's `orthographic` sensor (src/sensors/orthographic.cpp): camera space
+    /// x ∈ [-1, 1] across the image's width and y ∈ [-1/aspect, 1/aspect] across its
+    /// height (`orthographic_projection`, include/mitsuba/render/sensor.h), mapped by
+    /// `to_world`, whose scale thus sets the image plane's size; rays leave the near
+    /// plane (z = `near_clip`, default 0.01) along +z. heron's pixels are square: when
+    /// `to_world` scales x and y differently the height is kept, with a warning.
+    fn orthographic(
+        &mut self,
+        n: &Node,
+        p: &Props,
+        to_world: &DMat4,
+        (width, height): (u32, u32),
+    ) -> Result<CameraFile, Diagnostic> {
+        let near = p.float("near_clip")?.unwrap_or(1e-2);
+        if !(near >= 0.0 && near.is_finite()) {
+            return Err(n.diag(format!(
+                "near_clip: expected a finite distance >= 0, got {near}"
+            )));
+        }
+        let aspect = width as f64 / height as f64;
+        let sx = to_world.transform_vector3(DVec3::X).length();
+        let sy = to_world.transform_vector3(DVec3::Y).length();
+        if !(sy > 0.0 && sx > 0.0 && (sx * sy).is_finite()) {
+            return Err(n.diag(
+                "to_world: expected a finite transform that keeps the image plane's size positive",
+            ));
+        }
+        if (sx - sy).abs() > 1e-6 * sx.max(sy) {
+            self.warn(n.diag(format!(
+                "to_world scales the image plane's x by {sx} and y by {sy}; heron's pixels are square, so the plane keeps its height and its width is {sy} x 2 (Mitsuba's is {sx} x 2)"
+            )))?;
+        }
+        let eye = to_world.transform_point3(DVec3::new(0.0, 0.0, near));
+        let look = eye + to_world.transform_vector3(DVec3::Z);
+        let up = to_world.transform_vector3(DVec3::Y);
+        let mut cam = schema::pinhole(eye, look, up, 1.0, (width, height));
+        cam.d = None;
+        cam.kind = Some("orthographic".into());
+        cam.height = Some(schema::positive(2.0 * sy / aspect));
+        Ok(cam)
     }
 
     /// tan of half the vertical field of view (heron's image plane has height 1 at d),

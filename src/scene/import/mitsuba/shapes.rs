@@ -99,6 +99,7 @@ impl<'a> Converter<'a> {
                     DISK_SEGMENTS,
                 ));
             }
+            "cylinder" => entries.push(self.cylinder(n, &p, &to_world, flip)?),
             "sphere" => {
                 let center = p.point("center")?.unwrap_or(DVec3::ZERO);
                 let radius = p.float("radius")?.unwrap_or(1.0);
@@ -123,7 +124,7 @@ impl<'a> Converter<'a> {
             }
             other => {
                 self.warn(n.diag(format!(
-                    "shape {other:?} is not supported (rectangle, cube, disk, sphere, obj, ply, serialized are), ignored"
+                    "shape {other:?} is not supported (rectangle, cube, disk, cylinder, sphere, obj, ply, serialized are), ignored"
                 )))?;
                 return self.finish(&p);
             }
@@ -438,4 +439,52 @@ pub(super) fn cube_triangles(to_world: &DMat4, flip: bool) -> Vec<[DVec3; 3]> {
         }
     }
     out
+}
+
+impl Converter<'_> {
+    /// Mitsuba 3's `cylinder` (src/shapes/cylinder.cpp): the open side of radius
+    /// `radius` (default 1) from `p0` (default the origin) to `p1` (default +z), placed
+    /// as `to_world` · translate(p0) · to_frame(Frame(p1 − p0)) · scale(r, r, |p1 − p0|),
+    /// the unit cylinder's uv (φ/2π, z) kept. Its normals point outward, inward under
+    /// `flip_normals`, whatever the handedness of `to_world` (Mitsuba flips them back
+    /// for a mirroring one).
+    fn cylinder(
+        &mut self,
+        n: &Node,
+        p: &Props,
+        to_world: &DMat4,
+        flip: bool,
+    ) -> Result<ShapeFile, Diagnostic> {
+        let radius = p.float("radius")?.unwrap_or(1.0);
+        let p0 = p.point("p0")?.unwrap_or(DVec3::ZERO);
+        let p1 = p.point("p1")?.unwrap_or(DVec3::Z);
+        let d = p1 - p0;
+        let len = d.length();
+        if !(radius > 0.0 && radius.is_finite() && len > 0.0 && len.is_finite()) {
+            return Err(n.diag(format!(
+                "cylinder: expected a positive finite radius and distinct finite p0 and p1, got radius {radius}, p0 {p0}, p1 {p1}"
+            )));
+        }
+        let axis = d / len;
+        let (s, t) = schema::coordinate_system(axis);
+        let frame = DMat4::from_cols(
+            s.extend(0.0),
+            t.extend(0.0),
+            axis.extend(0.0),
+            DVec3::ZERO.extend(1.0),
+        );
+        let m = *to_world
+            * DMat4::from_translation(p0)
+            * frame
+            * DMat4::from_scale(DVec3::new(radius, radius, len));
+        let swap = flip ^ (m.determinant() < 0.0);
+        Ok(schema::cylinder(
+            &m,
+            1.0,
+            (0.0, 1.0),
+            std::f64::consts::TAU,
+            swap,
+            DISK_SEGMENTS,
+        ))
+    }
 }

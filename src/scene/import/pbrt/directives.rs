@@ -231,22 +231,36 @@ impl Conv {
 
     fn camera(&mut self, d: &Directive) -> Result<(), Diagnostic> {
         let (path, line, p) = (d.path, d.line(), d.params());
-        if d.name() != "perspective" {
-            return Err(self.diag(
-                path,
-                line,
-                format!("Camera: expected \"perspective\", got {:?}", d.name()),
-            ));
-        }
-        let fov = p.float("fov").unwrap_or(90.0);
-        for k in [
-            "lensradius",
-            "focaldistance",
-            "screenwindow",
-            "frameaspectratio",
-            "shutteropen",
-            "shutterclose",
-        ] {
+        let projection = match d.name().as_str() {
+            "perspective" => {
+                for k in [
+                    "lensradius",
+                    "focaldistance",
+                    "screenwindow",
+                    "frameaspectratio",
+                ] {
+                    if p.get(k).is_some() {
+                        self.warn(self.diag(
+                            path,
+                            line,
+                            format!("Camera: {k} is not supported, ignored"),
+                        ))?;
+                    }
+                }
+                Projection::Perspective {
+                    fov: p.float("fov").unwrap_or(90.0),
+                }
+            }
+            "orthographic" => self.orthographic(d)?,
+            other => {
+                return Err(self.diag(
+                    path,
+                    line,
+                    format!("Camera: expected \"perspective\" or \"orthographic\", got {other:?}"),
+                ))
+            }
+        };
+        for k in ["shutteropen", "shutterclose"] {
             if p.get(k).is_some() {
                 self.warn(self.diag(path, line, format!("Camera: {k} is not supported, ignored")))?;
             }
@@ -255,8 +269,38 @@ impl Conv {
             let m = format!("Camera: the camera is inside the medium {:?} (MediumInterface), which heron does not render: its camera is outside every medium", self.g.outside);
             self.warn(self.diag(path, line, m))?;
         }
-        self.camera_from_world = Some((self.g.ctm, line, path.to_path_buf(), fov));
+        self.camera_from_world = Some((self.g.ctm, line, path.to_path_buf(), projection));
         Ok(())
+    }
+
+    /// pbrt-v4's `Camera "orthographic"` (`OrthographicCamera::Create`, cameras.cpp):
+    /// `screenwindow` (four numbers) or the default window from `frameaspectratio`;
+    /// a thin lens (`lensradius` > 0) is ignored with a warning.
+    fn orthographic(&mut self, d: &Directive) -> Result<Projection, Diagnostic> {
+        let (path, line, p) = (d.path, d.line(), d.params());
+        let lens = p.float("lensradius").unwrap_or(0.0);
+        p.get("focaldistance");
+        if lens > 0.0 {
+            self.warn(self.diag(path, line, format!("Camera \"orthographic\": lensradius {lens}: heron's orthographic camera has no lens, rendered without depth of field")))?;
+        }
+        let window = match p.get("screenwindow") {
+            None => None,
+            Some(w) => match w.nums[..] {
+                [x0, x1, y0, y1] if x0 < x1 && y0 < y1 && (x1 - x0 + y1 - y0).is_finite() => {
+                    Some([x0, x1, y0, y1])
+                }
+                _ => {
+                    return Err(self.diag(path, line, format!("Camera \"orthographic\": screenwindow: expected four finite numbers x0 < x1, y0 < y1, got {:?}", w.nums)))
+                }
+            },
+        };
+        let frame = p.float("frameaspectratio");
+        if let Some(f) = frame {
+            if !(f > 0.0 && f.is_finite()) {
+                return Err(self.diag(path, line, format!("Camera \"orthographic\": frameaspectratio: expected a positive number, got {f}")));
+            }
+        }
+        Ok(Projection::Orthographic { window, frame })
     }
 
     fn film(&mut self, d: &Directive) -> Result<(), Diagnostic> {

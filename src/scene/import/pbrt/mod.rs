@@ -74,6 +74,12 @@ enum Geom {
         inner: f64,
         phi_max: f64,
     },
+    /// pbrt-v4's `cylinder` (the open side from z = zmin to zmax), as triangles.
+    Cylinder {
+        radius: f64,
+        z: (f64, f64),
+        phi_max: f64,
+    },
 }
 
 /// A `Shape` with the graphics state current at it (pbrt-v4's `ShapeSceneEntity`: the
@@ -151,7 +157,8 @@ struct Conv {
     /// `[environment]` from an image `infinite` light.
     environment: Option<EnvironmentFile>,
     camera: Option<CameraFile>,
-    camera_from_world: Option<(DMat4, u32, PathBuf, f64)>,
+    /// The `Camera` directive: its CTM, line and file, and its projection.
+    camera_from_world: Option<(DMat4, u32, PathBuf, Projection)>,
     resolution: (u32, u32),
     /// `[render]`, made by the first key set.
     render: Option<RenderFile>,
@@ -355,4 +362,18 @@ fn scaled(c: ColourValue, k: f64) -> ColourValue {
             scale: tidy(scale * k),
         },
     }
+}
+
+/// What a `Camera` directive projects with: pbrt-v4's `perspective` (its `fov`,
+/// degrees across the shorter image axis) or `orthographic` (its `screenwindow`
+/// [x0, x1, y0, y1] in camera space, or the default made from `frameaspectratio`).
+#[derive(Clone, Debug)]
+pub(super) enum Projection {
+    Perspective {
+        fov: f64,
+    },
+    Orthographic {
+        window: Option<[f64; 4]>,
+        frame: Option<f64>,
+    },
 }

@@ -681,14 +681,42 @@ impl Conv {
                     phi_max: phi_max.to_radians(),
                 }
             }
+            "cylinder" => self.cylinder(path, line, p)?,
             other => {
                 for q in &p.0 {
                     q.used.set(true);
                 }
-                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, disk, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
+                self.warn(self.diag(path, line, format!("Shape {other:?} is not supported (sphere, disk, cylinder, trianglemesh, bilinearmesh, plymesh are), ignored")))?;
                 return Ok(None);
             }
         }))
+    }
+
+    /// pbrt-v4's `cylinder` (`Cylinder::Create`, shapes.cpp): `radius` (default 1),
+    /// `zmin` (−1), `zmax` (1), `phimax` (360 degrees); zmin and zmax in either order,
+    /// as pbrt orders them.
+    fn cylinder(&mut self, path: &Path, line: u32, p: &Params) -> Result<Geom, Diagnostic> {
+        let radius = p.float("radius").unwrap_or(1.0);
+        let (z0, z1) = (
+            p.float("zmin").unwrap_or(-1.0),
+            p.float("zmax").unwrap_or(1.0),
+        );
+        let phi_max = p.float("phimax").unwrap_or(360.0);
+        if !(radius > 0.0 && radius.is_finite() && z0 != z1 && (z0 - z1).is_finite()) {
+            return Err(self.diag(path, line, format!("Shape \"cylinder\": expected a positive radius and finite zmin != zmax, got radius {radius}, zmin {z0}, zmax {z1}")));
+        }
+        if !(phi_max > 0.0 && phi_max <= 360.0) {
+            return Err(self.diag(
+                path,
+                line,
+                format!("Shape \"cylinder\": expected phimax in (0, 360] degrees, got {phi_max}"),
+            ));
+        }
+        Ok(Geom::Cylinder {
+            radius,
+            z: (z0.min(z1), z0.max(z1)),
+            phi_max: phi_max.to_radians(),
+        })
     }
 
     /// The heron shape tables of `sd` placed by its CTM, or for an `ObjectInstance`
@@ -720,7 +748,7 @@ impl Conv {
         let flip = sd.reverse ^ (m.determinant() < 0.0);
         let closed = match &sd.geom {
             Geom::Sphere { .. } | Geom::Ply { .. } => true,
-            Geom::Disk { .. } => false,
+            Geom::Disk { .. } | Geom::Cylinder { .. } => false,
             Geom::Mesh { kind, faces, .. } => faces_closed(kind, faces),
         };
         let medium = self.interior(sd, closed, &file, line, &ctx)?;
@@ -815,6 +843,10 @@ impl Conv {
                     &m, *radius, *inner, *height, *phi_max, flip, segs,
                 ));
             }
+            Geom::Cylinder { radius, z, phi_max } => {
+                let segs = crate::scene::import::DISK_SEGMENTS;
+                entries.push(schema::cylinder(&m, *radius, *z, *phi_max, flip, segs));
+            }
             Geom::Ply { file: f } => {
                 if flip {
                     self.warn(self.diag(&file, line, format!("{ctx}Shape \"plymesh\": ReverseOrientation or a mirroring transform on a mesh is not supported, ignored")))?;
@@ -838,8 +870,12 @@ impl Conv {
     }
 
     pub(super) fn finish_camera(&mut self, path: &Path) -> Result<(), Diagnostic> {
-        let Some((cfw, line, file, fov)) = self.camera_from_world.clone() else {
-            return Err(self.diag(path, 1, "expected a Camera \"perspective\" directive"));
+        let Some((cfw, line, file, projection)) = self.camera_from_world.clone() else {
+            return Err(self.diag(
+                path,
+                1,
+                "expected a Camera \"perspective\" or \"orthographic\" directive",
+            ));
         };
         let wfc = cfw.inverse();
         let eye = wfc.transform_point3(DVec3::ZERO);
@@ -852,11 +888,60 @@ impl Conv {
         }
         let (w, h) = self.resolution;
         let aspect = w as f64 / h as f64;
+        let fov = match projection {
+            Projection::Perspective { fov } => fov,
+            Projection::Orthographic { window, frame } => {
+                let cam = self.orthographic_camera(&wfc, (&file, line), window, frame)?;
+                self.camera = Some(cam);
+                return Ok(());
+            }
+        };
         // pbrt's fov spans the shorter image axis.
         let t = (0.5 * fov.to_radians()).tan();
         let tan_y = if aspect >= 1.0 { t } else { t / aspect };
         self.camera = Some(schema::pinhole(eye, look, up, 0.5 / tan_y, (w, h)));
         Ok(())
+    }
+
+    /// pbrt-v4's orthographic camera: rays along camera +z from the screen window's
+    /// point at z = 0 (camera space is screen space for x and y). By default the window
+    /// spans [-1, 1] on the shorter axis of `frameaspectratio` (the image's aspect
+    /// ratio unless given). heron's image plane is centred at its eye and has square
+    /// pixels: an off-centre window moves the eye to the window's centre; a window whose
+    /// shape is not the image's keeps its height, with a warning.
+    fn orthographic_camera(
+        &mut self,
+        wfc: &DMat4,
+        (file, line): (&Path, u32),
+        window: Option<[f64; 4]>,
+        frame: Option<f64>,
+    ) -> Result<CameraFile, Diagnostic> {
+        let (w, h) = self.resolution;
+        let aspect = w as f64 / h as f64;
+        let [x0, x1, y0, y1] = window.unwrap_or_else(|| {
+            let f = frame.unwrap_or(aspect);
+            if f > 1.0 {
+                [-f, f, -1.0, 1.0]
+            } else {
+                [-1.0, 1.0, -1.0 / f, 1.0 / f]
+            }
+        });
+        let shape = (x1 - x0) / (y1 - y0);
+        if (shape - aspect).abs() > 1e-6 * aspect {
+            self.warn(self.diag(file, line, format!("Camera \"orthographic\": the screen window is {} x {} and the image's aspect ratio {aspect}; heron's pixels are square, so the window keeps its height and its width is {}", x1 - x0, y1 - y0, (y1 - y0) * aspect)))?;
+        }
+        let centre = DVec3::new(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0);
+        // The camera-from-world transform may scale (pbrt warns and goes on): the
+        // window is measured in camera space, so its height is scaled to the world's.
+        let sy = wfc.transform_vector3(DVec3::Y).length();
+        let eye = wfc.transform_point3(centre);
+        let look = eye + wfc.transform_vector3(DVec3::Z);
+        let up = wfc.transform_vector3(DVec3::Y);
+        let mut cam = schema::pinhole(eye, look, up, 1.0, (w, h));
+        cam.d = None;
+        cam.kind = Some("orthographic".into());
+        cam.height = Some(schema::positive((y1 - y0) * sy));
+        Ok(cam)
     }
 }
 
