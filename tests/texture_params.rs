@@ -345,3 +345,151 @@ fn bad_texture_keys_name_the_key() {
         "{e}"
     );
 }
+
+fn import(dir: &Path, name: &str, text: &str) -> heron::scene::import::Imported {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    heron::scene::import::import_scene(&p, &heron::scene::import::ImportOptions::default()).unwrap()
+}
+
+/// The TOML value at the dotted `path` of `t`.
+fn at<'a>(t: &'a toml::Table, path: &str) -> &'a toml::Value {
+    let mut v = t.get(path.split('.').next().unwrap()).unwrap();
+    for k in path.split('.').skip(1) {
+        v = v.get(k).unwrap_or_else(|| panic!("no {path} in {t:#?}"));
+    }
+    v
+}
+
+/// Mitsuba: a roughconductor's checkerboard `alpha` becomes a table with the colours
+/// swapped (Mitsuba's `eval_1` does), a roughplastic's bitmap `diffuse_reflectance` an
+/// image table and its `alpha` a texture too; a roughdielectric's two different alpha_u
+/// / alpha_v (one a texture) a mix, with a warning naming the line. The scene loads.
+#[test]
+fn mitsuba_textured_parameters_import() {
+    let dir = tempfile::tempdir().unwrap();
+    common::images::write_exr(&dir.path().join("d.exr"), 4, 4, |i, j| {
+        [0.1 + 0.2 * i as f32, 0.5, 0.1 + 0.2 * j as f32]
+    });
+    let body = r#"
+<texture type="checkerboard" id="cb">
+    <float name="color0" value="0.05"/>
+    <float name="color1" value="0.3"/>
+</texture>
+<bsdf type="roughconductor" id="metal">
+    <string name="material" value="Au"/>
+    <string name="distribution" value="ggx"/>
+    <ref name="alpha" id="cb"/>
+</bsdf>
+<bsdf type="roughplastic" id="plastic">
+    <string name="distribution" value="ggx"/>
+    <texture type="bitmap" name="diffuse_reflectance">
+        <string name="filename" value="d.exr"/>
+    </texture>
+    <float name="alpha" value="0.2"/>
+</bsdf>
+<bsdf type="roughdielectric" id="glass">
+    <string name="distribution" value="ggx"/>
+    <ref name="alpha_u" id="cb"/>
+    <float name="alpha_v" value="0.1"/>
+</bsdf>
+<shape type="rectangle"><ref id="metal"/></shape>
+<shape type="rectangle"><ref id="plastic"/></shape>
+<shape type="rectangle"><ref id="glass"/></shape>
+"#;
+    let imp = import(
+        dir.path(),
+        "scene.xml",
+        &common::scenes::mitsuba_around(body),
+    );
+    let t = imp.table();
+    let metal_alpha = at(&t, "materials.metal.roughness.texture")
+        .as_str()
+        .unwrap();
+    let table = at(&t, &format!("textures.{metal_alpha}"))
+        .as_table()
+        .unwrap();
+    assert_eq!(table["color0"].as_float(), Some(0.3), "{table:#?}");
+    assert_eq!(table["color1"].as_float(), Some(0.05), "{table:#?}");
+    let rho = at(&t, "materials.plastic.reflectance.texture")
+        .as_str()
+        .unwrap();
+    assert_eq!(
+        at(&t, &format!("textures.{rho}.type")).as_str(),
+        Some("image")
+    );
+    let glass = at(&t, "materials.glass.roughness.texture")
+        .as_str()
+        .unwrap();
+    assert_eq!(
+        at(&t, &format!("textures.{glass}.type")).as_str(),
+        Some("mix")
+    );
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        w.iter()
+            .any(|m| m.contains("anisotropic roughness") && m.contains("mix texture")),
+        "{w:#?}"
+    );
+    let s = heron::scene::load::load_imported(&imp).unwrap();
+    assert!(s.materials.iter().filter(|m| m.is_textured()).count() >= 3);
+}
+
+/// pbrt-v4: `coateddiffuse` with a reflectance texture and a float roughness texture,
+/// `conductor` and `dielectric` with roughness textures; the remap pbrt applies to a
+/// texture's values (√) warns, naming the line; `remaproughness false` does not.
+#[test]
+fn pbrt_textured_parameters_import() {
+    let dir = tempfile::tempdir().unwrap();
+    let quad = "Shape \"trianglemesh\" \"point3 P\" [ -4 -4 0  4 -4 0  4 4 0  -4 4 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]\n";
+    let text = format!(
+        "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\nFilm \"rgb\" \"integer xresolution\" [ 20 ] \"integer yresolution\" [ 20 ]\nWorldBegin\n\
+Texture \"r\" \"float\" \"checkerboard\" \"float tex1\" 0.04 \"float tex2\" 0.3\n\
+Texture \"c\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [ 0.7 0.2 0.1 ] \"rgb tex2\" [ 0.1 0.2 0.7 ]\n\
+Material \"coateddiffuse\" \"texture reflectance\" \"c\" \"texture roughness\" \"r\" \"bool remaproughness\" false\n{quad}\
+Material \"conductor\" \"texture roughness\" \"r\"\n{quad}\
+Material \"dielectric\" \"texture uroughness\" \"r\" \"float vroughness\" 0.2 \"bool remaproughness\" false\n{quad}"
+    );
+    let imp = import(dir.path(), "scene.pbrt", &text);
+    let t = imp.table();
+    assert_eq!(
+        at(&t, "materials.coateddiffuse-1.reflectance.texture").as_str(),
+        Some("c")
+    );
+    // pbrt's float texture "r" (its table named for its kind when a spectrum texture
+    // could share the name).
+    let r = at(&t, "materials.coateddiffuse-1.roughness.texture")
+        .as_str()
+        .unwrap();
+    assert!(r.starts_with('r'), "{r}");
+    // pbrt's float texture "r" (its table named for its kind when a spectrum texture
+    // could share the name).
+    let r = at(&t, "materials.conductor-2.roughness.texture")
+        .as_str()
+        .unwrap();
+    assert!(r.starts_with('r'), "{r}");
+    let mix = at(&t, "materials.dielectric-3.roughness.texture")
+        .as_str()
+        .unwrap();
+    assert_eq!(
+        at(&t, &format!("textures.{mix}.type")).as_str(),
+        Some("mix")
+    );
+    let w: Vec<(u32, String)> = imp
+        .warnings
+        .iter()
+        .map(|w| (w.line, w.message.clone()))
+        .collect();
+    let remap: Vec<u32> = w
+        .iter()
+        .filter(|(_, m)| m.contains("√value"))
+        .map(|(l, _)| *l)
+        .collect();
+    assert_eq!(remap, vec![9], "{w:#?}");
+    assert!(
+        w.iter()
+            .any(|(l, m)| *l == 11 && m.contains("anisotropic roughness")),
+        "{w:#?}"
+    );
+    heron::scene::load::load_imported(&imp).unwrap();
+}
