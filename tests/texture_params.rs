@@ -444,8 +444,9 @@ fn mitsuba_textured_parameters_import() {
 }
 
 /// pbrt-v4: `coateddiffuse` with a reflectance texture and a float roughness texture,
-/// `conductor` and `dielectric` with roughness textures; the remap pbrt applies to a
-/// texture's values (√) warns, naming the line; `remaproughness false` does not.
+/// `conductor` and `dielectric` with roughness textures; pbrt's remap α = √r is applied
+/// to a checkerboard's values (a copy of its table), and warns, naming the line, for an
+/// image, which heron cannot remap; `remaproughness false` takes the values as they are.
 #[test]
 fn pbrt_textured_parameters_import() {
     let dir = tempfile::tempdir().unwrap();
@@ -454,10 +455,13 @@ fn pbrt_textured_parameters_import() {
         "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\nFilm \"rgb\" \"integer xresolution\" [ 20 ] \"integer yresolution\" [ 20 ]\nWorldBegin\n\
 Texture \"r\" \"float\" \"checkerboard\" \"float tex1\" 0.04 \"float tex2\" 0.3\n\
 Texture \"c\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [ 0.7 0.2 0.1 ] \"rgb tex2\" [ 0.1 0.2 0.7 ]\n\
+Texture \"img\" \"float\" \"imagemap\" \"string filename\" \"g.exr\"\n\
 Material \"coateddiffuse\" \"texture reflectance\" \"c\" \"texture roughness\" \"r\" \"bool remaproughness\" false\n{quad}\
 Material \"conductor\" \"texture roughness\" \"r\"\n{quad}\
-Material \"dielectric\" \"texture uroughness\" \"r\" \"float vroughness\" 0.2 \"bool remaproughness\" false\n{quad}"
+Material \"dielectric\" \"texture uroughness\" \"r\" \"float vroughness\" 0.2 \"bool remaproughness\" false\n{quad}\
+Material \"conductor\" \"texture roughness\" \"img\"\n{quad}"
     );
+    common::images::write_exr(&dir.path().join("g.exr"), 2, 2, |i, _| [0.1 * i as f32; 3]);
     let imp = import(dir.path(), "scene.pbrt", &text);
     let t = imp.table();
     assert_eq!(
@@ -472,10 +476,13 @@ Material \"dielectric\" \"texture uroughness\" \"r\" \"float vroughness\" 0.2 \"
     assert!(r.starts_with('r'), "{r}");
     // pbrt's float texture "r" (its table named for its kind when a spectrum texture
     // could share the name).
+    // pbrt's remap α = √r, applied to the checkerboard's leaves in a copy of the table.
     let r = at(&t, "materials.conductor-2.roughness.texture")
         .as_str()
         .unwrap();
-    assert!(r.starts_with('r'), "{r}");
+    assert!(r.starts_with('r') && r.ends_with("(alpha)"), "{r}");
+    let sq = |k: &str| at(&t, &format!("textures.{r}.{k}")).as_float().unwrap();
+    assert!((sq("color0") - 0.2).abs() < 1e-12 && (sq("color1") - 0.3f64.sqrt()).abs() < 1e-12);
     let mix = at(&t, "materials.dielectric-3.roughness.texture")
         .as_str()
         .unwrap();
@@ -493,10 +500,10 @@ Material \"dielectric\" \"texture uroughness\" \"r\" \"float vroughness\" 0.2 \"
         .filter(|(_, m)| m.contains("√value"))
         .map(|(l, _)| *l)
         .collect();
-    assert_eq!(remap, vec![9], "{w:#?}");
+    assert_eq!(remap, vec![14], "{w:#?}");
     assert!(
         w.iter()
-            .any(|(l, m)| *l == 11 && m.contains("anisotropic roughness")),
+            .any(|(l, m)| *l == 12 && m.contains("anisotropic roughness")),
         "{w:#?}"
     );
     heron::scene::load::load_imported(&imp).unwrap();

@@ -12,7 +12,7 @@
 use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
-    CheckerboardFile, ImageTextureFile, MixTextureFile, NonNegativeNumber, Reflectance,
+    CheckerboardFile, Colour, ImageTextureFile, MixTextureFile, NonNegativeNumber, Reflectance,
     ScaleTextureFile, TextureFile, Textured, UnitNumber, UvMatrix,
 };
 
@@ -241,9 +241,10 @@ impl Conv {
     /// luminance; pbrt-v4 reads a float image's first channel, the same for a grey
     /// image). Two different sides become their mean, a `mix` table, with a warning
     /// (heron's microfacets are isotropic). pbrt-v4 remaps a texture's value r to α = √r
-    /// per point unless `remaproughness` is false; heron has no square root in its
-    /// textures, so the values are used as α, with a warning. None when no texture is
-    /// named.
+    /// per point unless `remaproughness` is false: a tree of constants, checkerboards
+    /// and scales is copied with its values' square roots ([`Self::sqrt_table`]); an
+    /// image or a mix has no such copy (heron's textures have no square root), so its
+    /// values are used as α, with a warning. None when no texture is named.
     pub(super) fn roughness_texture(
         &mut self,
         path: &Path,
@@ -301,11 +302,56 @@ impl Conv {
             // constant path reads it.
             return Ok(None);
         };
+        let mut tex = tex;
         if p.string("remaproughness") != Some("false") {
-            self.warn(self.diag(path, line, format!("{what}: a roughness texture's values are used as GGX α; pbrt-v4 remaps each to √value (remaproughness true, its default), which heron's textures cannot compute")))?;
+            match self.sqrt_table(&tex, 0) {
+                Some(t) => tex = t,
+                None => self.warn(self.diag(path, line, format!("{what}: a roughness texture's values are used as GGX α; pbrt-v4 remaps each to √value (remaproughness true, its default), which heron's textures cannot compute for an image or a mix")))?,
+            }
         }
         p.get("remaproughness");
         Ok(Some(Textured::Texture(tex)))
+    }
+
+    /// A copy of table `name` whose every value is the square root of the original's
+    /// (pbrt-v4's roughness remap, α = √r, applied to the leaves: exact through a
+    /// checkerboard, which picks a leaf, and a scale, √(ab) = √a √b), named
+    /// `"NAME (alpha)"`; None when the tree holds an image or a mix (or is too deep).
+    fn sqrt_table(&mut self, name: &str, depth: u32) -> Option<String> {
+        let out = format!("{name} (alpha)");
+        if self.textures.contains_key(&out) {
+            return Some(out);
+        }
+        if depth > 16 {
+            return None;
+        }
+        let leaf = |this: &mut Self, v: Option<&Textured<Reflectance>>, default: f64| match v {
+            None => Some(Textured::Value(Reflectance(Colour::Grey(tidy(
+                default.sqrt(),
+            ))))),
+            Some(Textured::Value(Reflectance(Colour::Grey(g)))) => Some(Textured::Value(
+                Reflectance(Colour::Grey(tidy(g.max(0.0).sqrt()))),
+            )),
+            Some(Textured::Value(_)) => None,
+            Some(Textured::Texture(t)) => this.sqrt_table(t, depth + 1).map(Textured::Texture),
+        };
+        let file = match self.textures.get(name)?.clone() {
+            TextureFile::Checkerboard(c) => TextureFile::Checkerboard(CheckerboardFile {
+                color0: Some(leaf(self, c.color0.as_ref(), 0.4)?),
+                color1: Some(leaf(self, c.color1.as_ref(), 0.2)?),
+                to_uv: c.to_uv,
+            }),
+            TextureFile::Scale(sc) => TextureFile::Scale(ScaleTextureFile {
+                tex: leaf(self, Some(&sc.tex), 1.0)?,
+                scale: match sc.scale {
+                    Textured::Value(x) => Textured::Value(NonNegativeNumber(tidy(x.0.sqrt()))),
+                    Textured::Texture(_) => return None,
+                },
+            }),
+            TextureFile::Image(_) | TextureFile::Mix(_) => return None,
+        };
+        self.textures.insert(out.clone(), file);
+        Some(out)
     }
 
     /// `c` as a reflectance, components above 1 clamped with a warning.
