@@ -46,6 +46,7 @@ fn glossy(rho_d: f32, rho_s: f32, s: f32, base: Option<Dielectric>) -> Material 
         rho_s,
         shininess: s,
         base,
+        textures: None,
     })
 }
 
@@ -65,6 +66,7 @@ fn rough_conductor(ior: ComplexIor, alpha: f32) -> Material {
     Material::RoughConductor(RoughConductor {
         ior,
         distribution: TrowbridgeReitz { alpha },
+        alpha_texture: None,
     })
 }
 
@@ -72,6 +74,7 @@ fn rough_dielectric(ior: Ior, alpha: f32) -> Material {
     Material::RoughDielectric(RoughDielectric {
         interface: Dielectric::new(ior, true),
         distribution: TrowbridgeReitz { alpha },
+        alpha_texture: None,
     })
 }
 
@@ -764,6 +767,7 @@ fn ideal_materials_conserve_energy_exactly() {
     let white = lambertian(1.0);
     let mirror = Material::Mirror(Mirror {
         rho_s: DenseSpectrum::constant(1.0),
+        texture: None,
     });
     let metal = Material::Conductor(Conductor {
         ior: perfect_metal(),
@@ -1113,6 +1117,7 @@ fn delta_materials_have_no_density() {
     let mats = [
         Material::Mirror(Mirror {
             rho_s: DenseSpectrum::constant(0.8),
+            texture: None,
         }),
         Material::Conductor(Conductor { ior: gold() }),
         Material::Dielectric(Dielectric::new(glass(), true)),

@@ -97,6 +97,7 @@ fn white_furnace_specular_objects_vanish() {
     let materials = [
         Material::Mirror(Mirror {
             rho_s: DenseSpectrum::constant(1.0),
+            texture: None,
         }),
         Material::Dielectric(Dielectric::new(Ior::Constant(1.5), true)),
         Material::Dielectric(Dielectric::new(Ior::Constant(2.42), false)),
@@ -105,6 +106,7 @@ fn white_furnace_specular_objects_vanish() {
             rho_s: 0.1,
             shininess: 42.0,
             base: Some(Dielectric::new(Ior::Constant(1.5), true)),
+            textures: None,
         }),
     ];
     for m in materials {

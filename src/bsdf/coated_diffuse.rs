@@ -77,9 +77,19 @@
 //!
 //! The surface is two-sided, as heron's Lambertian: ωo below the surface sees the same
 //! layering mirrored.
+//!
+//! **Textures.** ρ may be a reflectance texture (`rho_texture`, looked up at the hit,
+//! clamped to [0, 1]): ρ enters only the closed form's per-lane factor, so nothing is
+//! tabulated for it. The roughness α may be a texture too ([`CoatedDiffuse::textured_alpha`]),
+//! but E(μ) and K are tabulated per α when the material is built: the material then holds
+//! one coat per *level* of α and each hit takes the level nearest to the texture's value
+//! (its luminance). A texture of constants and checkerboards has its few values as the
+//! levels, exactly; an image (or a mix) is quantised to [`ALPHA_LEVELS`] levels uniform
+//! over its range of α (an error of at most half a step, (max − min)/62 in α).
 use super::fresnel::fresnel_dielectric;
 use super::microfacet::TrowbridgeReitz;
 use super::polarization::{normalized, s_of_plane, Polarizing};
+use super::texture_params::{alpha_at, reflectance_at};
 use super::{
     reflect, reflect_local, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample,
     LobeFlags,
@@ -89,9 +99,14 @@ use crate::math::Frame;
 use crate::optics::mueller;
 use crate::spectrum::ior::Ior;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use num_complex::Complex64;
 use std::f32::consts::FRAC_1_PI;
+use std::sync::Arc;
+
+/// Levels of α of a coat whose roughness is an image texture (module doc).
+pub const ALPHA_LEVELS: usize = 32;
 
 /// Points of the rough coat's E(μ) table, uniform in μ on [0, 1].
 const N_MU: usize = 64;
@@ -125,7 +140,37 @@ pub struct CoatedDiffuse {
     pub thickness: f32,
     /// Mitsuba's `nonlinear = false`: ρ/(1 − K) instead of ρ/(1 − ρK).
     pub linear: bool,
+    /// ρ over the surface's uv, replacing `rho` (None: the constant).
+    pub rho_texture: Option<Arc<Texture>>,
+    /// A roughness texture's levels (None: `distribution` everywhere).
+    by_alpha: Option<Arc<AlphaLevels>>,
     table: CoatTable,
+}
+
+/// The coats of a textured roughness, one per level of α (sorted), all sharing the
+/// base's reflectance.
+#[derive(Clone, Debug)]
+struct AlphaLevels {
+    texture: Arc<Texture>,
+    alphas: Vec<f32>,
+    coats: Vec<CoatedDiffuse>,
+}
+
+impl AlphaLevels {
+    /// The coat whose α is nearest to the texture's at the hit.
+    #[inline]
+    fn pick(&self, ctx: &BsdfContext) -> &CoatedDiffuse {
+        let a = alpha_at(&self.texture, ctx).alpha;
+        let i = self.alphas.partition_point(|&x| x < a);
+        let i = if i == 0 {
+            0
+        } else if i == self.alphas.len() || a - self.alphas[i - 1] <= self.alphas[i] - a {
+            i - 1
+        } else {
+            i
+        };
+        &self.coats[i]
+    }
 }
 
 /// K, T̄ and (rough coat) E(μ) at `n` values of η from `eta_lo` in steps of `d_eta`.
@@ -224,7 +269,77 @@ impl CoatedDiffuse {
             distribution,
             thickness,
             linear,
+            rho_texture: None,
+            by_alpha: None,
             table,
+        }
+    }
+
+    /// The material with ρ looked up in `rho` at each hit.
+    pub fn with_rho_texture(mut self, rho: Arc<Texture>) -> CoatedDiffuse {
+        if let Some(l) = &mut self.by_alpha {
+            for c in &mut Arc::make_mut(l).coats {
+                c.rho_texture = Some(rho.clone());
+            }
+        }
+        self.rho_texture = Some(rho);
+        self
+    }
+
+    /// A rough coat whose α is the texture `alpha`'s luminance at each hit, clamped to
+    /// [`super::microfacet::MIN_ALPHA`], 1]: one coat per level of α (module doc).
+    pub fn textured_alpha(
+        rho: DenseSpectrum,
+        ior: Ior,
+        alpha: Arc<Texture>,
+        thickness: f32,
+        linear: bool,
+    ) -> CoatedDiffuse {
+        let clamp = |a: f32| a.clamp(super::microfacet::MIN_ALPHA, 1.0);
+        let mut alphas: Vec<f32> = match alpha.scalar_values(ALPHA_LEVELS) {
+            Some(v) => v.into_iter().map(clamp).collect(),
+            None => {
+                let (lo, hi) = alpha.scalar_range();
+                let (lo, hi) = (clamp(lo), clamp(hi));
+                (0..ALPHA_LEVELS)
+                    .map(|i| lo + (hi - lo) * i as f32 / (ALPHA_LEVELS - 1) as f32)
+                    .collect()
+            }
+        };
+        alphas.dedup();
+        let coats: Vec<CoatedDiffuse> = alphas
+            .iter()
+            .map(|&alpha| {
+                let d = TrowbridgeReitz { alpha };
+                CoatedDiffuse::new(rho.clone(), ior.clone(), Some(d), thickness, linear)
+            })
+            .collect();
+        // The outer material answers flags and mueller (rough, as every level); each
+        // query goes to the level at the hit.
+        let mut outer = coats[0].clone();
+        outer.by_alpha = Some(Arc::new(AlphaLevels {
+            texture: alpha,
+            alphas,
+            coats,
+        }));
+        outer
+    }
+
+    /// Whether a parameter is a texture (the hit's uv is read).
+    pub fn is_textured(&self) -> bool {
+        self.rho_texture.is_some() || self.by_alpha.is_some()
+    }
+
+    /// ρ per lane at the hit.
+    #[inline]
+    fn rho_at<const N: usize>(
+        &self,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> SampledSpectrum<N> {
+        match &self.rho_texture {
+            None => wl.eval(&self.rho),
+            Some(t) => reflectance_at(t, ctx, wl),
         }
     }
 
@@ -381,7 +496,7 @@ impl CoatedDiffuse {
         ctx: &BsdfContext,
     ) -> ([Lane; N], [f32; N], [f32; N], f32) {
         let lanes = self.lanes(wl);
-        let base = self.base(&lanes, &wl.eval(&self.rho));
+        let base = self.base(&lanes, &self.rho_at(wl, ctx));
         let entry_o = self.entry(&lanes, mu_o);
         let ps = self.p_specular(&lanes, &base, &entry_o, mu_o, ctx);
         (lanes, base, entry_o, ps)
@@ -526,7 +641,7 @@ impl BsdfModel for CoatedDiffuse {
         } else {
             SPECULAR
         };
-        if self.rho.max_value() > 0.0 {
+        if self.rho.max_value() > 0.0 || self.rho_texture.is_some() {
             spec | DIFFUSE
         } else {
             spec
@@ -539,13 +654,16 @@ impl BsdfModel for CoatedDiffuse {
         wo: Vec3,
         wi: Vec3,
         wl: &SampledWavelengths<N>,
-        _: &BsdfContext,
+        ctx: &BsdfContext,
     ) -> BsdfEval<N> {
+        if let Some(l) = &self.by_alpha {
+            return l.pick(ctx).eval(wo, wi, wl, ctx);
+        }
         let Some((wo, wi)) = upper(wo, wi) else {
             return BsdfEval::zero();
         };
         let lanes = self.lanes(wl);
-        let base = self.base(&lanes, &wl.eval(&self.rho));
+        let base = self.base(&lanes, &self.rho_at(wl, ctx));
         let entry_o = self.entry(&lanes, wo.z);
         let mut f = self.diffuse(&lanes, &base, &entry_o, wi.z);
         if let Some(d) = &self.distribution {
@@ -562,6 +680,9 @@ impl BsdfModel for CoatedDiffuse {
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> f32 {
+        if let Some(l) = &self.by_alpha {
+            return l.pick(ctx).pdf(wo, wi, wl, ctx);
+        }
         let Some((wo, wi)) = upper(wo, wi) else {
             return 0.0;
         };
@@ -581,6 +702,9 @@ impl BsdfModel for CoatedDiffuse {
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
+        if let Some(l) = &self.by_alpha {
+            return l.pick(ctx).sample(wo, uc, u, wl, ctx);
+        }
         let flip = Vec3::new(1.0, 1.0, wo.z.signum());
         let wo = wo * flip;
         let (lanes, base, entry_o, ps) = self.setup(wo.z, wl, ctx);

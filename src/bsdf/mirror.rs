@@ -1,12 +1,16 @@
 //! Perfect specular reflector (seed, "Reflected rays"): the law of reflection,
 //! ωr = 2(ωi·n)n − ωi, with ωi pointing away from the surface. As a BSDF it is the
-//! delta ρs δ(ωi − ωr)/|cos θi|, so the throughput changes by ρs.
+//! delta ρs δ(ωi − ωr)/|cos θi|, so the throughput changes by ρs. ρs may be a texture
+//! over the surface (src/bsdf/texture_params.rs).
 use super::polarization::{s_of_plane, Polarizing};
+use super::texture_params::reflectance_at;
 use super::{reflect_local, BsdfContext, BsdfModel, BsdfSample, LobeFlags};
 use crate::math::Frame;
 use crate::spectrum::{DenseSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 use glam::Mat4;
 use glam::{Vec2, Vec3};
+use std::sync::Arc;
 
 pub use super::reflect;
 
@@ -14,6 +18,8 @@ pub use super::reflect;
 pub struct Mirror {
     /// Specular reflectance ρs(λ) in [0, 1]; 1 for the lecture's ideal mirror.
     pub rho_s: DenseSpectrum,
+    /// ρs over the surface's uv, replacing `rho_s` (None: the constant).
+    pub texture: Option<Arc<Texture>>,
 }
 
 const LOBE: LobeFlags = LobeFlags::SPECULAR.union(LobeFlags::REFLECTION);
@@ -39,7 +45,10 @@ impl BsdfModel for Mirror {
         let wi = reflect_local(wo);
         Some(BsdfSample {
             wi,
-            f: wl.eval(&self.rho_s) / wi.z.abs(),
+            f: match &self.texture {
+                None => wl.eval(&self.rho_s),
+                Some(t) => reflectance_at(t, ctx, wl),
+            } / wi.z.abs(),
             pdf: 1.0,
             flags: LOBE,
             eta: 1.0,

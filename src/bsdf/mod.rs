@@ -40,6 +40,7 @@ pub mod polarizer;
 pub mod retarder;
 pub mod rough_conductor;
 pub mod rough_dielectric;
+pub mod texture_params;
 pub mod textured_diffuse;
 pub mod thin_dielectric;
 
@@ -49,7 +50,7 @@ pub use dielectric::Dielectric;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use lambertian::Lambertian;
 pub use mirror::Mirror;
-pub use phong::Glossy;
+pub use phong::{Glossy, GlossyTextures};
 pub use polarization::Polarizing;
 pub use polarizer::Polarizer;
 pub use retarder::Retarder;
@@ -419,7 +420,15 @@ impl Material {
     /// scene computes it at a hit (only then: a sphere's uv costs two arctangents).
     #[inline]
     pub fn is_textured(&self) -> bool {
-        matches!(self, Material::TexturedDiffuse(_))
+        match self {
+            Material::TexturedDiffuse(_) => true,
+            Material::Glossy(g) => g.textures.is_some(),
+            Material::Mirror(m) => m.texture.is_some(),
+            Material::RoughConductor(c) => c.alpha_texture.is_some(),
+            Material::RoughDielectric(d) => d.alpha_texture.is_some(),
+            Material::CoatedDiffuse(c) => c.is_textured(),
+            _ => false,
+        }
     }
 
     /// Every lobe this material may scatter into.

@@ -16,7 +16,16 @@
 //! the Phong part from the lights and continues through the base, as the course does;
 //! with ρd > 0 that combination can reflect more than it receives (the course's scenes
 //! use ρd = 0). The path tracer samples the same sum, base weight 1.
+//!
+//! **Textures** ([`GlossyTextures`]): ρd may be a reflectance texture and ρs a texture
+//! read as a number (its luminance, [`crate::texture::Texture::eval_scalar`]: ρs is one
+//! number per point in the model, and the luminance is the value the eye weighs). The
+//! constants' check ρd + ρs ≤ 1 cannot be made at load for a texture short of refusing
+//! a whole image for one bright texel, so a textured material clamps at the hit
+//! instead: ρs to [0, 1], then ρd per lane to [0, 1 − ρs], which keeps the model
+//! energy-conserving wherever it is looked up (tests/texture_params.rs's furnace).
 use super::polarization::Polarizing;
+use super::texture_params::{reflectance_at, unit_at};
 use super::{
     reflect_local, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, Dielectric,
     LobeFlags,
@@ -24,8 +33,10 @@ use super::{
 use crate::math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::math::Frame;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct Glossy {
@@ -37,6 +48,15 @@ pub struct Glossy {
     /// The seed's glossy-over-refractive combination: highlights from the lights, and the
     /// path continues through this dielectric.
     pub base: Option<Dielectric>,
+    /// Textures that replace `rho_d` and/or `rho_s` (None: both constant).
+    pub textures: Option<Box<GlossyTextures>>,
+}
+
+/// The textured parameters of a [`Glossy`]; a parameter without one keeps its constant.
+#[derive(Clone, Debug, Default)]
+pub struct GlossyTextures {
+    pub rho_d: Option<Arc<Texture>>,
+    pub rho_s: Option<Arc<Texture>>,
 }
 
 const DIFFUSE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
@@ -65,6 +85,25 @@ fn lobe_pdf(s: f32, wr: Vec3, wi: Vec3) -> f32 {
 }
 
 impl Glossy {
+    /// ρd per lane and ρs at the hit: the constants, or the textures clamped so that
+    /// ρd + ρs ≤ 1 (module doc).
+    #[inline]
+    fn params<const N: usize>(
+        &self,
+        wl: &SampledWavelengths<N>,
+        ctx: &BsdfContext,
+    ) -> (SampledSpectrum<N>, f32) {
+        let Some(t) = &self.textures else {
+            return (wl.eval(&self.rho_d), self.rho_s);
+        };
+        let rho_s = t.rho_s.as_ref().map_or(self.rho_s, |t| unit_at(t, ctx));
+        let rho_d = match &t.rho_d {
+            Some(t) => reflectance_at(t, ctx, wl),
+            None => wl.eval(&self.rho_d),
+        };
+        (SampledSpectrum(rho_d.0.map(|x| x.min(1.0 - rho_s))), rho_s)
+    }
+
     /// Selection weights of the diffuse term, the lobe and the base under `ctx.lobes`:
     /// the mean of ρd over the lanes (so that a lane whose ρd is positive is never left
     /// without a sampling strategy), ρs, and 1 for the base's R + T.
@@ -72,6 +111,7 @@ impl Glossy {
     fn weights<const N: usize>(
         &self,
         rho_d: &SampledSpectrum<N>,
+        rho_s: f32,
         ctx: &BsdfContext,
     ) -> (f32, f32, f32) {
         let wd = if ctx.lobes.allows(DIFFUSE) {
@@ -79,11 +119,7 @@ impl Glossy {
         } else {
             0.0
         };
-        let ws = if ctx.lobes.allows(LOBE) {
-            self.rho_s
-        } else {
-            0.0
-        };
+        let ws = if ctx.lobes.allows(LOBE) { rho_s } else { 0.0 };
         // The base is two delta lobes: it may be chosen when the mask allows either.
         let base_allowed = ctx
             .lobes
@@ -114,10 +150,11 @@ impl BsdfModel for Glossy {
     #[inline]
     fn flags(&self) -> LobeFlags {
         let mut f = LobeFlags::NONE;
-        if self.rho_d.max_value() > 0.0 {
+        let t = self.textures.as_deref();
+        if self.rho_d.max_value() > 0.0 || t.is_some_and(|t| t.rho_d.is_some()) {
             f = f | DIFFUSE;
         }
-        if self.rho_s > 0.0 {
+        if self.rho_s > 0.0 || t.is_some_and(|t| t.rho_s.is_some()) {
             f = f | LOBE;
         }
         if let Some(b) = &self.base {
@@ -132,13 +169,14 @@ impl BsdfModel for Glossy {
         wo: Vec3,
         wi: Vec3,
         wl: &SampledWavelengths<N>,
-        _: &BsdfContext,
+        ctx: &BsdfContext,
     ) -> BsdfEval<N> {
         if !same_hemisphere(wo, wi) {
             return BsdfEval::zero();
         }
-        let fd = wl.eval(&self.rho_d) * FRAC_1_PI;
-        let fs = phong_specular(self.rho_s, self.shininess, wi, wo, Vec3::Z);
+        let (rho_d, rho_s) = self.params(wl, ctx);
+        let fd = rho_d * FRAC_1_PI;
+        let fs = phong_specular(rho_s, self.shininess, wi, wo, Vec3::Z);
         BsdfEval::keep(fd + SampledSpectrum::splat(fs))
     }
 
@@ -150,7 +188,8 @@ impl BsdfModel for Glossy {
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> f32 {
-        let (wd, ws, wb) = self.weights(&wl.eval(&self.rho_d), ctx);
+        let (rho_d, rho_s) = self.params(wl, ctx);
+        let (wd, ws, wb) = self.weights(&rho_d, rho_s, ctx);
         self.pdf_mix(wo, wi, wd, ws, wd + ws + wb)
     }
 
@@ -163,8 +202,8 @@ impl BsdfModel for Glossy {
         wl: &SampledWavelengths<N>,
         ctx: &BsdfContext,
     ) -> Option<BsdfSample<N>> {
-        let rho_d = wl.eval(&self.rho_d);
-        let (wd, ws, wb) = self.weights(&rho_d, ctx);
+        let (rho_d, rho_s) = self.params(wl, ctx);
+        let (wd, ws, wb) = self.weights(&rho_d, rho_s, ctx);
         let total = wd + ws + wb;
         if total <= 0.0 {
             return None;
@@ -203,7 +242,7 @@ impl BsdfModel for Glossy {
         if pdf <= 0.0 {
             return None;
         }
-        let fs = phong_specular(self.rho_s, self.shininess, wi, wo, Vec3::Z);
+        let fs = phong_specular(rho_s, self.shininess, wi, wo, Vec3::Z);
         Some(BsdfSample {
             wi,
             f: rho_d * FRAC_1_PI + SampledSpectrum::splat(fs),

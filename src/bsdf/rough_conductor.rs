@@ -5,24 +5,40 @@
 //!
 //! with the conductor Fresnel term per lane and directions sampled from the visible
 //! normals (Heitz 2018): pdf = D_ωo(ωm)/(4 |ωo·ωm|). Single scattering only, so energy
-//! is lost at high roughness (tests/bsdf.rs states how much).
+//! is lost at high roughness (tests/bsdf.rs states how much). α may be a texture over
+//! the surface (`alpha_texture`, read as a number: its luminance;
+//! src/bsdf/texture_params.rs), looked up at each hit.
 use super::microfacet::TrowbridgeReitz;
 use super::polarization::{s_of_pair, Polarizing};
+use super::texture_params::alpha_at;
 use super::{reflect, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample, LobeFlags};
 use crate::math::Frame;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::SampledWavelengths;
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct RoughConductor {
     pub ior: ComplexIor,
     pub distribution: TrowbridgeReitz,
+    /// α over the surface's uv, replacing `distribution` (None: the constant).
+    pub alpha_texture: Option<Arc<Texture>>,
 }
 
 const LOBE: LobeFlags = LobeFlags::GLOSSY.union(LobeFlags::REFLECTION);
 
 impl RoughConductor {
+    /// The distribution at the hit.
+    #[inline]
+    fn distribution_at(&self, ctx: &BsdfContext) -> TrowbridgeReitz {
+        match &self.alpha_texture {
+            None => self.distribution,
+            Some(t) => alpha_at(t, ctx),
+        }
+    }
+
     /// The half vector of a reflection pair, on the outward side; None when degenerate.
     #[inline]
     fn half(wo: Vec3, wi: Vec3) -> Option<Vec3> {
@@ -50,12 +66,12 @@ impl BsdfModel for RoughConductor {
         wo: Vec3,
         wi: Vec3,
         wl: &SampledWavelengths<N>,
-        _: &BsdfContext,
+        ctx: &BsdfContext,
     ) -> BsdfEval<N> {
         let Some(wm) = Self::half(wo, wi) else {
             return BsdfEval::zero();
         };
-        let d = &self.distribution;
+        let d = &self.distribution_at(ctx);
         let k = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z.abs() * wi.z.abs());
         BsdfEval::keep(self.ior.reflectance(wo.dot(wm).abs(), wl) * k)
     }
@@ -74,7 +90,7 @@ impl BsdfModel for RoughConductor {
         let Some(wm) = Self::half(wo, wi) else {
             return 0.0;
         };
-        self.distribution.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+        self.distribution_at(ctx).d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
     }
 
     #[inline]
@@ -89,7 +105,7 @@ impl BsdfModel for RoughConductor {
         if !ctx.lobes.allows(LOBE) {
             return None;
         }
-        let d = &self.distribution;
+        let d = &self.distribution_at(ctx);
         let wm = d.sample_wm(wo, u);
         let wi = reflect(wo, wm);
         if !same_hemisphere(wo, wi) || wi.z == 0.0 {

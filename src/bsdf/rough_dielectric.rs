@@ -18,22 +18,30 @@
 //! Dispersion as for the smooth dielectric ([`super::dielectric`]): reflections keep
 //! every lane with its own F(λᵢ); transmissions follow the hero and end the companions.
 //! Single scattering only, so energy is lost at high roughness.
+//!
+//! α may be a texture over the surface (`alpha_texture`, read as a number: its
+//! luminance; src/bsdf/texture_params.rs), looked up at each hit.
 use super::fresnel::fresnel_dielectric_signed;
 use super::microfacet::TrowbridgeReitz;
 use super::polarization::{s_of_pair, Polarizing};
+use super::texture_params::alpha_at;
 use super::{
     reflect, refract_eta, same_hemisphere, BsdfContext, BsdfEval, BsdfModel, BsdfSample,
     Dielectric, LobeFlags, TransportMode,
 };
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct RoughDielectric {
     /// The interface's indices (inside and outside).
     pub interface: Dielectric,
     pub distribution: TrowbridgeReitz,
+    /// α over the surface's uv, replacing `distribution` (None: the constant).
+    pub alpha_texture: Option<Arc<Texture>>,
 }
 
 const REFL: LobeFlags = LobeFlags::GLOSSY.union(LobeFlags::REFLECTION);
@@ -71,6 +79,15 @@ fn half(wo: Vec3, wi: Vec3, eta: f32) -> Option<(Vec3, f32, bool)> {
 }
 
 impl RoughDielectric {
+    /// The distribution at the hit.
+    #[inline]
+    fn distribution_at(&self, ctx: &BsdfContext) -> TrowbridgeReitz {
+        match &self.alpha_texture {
+            None => self.distribution,
+            Some(t) => alpha_at(t, ctx),
+        }
+    }
+
     /// Probabilities of reflection and transmission for Fresnel reflectance `r`.
     #[inline]
     fn choice(r: f32, ctx: &BsdfContext) -> (f32, f32) {
@@ -104,14 +121,13 @@ impl RoughDielectric {
 
     #[inline]
     fn transmission_value(
-        &self,
+        d: &TrowbridgeReitz,
         wo: Vec3,
         wi: Vec3,
         wm: Vec3,
         etap: f32,
         mode: TransportMode,
     ) -> f32 {
-        let d = &self.distribution;
         let denom = (wi.dot(wm) + wo.dot(wm) / etap).powi(2) * wi.z * wo.z;
         let mut f = d.d(wm) * d.g(wo, wi) * (wi.dot(wm) * wo.dot(wm) / denom).abs();
         if mode == TransportMode::Radiance {
@@ -149,13 +165,14 @@ impl BsdfModel for RoughDielectric {
         let split = ctx.companions_alive && self.interface.is_dispersive();
         let cos_om = wo.dot(wm);
         let r = fresnel_dielectric_signed(cos_om, eta);
-        let d = &self.distribution;
+        let d = &self.distribution_at(ctx);
         if is_reflection {
             let k = d.d(wm) * d.g(wo, wi) / (4.0 * wi.z.abs() * wo.z.abs());
             return BsdfEval::keep(self.fresnel_lanes(cos_om, r, wl, split) * k);
         }
-        let mut f =
-            SampledSpectrum::splat((1.0 - r) * self.transmission_value(wo, wi, wm, etap, ctx.mode));
+        let mut f = SampledSpectrum::splat(
+            (1.0 - r) * Self::transmission_value(d, wo, wi, wm, etap, ctx.mode),
+        );
         if split {
             f.terminate_secondary();
         }
@@ -185,7 +202,7 @@ impl BsdfModel for RoughDielectric {
         if pr + pt <= 0.0 {
             return 0.0;
         }
-        let dv = self.distribution.d_visible(wo, wm);
+        let dv = self.distribution_at(ctx).d_visible(wo, wm);
         if is_reflection {
             dv / (4.0 * wo.dot(wm).abs()) * pr / (pr + pt)
         } else {
@@ -210,7 +227,7 @@ impl BsdfModel for RoughDielectric {
             // lobe would divide by the zero half vector ωo + ωi (found by heron stress).
             return self.interface.sample(wo, uc, u, wl, ctx);
         }
-        let d = &self.distribution;
+        let d = &self.distribution_at(ctx);
         let wm = d.sample_wm(wo, u);
         let cos_om = wo.dot(wm);
         let r = fresnel_dielectric_signed(cos_om, eta);
@@ -248,8 +265,9 @@ impl BsdfModel for RoughDielectric {
         if !(pdf > 0.0) {
             return None;
         }
-        let mut f =
-            SampledSpectrum::splat((1.0 - r) * self.transmission_value(wo, wi, wm, etap, ctx.mode));
+        let mut f = SampledSpectrum::splat(
+            (1.0 - r) * Self::transmission_value(d, wo, wi, wm, etap, ctx.mode),
+        );
         if split {
             f.terminate_secondary();
         }

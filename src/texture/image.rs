@@ -22,6 +22,18 @@ pub struct ImageTexture {
     height: usize,
     /// Sigmoid coefficients per texel, row by row from the top.
     texels: Vec<[f32; 3]>,
+    /// Luminance Y = 0.2126 r + 0.7152 g + 0.0722 b of each clamped texel (Rec. 709,
+    /// Mitsuba 3's `luminance`), for a lookup as a number ([`ImageTexture::eval_scalar`]).
+    grey: Vec<f32>,
+}
+
+/// Rec. 709 luminance of linear sRGB; a grey's own value exactly (the weighted sum
+/// could miss it by a rounding).
+pub fn luminance(c: [f32; 3]) -> f32 {
+    if c[0] == c[1] && c[1] == c[2] {
+        return c[0];
+    }
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
 impl ImageTexture {
@@ -29,17 +41,17 @@ impl ImageTexture {
     /// component is clamped to [0, 1] (NaN counts as 0).
     pub fn new(width: usize, height: usize, rgb: &[[f32; 3]]) -> ImageTexture {
         assert!(width >= 1 && height >= 1 && rgb.len() == width * height);
-        let texels = rgb
+        let clamped: Vec<[f32; 3]> = rgb
             .iter()
-            .map(|c| {
-                let c = c.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) });
-                srgb_table().texel(c).c
-            })
+            .map(|c| c.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }))
             .collect();
+        let texels = clamped.iter().map(|&c| srgb_table().texel(c).c).collect();
+        let grey = clamped.iter().map(|&c| luminance(c)).collect();
         ImageTexture {
             width,
             height,
             texels,
+            grey,
         }
     }
 
@@ -47,9 +59,18 @@ impl ImageTexture {
         (self.width, self.height)
     }
 
-    /// ρ(λ) at `uv`, per lane.
+    /// The smallest and largest texel luminance.
+    pub fn grey_range(&self) -> (f32, f32) {
+        self.grey
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &g| {
+                (lo.min(g), hi.max(g))
+            })
+    }
+
+    /// The texel indices and bilinear weights of the four texels around `uv`.
     #[inline]
-    pub fn eval<const N: usize>(&self, uv: Vec2, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+    fn corners(&self, uv: Vec2) -> [(usize, f32); 4] {
         let (w, h) = (self.width, self.height);
         let x = uv.x * w as f32 - 0.5;
         let y = uv.y * h as f32 - 0.5;
@@ -65,12 +86,29 @@ impl ImageTexture {
         };
         let (i0, j0) = (wrap(x0, w), wrap(y0, h));
         let (i1, j1) = ((i0 + 1) % w, (j0 + 1) % h);
-        let corners = [
-            (self.texels[j0 * w + i0], (1.0 - fx) * (1.0 - fy)),
-            (self.texels[j0 * w + i1], fx * (1.0 - fy)),
-            (self.texels[j1 * w + i0], (1.0 - fx) * fy),
-            (self.texels[j1 * w + i1], fx * fy),
-        ];
+        [
+            (j0 * w + i0, (1.0 - fx) * (1.0 - fy)),
+            (j0 * w + i1, fx * (1.0 - fy)),
+            (j1 * w + i0, (1.0 - fx) * fy),
+            (j1 * w + i1, fx * fy),
+        ]
+    }
+
+    /// The luminance at `uv`, bilinear over the texels' luminances: a number for a
+    /// float-valued parameter (a roughness, a Phong ρs), as Mitsuba 3's `bitmap`
+    /// `eval_1` (the luminance of the interpolated linear RGB).
+    #[inline]
+    pub fn eval_scalar(&self, uv: Vec2) -> f32 {
+        self.corners(uv)
+            .iter()
+            .map(|&(i, wt)| if wt > 0.0 { wt * self.grey[i] } else { 0.0 })
+            .sum()
+    }
+
+    /// ρ(λ) at `uv`, per lane.
+    #[inline]
+    pub fn eval<const N: usize>(&self, uv: Vec2, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
+        let corners = self.corners(uv).map(|(i, wt)| (self.texels[i], wt));
         let mut s = SampledSpectrum::<N>::zero();
         for k in 0..N {
             let l = wl.lambda[k];

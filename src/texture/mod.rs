@@ -16,13 +16,23 @@
 //! not depend on wavelength: greys, exact through the uplift (Jakob & Hanika 2019's
 //! sigmoid of a grey is flat).
 //!
+//! A float-valued *material parameter* (a GGX roughness, a Phong ρs) reads a tree as a
+//! number with [`Texture::eval_scalar`]: the same tree with every leaf taken as its
+//! luminance Y (an image texel's Rec. 709 luminance of its linear RGB, a constant's of
+//! its RGB when it was given as one — a grey's own value — and otherwise its
+//! spectrum's CIE 1931 Y under the film's convention), so that the value does not depend on
+//! the path's wavelengths (a roughness that changed with the hero wavelength would blur
+//! the lobe by colour noise). It is Mitsuba 3's `eval_1` (the luminance of a `bitmap`);
+//! pbrt-v4's float textures read a grey image, where both agree (pbrt-v4 averages the
+//! channels of a colour image instead).
+//!
 //! A material without a texture holds none and never reads uv: only a textured material
 //! asks the scene to compute it (`Material::is_textured`).
 mod checkerboard;
 mod image;
 
 pub use checkerboard::Checkerboard;
-pub use image::ImageTexture;
+pub use image::{luminance, ImageTexture};
 
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths};
 use glam::Vec2;
@@ -105,6 +115,22 @@ pub enum Node {
 #[derive(Clone, Debug)]
 pub struct Texture {
     nodes: Vec<Node>,
+    /// The luminance Y of each constant node (0 for the other kinds), for
+    /// [`Texture::eval_scalar`].
+    grey: Vec<f32>,
+}
+
+/// The luminance of each constant node.
+fn greys(nodes: &[Node]) -> Vec<f32> {
+    nodes
+        .iter()
+        .map(|n| match n {
+            // A flat spectrum's own value, exactly (its Y could miss it by a rounding).
+            Node::Constant(s) if s.values().iter().all(|&x| x == s.values()[0]) => s.values()[0],
+            Node::Constant(s) => crate::spectrum::cie::spectrum_to_xyz(s)[1],
+            _ => 0.0,
+        })
+        .collect()
 }
 
 impl Texture {
@@ -128,14 +154,114 @@ impl Texture {
                 ));
             }
         }
-        Ok(Texture { nodes })
+        let grey = greys(&nodes);
+        Ok(Texture { nodes, grey })
     }
 
     /// One image at uv itself.
     pub fn image(image: Arc<ImageTexture>) -> Texture {
         Texture {
             nodes: vec![Node::Image { image, to_uv: None }],
+            grey: vec![0.0],
         }
+    }
+
+    /// The tree with the luminance of constant nodes given as RGB set from that RGB
+    /// ([`luminance`]) rather than from their uplifted spectra: a grey number is then
+    /// read back exactly. Each pair is (node, linear sRGB); other nodes are left.
+    pub fn with_constant_rgb(mut self, rgb: &[(NodeId, [f32; 3])]) -> Texture {
+        for &(id, c) in rgb {
+            if let Some(Node::Constant(_)) = self.nodes.get(id as usize) {
+                self.grey[id as usize] = luminance(c);
+            }
+        }
+        self
+    }
+
+    fn root(&self) -> NodeId {
+        self.nodes.len() as NodeId - 1
+    }
+
+    /// The texture's value at `uv` as a number: the tree with every leaf read as its
+    /// luminance (module doc).
+    #[inline]
+    pub fn eval_scalar(&self, uv: Vec2) -> f32 {
+        self.scalar_node(self.root(), uv)
+    }
+
+    fn scalar_node(&self, id: NodeId, uv: Vec2) -> f32 {
+        match &self.nodes[id as usize] {
+            Node::Constant(_) => self.grey[id as usize],
+            Node::Image { image, to_uv } => match to_uv {
+                None => image.eval_scalar(uv),
+                Some(m) => image.eval_scalar(m.apply(uv)),
+            },
+            Node::Checkerboard(c) => self.scalar_node(c.pick(uv), uv),
+            Node::Scale { a, b } => self.scalar_node(*a, uv) * self.scalar_node(*b, uv),
+            Node::Mix { a, b, amount } => {
+                let t = self.scalar_node(*amount, uv);
+                (1.0 - t) * self.scalar_node(*a, uv) + t * self.scalar_node(*b, uv)
+            }
+        }
+    }
+
+    /// Bounds [lo, hi] of [`Texture::eval_scalar`] over the whole surface (exact for
+    /// constants and images, conservative for products and mixes).
+    pub fn scalar_range(&self) -> (f32, f32) {
+        self.range_node(self.root())
+    }
+
+    fn range_node(&self, id: NodeId) -> (f32, f32) {
+        match &self.nodes[id as usize] {
+            Node::Constant(_) => (self.grey[id as usize], self.grey[id as usize]),
+            Node::Image { image, .. } => image.grey_range(),
+            Node::Checkerboard(c) => {
+                let (a, b) = (self.range_node(c.color0), self.range_node(c.color1));
+                (a.0.min(b.0), a.1.max(b.1))
+            }
+            Node::Scale { a, b } => {
+                let (a, b) = (self.range_node(*a), self.range_node(*b));
+                let p = [a.0 * b.0, a.0 * b.1, a.1 * b.0, a.1 * b.1];
+                (
+                    p.iter().copied().fold(f32::INFINITY, f32::min),
+                    p.iter().copied().fold(f32::NEG_INFINITY, f32::max),
+                )
+            }
+            // A mix stays between its two sides when its amount is in [0, 1].
+            Node::Mix { a, b, .. } => {
+                let (a, b) = (self.range_node(*a), self.range_node(*b));
+                (a.0.min(b.0), a.1.max(b.1))
+            }
+        }
+    }
+
+    /// Every value [`Texture::eval_scalar`] can take, when they are few (at most `max`)
+    /// and known at load: a tree of constants, checkerboards and products; None with an
+    /// image or a mix.
+    pub fn scalar_values(&self, max: usize) -> Option<Vec<f32>> {
+        let mut v = self.values_node(self.root(), max)?;
+        v.sort_by(f32::total_cmp);
+        v.dedup();
+        Some(v)
+    }
+
+    fn values_node(&self, id: NodeId, max: usize) -> Option<Vec<f32>> {
+        let v = match &self.nodes[id as usize] {
+            Node::Constant(_) => vec![self.grey[id as usize]],
+            Node::Image { .. } | Node::Mix { .. } => return None,
+            Node::Checkerboard(c) => {
+                let mut v = self.values_node(c.color0, max)?;
+                v.extend(self.values_node(c.color1, max)?);
+                v
+            }
+            Node::Scale { a, b } => {
+                let (a, b) = (self.values_node(*a, max)?, self.values_node(*b, max)?);
+                a.iter()
+                    .flat_map(|x| b.iter().map(move |y| x * y))
+                    .collect()
+            }
+        };
+        (v.len() <= max).then_some(v)
     }
 
     pub fn nodes(&self) -> &[Node] {
@@ -145,7 +271,7 @@ impl Texture {
     /// The texture's value at `uv`, per lane.
     #[inline]
     pub fn eval<const N: usize>(&self, uv: Vec2, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
-        self.eval_node(self.nodes.len() as NodeId - 1, uv, wl)
+        self.eval_node(self.root(), uv, wl)
     }
 
     fn eval_node<const N: usize>(

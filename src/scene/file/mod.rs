@@ -409,9 +409,9 @@ pub struct LambertianFile {
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MirrorFile {
-    /// Default 1 (the lecture's ideal mirror).
+    /// Default 1 (the lecture's ideal mirror); a reflectance or `{ texture = "NAME" }`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rho_s: Option<Reflectance>,
+    pub rho_s: Option<Textured<Reflectance>>,
 }
 
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
@@ -421,9 +421,10 @@ pub struct DielectricFile {
     /// Default true; false is the lecture's pure refraction.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fresnel: Option<bool>,
-    /// GGX roughness α in [0, 1]; 0 (default) is the smooth interface.
+    /// GGX roughness α in [0, 1]; 0 (default) is the smooth interface; or
+    /// `{ texture = "NAME" }` (its luminance per point).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub roughness: Option<UnitNumber>,
+    pub roughness: Option<Textured<UnitNumber>>,
     /// Index of the medium outside the surface (the side its normal points to); default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outside_ior: Option<IorSpec>,
@@ -434,9 +435,10 @@ pub struct DielectricFile {
 #[serde(deny_unknown_fields)]
 pub struct ConductorFile {
     pub metal: MetalSpec,
-    /// GGX roughness α in [0, 1]; 0 (default) is the smooth metal.
+    /// GGX roughness α in [0, 1]; 0 (default) is the smooth metal; or
+    /// `{ texture = "NAME" }` (its luminance per point).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub roughness: Option<UnitNumber>,
+    pub roughness: Option<Textured<UnitNumber>>,
 }
 
 /// A metal's complex index: a catalogue name (Ag, Al, Au, Cu), `{ table = "nk.csv" }`
@@ -465,15 +467,16 @@ pub enum MetalSpec {
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CoatedFile {
-    /// The base's reflectance ρ.
-    pub reflectance: Reflectance,
+    /// The base's reflectance ρ, or `{ texture = "NAME" }`.
+    pub reflectance: Textured<Reflectance>,
     /// The coat's refractive index (relative to the outside), possibly dispersive;
     /// default 1.5.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ior: Option<IorSpec>,
-    /// The coat's GGX roughness α in [0, 1]; 0 (default) is a smooth coat.
+    /// The coat's GGX roughness α in [0, 1]; 0 (default) is a smooth coat; or
+    /// `{ texture = "NAME" }` (its luminance per point).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub roughness: Option<UnitNumber>,
+    pub roughness: Option<Textured<UnitNumber>>,
     /// Optical depth τ ≥ 0 of an absorbing layer between coat and base (pbrt-v4's
     /// `thickness`); default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -488,8 +491,10 @@ pub struct CoatedFile {
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GlossyFile {
-    pub rho_d: Reflectance,
-    pub rho_s: UnitNumber,
+    /// A reflectance or `{ texture = "NAME" }`.
+    pub rho_d: Textured<Reflectance>,
+    /// A number in [0, 1] or `{ texture = "NAME" }` (its luminance per point).
+    pub rho_s: Textured<UnitNumber>,
     pub shininess: PositiveNumber,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ior: Option<IorSpec>,

@@ -5,17 +5,21 @@ use super::errors::key;
 use super::textures::Textures;
 use crate::bsdf::microfacet::{TrowbridgeReitz, MIN_ALPHA};
 use crate::bsdf::{
-    CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Glossy, Lambertian, Material,
-    Mirror, Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse, ThinDielectric,
+    CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Glossy, GlossyTextures, Lambertian,
+    Material, Mirror, Polarizer, Retarder, RoughConductor, RoughDielectric, TexturedDiffuse,
+    ThinDielectric,
 };
 use crate::scene::file::{
-    DiffuseTransmissionFile, IorSpec, MaterialFile, MetalSpec, SceneFile, Textured,
+    DiffuseTransmissionFile, GlossyFile, IorSpec, MaterialFile, MetalSpec, SceneFile, Textured,
+    UnitNumber,
 };
 use crate::spectrum::ior::Ior;
 use crate::spectrum::metals::ComplexIor;
 use crate::spectrum::DenseSpectrum;
+use crate::texture::Texture;
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// The scene's materials: the file's, sorted by name (a TOML table keeps no order), then
 /// the ones the loader adds.
@@ -215,12 +219,20 @@ fn build_material(
                 ))
             }
         },
-        MaterialFile::Mirror(mi) => Material::Mirror(Mirror {
+        MaterialFile::Mirror(mi) => Material::Mirror(match &mi.rho_s {
             // Left out: the lecture's ideal mirror, exactly 1 at every wavelength.
-            rho_s: mi
-                .rho_s
-                .as_ref()
-                .map_or_else(|| DenseSpectrum::constant(1.0), |r| r.spectrum()),
+            None => Mirror {
+                rho_s: DenseSpectrum::constant(1.0),
+                texture: None,
+            },
+            Some(Textured::Value(r)) => Mirror {
+                rho_s: r.spectrum(),
+                texture: None,
+            },
+            Some(Textured::Texture(name)) => Mirror {
+                rho_s: DenseSpectrum::constant(1.0),
+                texture: Some(textures.tree(&format!("{at}.rho_s"), name, inputs)?),
+            },
         }),
         MaterialFile::Dielectric(d) => {
             let mut interface = Dielectric::new(
@@ -230,30 +242,35 @@ fn build_material(
             if let Some(o) = &d.outside_ior {
                 interface.outside = build_ior(&format!("{at}.outside_ior"), o, base_dir, inputs)?;
             }
-            let alpha = d.roughness.map_or(0.0, |r| r.get());
-            if alpha < MIN_ALPHA {
+            let (alpha, alpha_texture) =
+                roughness(at, d.roughness.as_ref(), textures, inputs)?;
+            if alpha < MIN_ALPHA && alpha_texture.is_none() {
                 Material::Dielectric(interface)
             } else {
                 if d.fresnel == Some(false) {
+                    let r = describe_roughness(d.roughness.as_ref());
                     return Err(format!(
-                        "{at}.fresnel: false applies to the smooth interface (the lecture's pure refraction), not with roughness = {alpha}"
+                        "{at}.fresnel: false applies to the smooth interface (the lecture's pure refraction), not with roughness = {r}"
                     ));
                 }
                 Material::RoughDielectric(RoughDielectric {
                     interface,
                     distribution: TrowbridgeReitz { alpha },
+                    alpha_texture,
                 })
             }
         }
         MaterialFile::Conductor(c) => {
             let ior = build_metal(at, &c.metal, base_dir, inputs)?;
-            let alpha = c.roughness.map_or(0.0, |r| r.get());
-            if alpha < MIN_ALPHA {
+            let (alpha, alpha_texture) =
+                roughness(at, c.roughness.as_ref(), textures, inputs)?;
+            if alpha < MIN_ALPHA && alpha_texture.is_none() {
                 Material::Conductor(Conductor { ior })
             } else {
                 Material::RoughConductor(RoughConductor {
                     ior,
                     distribution: TrowbridgeReitz { alpha },
+                    alpha_texture,
                 })
             }
         }
@@ -268,14 +285,30 @@ fn build_material(
                     "{at}.thickness: expected a finite optical depth >= 0, got {thickness}"
                 ));
             }
-            let alpha = c.roughness.map_or(0.0, |r| r.get());
-            Material::CoatedDiffuse(CoatedDiffuse::new(
-                c.reflectance.spectrum(),
-                ior,
-                (alpha >= MIN_ALPHA).then_some(TrowbridgeReitz { alpha }),
-                thickness as f32,
-                !c.nonlinear.unwrap_or(true),
-            ))
+            let (alpha, alpha_texture) =
+                roughness(at, c.roughness.as_ref(), textures, inputs)?;
+            let (rho, rho_texture) = match &c.reflectance {
+                Textured::Value(r) => (r.spectrum(), None),
+                Textured::Texture(name) => (
+                    DenseSpectrum::constant(0.0),
+                    Some(textures.tree(&format!("{at}.reflectance"), name, inputs)?),
+                ),
+            };
+            let (thickness, linear) = (thickness as f32, !c.nonlinear.unwrap_or(true));
+            let coat = match alpha_texture {
+                None => CoatedDiffuse::new(
+                    rho,
+                    ior,
+                    (alpha >= MIN_ALPHA).then_some(TrowbridgeReitz { alpha }),
+                    thickness,
+                    linear,
+                ),
+                Some(t) => CoatedDiffuse::textured_alpha(rho, ior, t, thickness, linear),
+            };
+            Material::CoatedDiffuse(match rho_texture {
+                None => coat,
+                Some(t) => coat.with_rho_texture(t),
+            })
         }
         MaterialFile::Glossy(g) => {
             if g.fresnel.is_some() && g.ior.is_none() {
@@ -283,21 +316,11 @@ fn build_material(
                     "{at}.fresnel: expected only together with ior (fresnel weights the refractive base), but ior is not given"
                 ));
             }
-            // Energy conservation, seed "Glossy materials": ρd + ρs ≤ 1.
-            let rho_s = g.rho_s.get();
-            let sum_max = match g.rho_d.0.rgb() {
-                Some(rgb) => rgb.iter().fold(f32::MIN, |a, &c| a.max(c + rho_s)),
-                None => g.rho_d.0.max_value() + rho_s,
-            };
-            if sum_max > 1.0 + 1e-6 {
-                let rho_d = g.rho_d.0.describe();
-                return Err(format!(
-                    "{at}: expected rho_d + rho_s <= 1 in every channel (energy conservation), got rho_d = {rho_d} and rho_s = {rho_s} (sum up to {sum_max})"
-                ));
-            }
+            let (rho_d, rho_s, textures) = glossy_params(at, g, textures, inputs)?;
             Material::Glossy(Glossy {
-                rho_d: g.rho_d.spectrum(),
+                rho_d,
                 rho_s,
+                textures,
                 shininess: g.shininess.get(),
                 base: match &g.ior {
                     Some(spec) => Some(Dielectric::new(
@@ -354,6 +377,79 @@ fn build_material(
         }
         MaterialFile::DiffuseTransmission(d) => diffuse_transmission(at, d)?,
     })
+}
+
+/// A roughness key (`roughness`): the constant α (0 when absent or textured) and the
+/// texture, if it names one.
+fn roughness(
+    at: &str,
+    r: Option<&Textured<UnitNumber>>,
+    textures: &mut Textures,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<(f32, Option<Arc<Texture>>), String> {
+    Ok(match r {
+        None => (0.0, None),
+        Some(Textured::Value(a)) => (a.get(), None),
+        Some(Textured::Texture(name)) => (
+            0.0,
+            Some(textures.tree(&format!("{at}.roughness"), name, inputs)?),
+        ),
+    })
+}
+
+/// A roughness key as written, for a message.
+fn describe_roughness(r: Option<&Textured<UnitNumber>>) -> String {
+    match r {
+        Some(Textured::Value(a)) => a.get().to_string(),
+        Some(Textured::Texture(name)) => format!("{{ texture = {name:?} }}"),
+        None => "0".into(),
+    }
+}
+
+/// The glossy model's ρd, ρs and textures. Constants keep the seed's check ρd + ρs ≤ 1
+/// ("Glossy materials", energy conservation) and are refused past it; a texture on
+/// either key is clamped at the hit instead (src/bsdf/phong.rs), as a texture's maximum
+/// is one texel's and should not refuse the whole image.
+type GlossyParams = (DenseSpectrum, f32, Option<Box<GlossyTextures>>);
+fn glossy_params(
+    at: &str,
+    g: &GlossyFile,
+    textures: &mut Textures,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<GlossyParams, String> {
+    let (rho_d, rho_s) = match (&g.rho_d, &g.rho_s) {
+        (Textured::Value(rho_d), Textured::Value(rho_s)) => {
+            let rho_s = rho_s.get();
+            let sum_max = match rho_d.0.rgb() {
+                Some(rgb) => rgb.iter().fold(f32::MIN, |a, &c| a.max(c + rho_s)),
+                None => rho_d.0.max_value() + rho_s,
+            };
+            if sum_max > 1.0 + 1e-6 {
+                let rho_d = rho_d.0.describe();
+                return Err(format!(
+                    "{at}: expected rho_d + rho_s <= 1 in every channel (energy conservation), got rho_d = {rho_d} and rho_s = {rho_s} (sum up to {sum_max})"
+                ));
+            }
+            return Ok((rho_d.spectrum(), rho_s, None));
+        }
+        pair => pair,
+    };
+    let mut t = GlossyTextures::default();
+    let rho_d = match rho_d {
+        Textured::Value(r) => r.spectrum(),
+        Textured::Texture(name) => {
+            t.rho_d = Some(textures.tree(&format!("{at}.rho_d"), name, inputs)?);
+            DenseSpectrum::constant(0.0)
+        }
+    };
+    let rho_s = match rho_s {
+        Textured::Value(r) => r.get(),
+        Textured::Texture(name) => {
+            t.rho_s = Some(textures.tree(&format!("{at}.rho_s"), name, inputs)?);
+            0.0
+        }
+    };
+    Ok((rho_d, rho_s, Some(Box::new(t))))
 }
 
 /// Diffuse transmission, with ρ_r + τ ≤ 1 (energy conservation) checked per RGB channel

@@ -23,6 +23,8 @@ pub(super) struct Textures<'a> {
 /// being expanded (for the cycle check).
 struct Tree {
     nodes: Vec<Node>,
+    /// The constant nodes given as RGB, with it (for a number read from the tree).
+    rgb: Vec<(NodeId, [f32; 3])>,
     done: HashMap<String, NodeId>,
     chain: Vec<String>,
 }
@@ -53,11 +55,13 @@ impl<'a> Textures<'a> {
         }
         let mut tree = Tree {
             nodes: Vec::new(),
+            rgb: Vec::new(),
             done: HashMap::new(),
             chain: Vec::new(),
         };
         self.table(&mut tree, at, name, inputs)?;
-        let t = Arc::new(Texture::new(tree.nodes).map_err(|e| format!("{at}: {e}"))?);
+        let t = Texture::new(tree.nodes).map_err(|e| format!("{at}: {e}"))?;
+        let t = Arc::new(t.with_constant_rgb(&tree.rgb));
         self.trees.insert(name.to_string(), t.clone());
         Ok(t)
     }
@@ -201,7 +205,13 @@ impl<'a> Textures<'a> {
     ) -> Result<NodeId, String> {
         match v {
             None => Ok(push(tree, Node::Constant(DenseSpectrum::constant(default)))),
-            Some(Textured::Value(r)) => Ok(push(tree, Node::Constant(r.spectrum()))),
+            Some(Textured::Value(r)) => {
+                let id = push(tree, Node::Constant(r.spectrum()));
+                if let Some(c) = r.0.rgb() {
+                    tree.rgb.push((id, c));
+                }
+                Ok(id)
+            }
             Some(Textured::Texture(n)) => self.table(tree, at, n, inputs),
         }
     }

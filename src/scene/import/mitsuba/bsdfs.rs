@@ -4,7 +4,7 @@
 use super::*;
 use crate::scene::file::{
     CoatedFile, Colour, ConductorFile, DielectricFile, IorSpec, LambertianFile, MetalSpec,
-    MirrorFile, Textured, ThinDielectricFile,
+    MirrorFile, MixTextureFile, Textured, ThinDielectricFile, UnitNumber,
 };
 use crate::scene::import::props::index_samples;
 
@@ -130,15 +130,15 @@ impl<'a> Converter<'a> {
 
     pub(super) fn dielectric(
         &mut self,
-        n: &Node,
-        p: &Props,
+        n: &'a Node,
+        p: &Props<'a>,
         kind: &str,
     ) -> Result<MaterialFile, Diagnostic> {
         Ok({
             let int = self.ior(p, "int_ior", "bk7")?;
             let ext = self.ior(p, "ext_ior", "air")?;
             let roughness = match kind {
-                "roughdielectric" => Some(schema::unit(self.roughness(n, p)?)),
+                "roughdielectric" => Some(self.roughness(n, p)?),
                 _ => None,
             };
             let t = MaterialFile::Dielectric(DielectricFile {
@@ -195,8 +195,8 @@ impl<'a> Converter<'a> {
 
     pub(super) fn conductor(
         &mut self,
-        n: &Node,
-        p: &Props,
+        n: &'a Node,
+        p: &Props<'a>,
         kind: &str,
     ) -> Result<MaterialFile, Diagnostic> {
         Ok({
@@ -270,7 +270,7 @@ impl<'a> Converter<'a> {
             match metal {
             // Mitsuba's `none`: a perfect mirror.
             None if kind == "conductor" => MaterialFile::Mirror(MirrorFile {
-                rho_s: Some(ColourValue::Grey(1.0).reflectance()),
+                rho_s: Some(Textured::Value(ColourValue::Grey(1.0).reflectance())),
             }),
             None => {
                 return Err(n.diag(
@@ -279,7 +279,7 @@ impl<'a> Converter<'a> {
             }
             Some(metal) => {
                 let roughness = match kind {
-                    "roughconductor" => Some(schema::unit(self.roughness(n, p)?)),
+                    "roughconductor" => Some(self.roughness(n, p)?),
                     _ => None,
                 };
                 MaterialFile::Conductor(ConductorFile { metal, roughness })
@@ -296,11 +296,11 @@ impl<'a> Converter<'a> {
     /// heron's 1 − E where Mitsuba tabulates the microfacet transmission.
     pub(super) fn plastic(
         &mut self,
-        n: &Node,
+        n: &'a Node,
         p: &Props<'a>,
         kind: &str,
     ) -> Result<MaterialFile, Diagnostic> {
-        let rho = self.colour(p, "diffuse_reflectance", ColourValue::Grey(0.5))?;
+        let rho = self.textured_reflectance(p, "diffuse_reflectance", ColourValue::Grey(0.5))?;
         let eta = match self.ior(p, "int_ior", "polypropylene")? {
             IorSpec::Constant(x) => x,
             IorSpec::Named(name) => mitsuba_ior(&name).unwrap_or(1.49),
@@ -317,7 +317,7 @@ impl<'a> Converter<'a> {
             )));
         }
         let roughness = match kind {
-            "roughplastic" => Some(schema::unit(self.roughness(n, p)?)),
+            "roughplastic" => Some(self.roughness(n, p)?),
             _ => None,
         };
         if kind == "roughplastic" {
@@ -332,7 +332,7 @@ impl<'a> Converter<'a> {
         }
         let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
         Ok(MaterialFile::Coated(CoatedFile {
-            reflectance: rho.reflectance(),
+            reflectance: rho,
             ior: Some(IorSpec::Constant(schema::tidy(eta))),
             roughness,
             thickness: None,
@@ -341,9 +341,15 @@ impl<'a> Converter<'a> {
         }))
     }
 
-    /// A microfacet BSDF's α: `alpha`, or `alpha_u`/`alpha_v` when equal; Mitsuba's
-    /// default 0.1. heron's microfacets are GGX.
-    pub(super) fn roughness(&mut self, n: &Node, p: &Props) -> Result<f64, Diagnostic> {
+    /// A microfacet BSDF's α: `alpha`, or `alpha_u`/`alpha_v` when equal (else their
+    /// mean, with a warning); Mitsuba's default 0.1. Each may be a texture, read as a
+    /// number (textures.rs); two different ones become their mean as a `mix` table.
+    /// heron's microfacets are GGX.
+    pub(super) fn roughness(
+        &mut self,
+        n: &'a Node,
+        p: &Props<'a>,
+    ) -> Result<Textured<UnitNumber>, Diagnostic> {
         let given = p.string("distribution")?;
         let dist = given.unwrap_or("beckmann");
         if dist != "ggx" {
@@ -358,11 +364,15 @@ impl<'a> Converter<'a> {
             self.warn(n.diag(msg))?;
         }
         p.get("sample_visible");
-        let alpha = p.float("alpha")?;
-        let (u, v) = (p.float("alpha_u")?, p.float("alpha_v")?);
+        let alpha = self.textured_float(p, "alpha")?;
+        let (u, v) = (
+            self.textured_float(p, "alpha_u")?,
+            self.textured_float(p, "alpha_v")?,
+        );
         let a = match (alpha, u, v) {
-            (Some(a), _, _) => a,
-            (None, Some(u), Some(v)) => {
+            (Some(Textured::Value(a)), _, _) => a,
+            (Some(Textured::Texture(t)), _, _) => return Ok(Textured::Texture(t)),
+            (None, Some(Textured::Value(u)), Some(Textured::Value(v))) => {
                 if u != v {
                     self.warn(n.diag(format!(
                         "anisotropic roughness (alpha_u {u}, alpha_v {v}) is not supported; their mean is used"
@@ -370,12 +380,42 @@ impl<'a> Converter<'a> {
                 }
                 0.5 * (u + v)
             }
+            (None, Some(u), Some(v)) => return self.mean_roughness(n, u, v),
             _ => 0.1,
         };
         if !(0.0..=1.0).contains(&a) {
             return Err(n.diag(format!("alpha: expected a roughness in [0, 1], got {a}")));
         }
-        Ok(a)
+        Ok(Textured::Value(schema::unit(a)))
+    }
+
+    /// The mean of `alpha_u` and `alpha_v` when one is a texture: a `mix` table with
+    /// amount ½, after a warning (heron's microfacets are isotropic).
+    fn mean_roughness(
+        &mut self,
+        n: &Node,
+        u: Textured<f64>,
+        v: Textured<f64>,
+    ) -> Result<Textured<UnitNumber>, Diagnostic> {
+        if u == v {
+            return Ok(match u {
+                Textured::Texture(t) => Textured::Texture(t),
+                Textured::Value(a) => Textured::Value(schema::unit(a)),
+            });
+        }
+        self.warn(n.diag(
+            "anisotropic roughness (alpha_u, alpha_v, a texture) is not supported; their mean (a mix texture) is used",
+        ))?;
+        let side = |x: Textured<f64>| match x {
+            Textured::Texture(t) => Textured::Texture(t),
+            Textured::Value(a) => Textured::Value(ColourValue::Grey(a).reflectance()),
+        };
+        let mix = TextureFile::Mix(MixTextureFile {
+            tex1: side(u),
+            tex2: side(v),
+            amount: None,
+        });
+        Ok(Textured::Texture(self.add_texture(n, mix, "alpha")))
     }
 
     /// An index of refraction as heron writes it: a number, or a catalogue name for the

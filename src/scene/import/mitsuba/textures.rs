@@ -3,6 +3,12 @@
 //! `to_uv`; a checkerboard's colours may be textures themselves. A plain bitmap used
 //! directly as a diffuse reflectance stays the lambertian's `texture = "file"`, as heron
 //! wrote it before it had tables.
+//!
+//! A float parameter (a microfacet `alpha`) reads its texture with Mitsuba's `eval_1`:
+//! a bitmap's luminance, which is heron's number from a texture (src/texture/mod.rs);
+//! but Mitsuba's checkerboard `eval_1` puts `color1` where its `eval` puts `color0`
+//! (checkerboard.cpp tests `mask.x() != mask.y()` there), so a checkerboard read as a
+//! number becomes a table with the two colours swapped, which renders what Mitsuba does.
 use super::*;
 use crate::scene::file::{CheckerboardFile, ImageTextureFile, Reflectance, Textured, UvMatrix};
 
@@ -114,6 +120,61 @@ impl<'a> Converter<'a> {
         ))
     }
 
+    /// A float parameter `name` (marked read): a number, or a texture read as a number
+    /// (module doc); None when absent, or (after a warning) a texture kind heron has not.
+    pub(super) fn textured_float(
+        &mut self,
+        p: &Props<'a>,
+        name: &str,
+    ) -> Result<Option<Textured<f64>>, Diagnostic> {
+        if let Some(t) = self.texture_node(p, name)? {
+            return Ok(self.float_texture(t)?.map(Textured::Texture));
+        }
+        Ok(p.float(name)?.map(Textured::Value))
+    }
+
+    /// The table of texture `t` read as a number: a checkerboard with its colours
+    /// swapped (module doc; a new table for each use), any other kind as [`Self::texture`].
+    fn float_texture(&mut self, t: &'a Node) -> Result<Option<String>, Diagnostic> {
+        if t.attr("type") != Some("checkerboard") {
+            return self.texture(t);
+        }
+        let tp = self.props(t);
+        let grey = |v: Option<Textured<f64>>, default: f64| match v {
+            Some(Textured::Texture(n)) => Textured::Texture(n),
+            Some(Textured::Value(x)) => Textured::Value(ColourValue::Grey(x).reflectance()),
+            None => Textured::Value(ColourValue::Grey(default).reflectance()),
+        };
+        let color0 = grey(self.textured_float(&tp, "color0")?, 0.4);
+        let color1 = grey(self.textured_float(&tp, "color1")?, 0.2);
+        let to_uv = tp.transform("to_uv")?.and_then(uv_matrix);
+        self.finish(&tp)?;
+        let file = TextureFile::Checkerboard(CheckerboardFile {
+            color0: Some(color1),
+            color1: Some(color0),
+            to_uv,
+        });
+        Ok(Some(self.add_texture(t, file, "float")))
+    }
+
+    /// Adds table `file` under a fresh name from `t`'s id (and `suffix`).
+    pub(super) fn add_texture(&mut self, t: &Node, file: TextureFile, suffix: &str) -> String {
+        let base = match (t.attr("id"), suffix) {
+            (Some(id), "") => id.to_string(),
+            (Some(id), s) => format!("{id}-{s}"),
+            (None, "") => "texture".to_string(),
+            (None, s) => format!("texture-{s}"),
+        };
+        let mut name = base.clone();
+        let mut k = 1;
+        while self.textures.contains_key(&name) {
+            k += 1;
+            name = format!("{base}-{k}");
+        }
+        self.textures.insert(name.clone(), file);
+        name
+    }
+
     /// The `[textures]` table of texture element `t` (converted once), or None (with a
     /// warning) for a kind heron has not.
     fn texture(&mut self, t: &'a Node) -> Result<Option<String>, Diagnostic> {
@@ -150,14 +211,7 @@ impl<'a> Converter<'a> {
                 return Ok(None);
             }
         };
-        let base = t.attr("id").unwrap_or("texture");
-        let mut name = base.to_string();
-        let mut k = 1;
-        while self.textures.contains_key(&name) {
-            k += 1;
-            name = format!("{base}-{k}");
-        }
-        self.textures.insert(name.clone(), file);
+        let name = self.add_texture(t, file, "");
         self.texture_of.insert(t as *const Node, name.clone());
         Ok(Some(name))
     }

@@ -12,8 +12,8 @@
 use super::tokens::Params;
 use super::*;
 use crate::scene::file::{
-    CheckerboardFile, ImageTextureFile, MixTextureFile, NonNegativeNumber, Reflectance,
-    ScaleTextureFile, TextureFile, Textured, UvMatrix,
+    CheckerboardFile, Colour, ImageTextureFile, MixTextureFile, NonNegativeNumber, Reflectance,
+    ScaleTextureFile, TextureFile, Textured, UnitNumber, UvMatrix,
 };
 
 impl Conv {
@@ -137,7 +137,7 @@ impl Conv {
     ) -> Result<TextureFile, Diagnostic> {
         let [su, sv, du, dv] = uv;
         if float {
-            self.warn(self.diag(path, line, format!("Texture {name:?}: a float imagemap is looked up as a colour (a spectrum per wavelength from its RGB), not as pbrt-v4's one channel")))?;
+            self.warn(self.diag(path, line, format!("Texture {name:?}: a float imagemap is read as its luminance where a material wants a number (a roughness) and as a colour (a spectrum per wavelength from its RGB) elsewhere; pbrt-v4 reads its first channel, the same for a grey image")))?;
         }
         let f = p.string("filename").unwrap_or_default().to_string();
         if f.is_empty() {
@@ -234,6 +234,124 @@ impl Conv {
         Ok(Textured::Value(
             self.colour(path, p, name, default)?.reflectance(),
         ))
+    }
+
+    /// A microfacet material's (`what`'s) roughness when `roughness`, `uroughness` or
+    /// `vroughness` names a texture: its table, read as a number per point (its
+    /// luminance; pbrt-v4 reads a float image's first channel, the same for a grey
+    /// image). Two different sides become their mean, a `mix` table, with a warning
+    /// (heron's microfacets are isotropic). pbrt-v4 remaps a texture's value r to α = √r
+    /// per point unless `remaproughness` is false: a tree of constants, checkerboards
+    /// and scales is copied with its values' square roots ([`Self::sqrt_table`]); an
+    /// image or a mix has no such copy (heron's textures have no square root), so its
+    /// values are used as α, with a warning. None when no texture is named.
+    pub(super) fn roughness_texture(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+        what: &str,
+    ) -> Result<Option<Textured<UnitNumber>>, Diagnostic> {
+        let is_tex = |n: &str| p.get(n).is_some_and(|q| q.ty == "texture");
+        if !["roughness", "uroughness", "vroughness"]
+            .iter()
+            .any(|n| is_tex(n))
+        {
+            return Ok(None);
+        }
+        let side =
+            |this: &mut Self, n: &str| -> Result<Option<Textured<Reflectance>>, Diagnostic> {
+                if p.get(n).is_none() {
+                    return Ok(None);
+                }
+                if is_tex(n) {
+                    let q = p.get(n).expect("checked");
+                    // A texture heron did not make (its directive warned): the default.
+                    return Ok(this
+                        .texture_name(q.strs.first(), true)
+                        .map(Textured::Texture));
+                }
+                let c = this.colour(path, p, n, 0.0)?;
+                Ok(Some(this.bounded(path, p, n, c)?)).map(|r| r.map(Textured::Value))
+            };
+        // pbrt-v4 reads uroughness and vroughness first, roughness when both are absent.
+        let (u, v) = (side(self, "uroughness")?, side(self, "vroughness")?);
+        let tex = match (u, v) {
+            (None, None) => side(self, "roughness")?,
+            (Some(u), Some(v)) if u != v => {
+                self.warn(self.diag(path, line, format!("{what}: anisotropic roughness (uroughness, vroughness, a texture); heron's microfacets are isotropic, their mean (a mix texture) is used")))?;
+                let mut name = format!("{what}-roughness");
+                let mut k = 1;
+                while self.textures.contains_key(&name) {
+                    k += 1;
+                    name = format!("{what}-roughness-{k}");
+                }
+                let mix = MixTextureFile {
+                    tex1: u,
+                    tex2: v,
+                    amount: None,
+                };
+                self.textures.insert(name.clone(), TextureFile::Mix(mix));
+                Some(Textured::Texture(name))
+            }
+            (Some(t), _) | (None, Some(t)) => Some(t),
+        };
+        p.get("roughness");
+        let Some(Textured::Texture(tex)) = tex else {
+            // A number on the side that counts (the texture was on the other): the
+            // constant path reads it.
+            return Ok(None);
+        };
+        let mut tex = tex;
+        if p.string("remaproughness") != Some("false") {
+            match self.sqrt_table(&tex, 0) {
+                Some(t) => tex = t,
+                None => self.warn(self.diag(path, line, format!("{what}: a roughness texture's values are used as GGX α; pbrt-v4 remaps each to √value (remaproughness true, its default), which heron's textures cannot compute for an image or a mix")))?,
+            }
+        }
+        p.get("remaproughness");
+        Ok(Some(Textured::Texture(tex)))
+    }
+
+    /// A copy of table `name` whose every value is the square root of the original's
+    /// (pbrt-v4's roughness remap, α = √r, applied to the leaves: exact through a
+    /// checkerboard, which picks a leaf, and a scale, √(ab) = √a √b), named
+    /// `"NAME (alpha)"`; None when the tree holds an image or a mix (or is too deep).
+    fn sqrt_table(&mut self, name: &str, depth: u32) -> Option<String> {
+        let out = format!("{name} (alpha)");
+        if self.textures.contains_key(&out) {
+            return Some(out);
+        }
+        if depth > 16 {
+            return None;
+        }
+        let leaf = |this: &mut Self, v: Option<&Textured<Reflectance>>, default: f64| match v {
+            None => Some(Textured::Value(Reflectance(Colour::Grey(tidy(
+                default.sqrt(),
+            ))))),
+            Some(Textured::Value(Reflectance(Colour::Grey(g)))) => Some(Textured::Value(
+                Reflectance(Colour::Grey(tidy(g.max(0.0).sqrt()))),
+            )),
+            Some(Textured::Value(_)) => None,
+            Some(Textured::Texture(t)) => this.sqrt_table(t, depth + 1).map(Textured::Texture),
+        };
+        let file = match self.textures.get(name)?.clone() {
+            TextureFile::Checkerboard(c) => TextureFile::Checkerboard(CheckerboardFile {
+                color0: Some(leaf(self, c.color0.as_ref(), 0.4)?),
+                color1: Some(leaf(self, c.color1.as_ref(), 0.2)?),
+                to_uv: c.to_uv,
+            }),
+            TextureFile::Scale(sc) => TextureFile::Scale(ScaleTextureFile {
+                tex: leaf(self, Some(&sc.tex), 1.0)?,
+                scale: match sc.scale {
+                    Textured::Value(x) => Textured::Value(NonNegativeNumber(tidy(x.0.sqrt()))),
+                    Textured::Texture(_) => return None,
+                },
+            }),
+            TextureFile::Image(_) | TextureFile::Mix(_) => return None,
+        };
+        self.textures.insert(out.clone(), file);
+        Some(out)
     }
 
     /// `c` as a reflectance, components above 1 clamped with a warning.

@@ -132,17 +132,8 @@ impl Conv {
         line: u32,
         p: &Params,
     ) -> Result<MaterialFile, Diagnostic> {
-        let rho = self.colour(path, p, "reflectance", 0.5)?;
-        let (u, v) = (p.float("uroughness"), p.float("vroughness"));
-        if p.get("roughness").is_none() {
-            if let (Some(u), Some(v)) = (u, v) {
-                if u != v {
-                    self.warn(self.diag(path, line, format!("coateddiffuse: anisotropic roughness (uroughness {u}, vroughness {v}); heron's coat is isotropic, their mean is used")))?;
-                }
-            }
-        }
-        let roughness = self.roughness(p);
-        p.get("remaproughness");
+        let rho = self.textured(path, p, "reflectance", 0.5)?;
+        let roughness = self.roughness(path, line, p, "coateddiffuse")?;
         let (ior, below_one) = self.eta(path, line, p)?;
         if let (IorSpec::Constant(e), None) | (_, Some(IorSpec::Constant(e))) = (&ior, &below_one) {
             let e = if below_one.is_some() { 1.0 / *e } else { *e };
@@ -172,7 +163,7 @@ impl Conv {
         p.get("maxdepth");
         p.get("nsamples");
         Ok(MaterialFile::Coated(CoatedFile {
-            reflectance: rho.reflectance(),
+            reflectance: rho,
             ior: Some(ior),
             roughness,
             thickness: (thickness > 0.0).then_some(tidy(thickness)),
@@ -180,11 +171,32 @@ impl Conv {
         }))
     }
 
-    /// A microfacet material's roughness: [`Self::alpha`] when above 0, at most 1.
-    fn roughness(&mut self, p: &Params) -> Option<UnitNumber> {
-        self.alpha(p)
+    /// A microfacet material's (`what`'s) roughness: [`Self::alpha`] when above 0, at
+    /// most 1; or a float texture ([`Self::roughness_texture`]). Different `uroughness`
+    /// and `vroughness` warn: heron's microfacets are isotropic, their mean is used.
+    fn roughness(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+        what: &str,
+    ) -> Result<Option<Textured<UnitNumber>>, Diagnostic> {
+        if let Some(t) = self.roughness_texture(path, line, p, what)? {
+            return Ok(Some(t));
+        }
+        let (u, v) = (p.float("uroughness"), p.float("vroughness"));
+        if p.get("roughness").is_none() {
+            if let (Some(u), Some(v)) = (u, v) {
+                if u != v {
+                    self.warn(self.diag(path, line, format!("{what}: anisotropic roughness (uroughness {u}, vroughness {v}); heron's microfacets are isotropic, their mean is used")))?;
+                }
+            }
+        }
+        p.get("remaproughness");
+        Ok(self
+            .alpha(p)
             .filter(|a| *a > 0.0)
-            .map(|a| schema::unit(a.min(1.0)))
+            .map(|a| Textured::Value(schema::unit(a.min(1.0)))))
     }
 
     pub(super) fn alpha(&mut self, p: &Params) -> Option<f64> {
@@ -217,8 +229,7 @@ impl Conv {
             }),
             "dielectric" => {
                 let (ior, outside_ior) = self.eta(path, line, p)?;
-                let roughness = self.roughness(p);
-                p.get("remaproughness");
+                let roughness = self.roughness(path, line, p, "dielectric")?;
                 MaterialFile::Dielectric(DielectricFile {
                     ior,
                     fresnel: None,
@@ -269,8 +280,7 @@ impl Conv {
                     (_, _, Some(q)) => return Err(self.diag(path, q.line, "conductor: \"reflectance\" (an artist's colour) is not supported; give eta and k")),
                     (Some(q), None, _) | (None, Some(q), _) => return Err(self.diag(path, q.line, "conductor: expected both eta and k")),
                 };
-                let roughness = self.roughness(p);
-                p.get("remaproughness");
+                let roughness = self.roughness(path, line, p, "conductor")?;
                 MaterialFile::Conductor(ConductorFile { metal, roughness })
             }
             "coateddiffuse" => self.coated_diffuse(path, line, p)?,
