@@ -189,7 +189,7 @@ impl<'a> Converter<'a> {
         kind: &str,
         material: Option<String>,
         null: bool,
-        emission: &Option<Emission>,
+        emission: &Option<crate::scene::file::ShapeEmission>,
         medium: &mut Option<MediumFile>,
     ) -> Result<Option<Option<String>>, Diagnostic> {
         if medium.is_some() {
