@@ -225,3 +225,97 @@ fn bad_textured_emissions_name_their_key() {
         assert!(e.contains("emission"), "{emission}: {e}");
     }
 }
+
+/// The shapes' `emission` of an imported scene, as TOML.
+fn emissions(imp: &heron::scene::import::Imported) -> Vec<toml::Value> {
+    imp.table()["shapes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|s| s.get("emission").cloned())
+        .collect()
+}
+
+#[test]
+fn mitsuba_radiance_textures_import_as_textured_emission() {
+    use heron::scene::import::{import_mitsuba_str, ImportOptions};
+    let xml = |radiance: &str| {
+        common::scenes::mitsuba_around(&format!(
+            r#"<texture type="checkerboard" id="checks"><rgb name="color0" value="0.9, 0.3, 0.1"/></texture>
+<shape type="rectangle"><emitter type="area">{radiance}</emitter></shape>"#
+        ))
+    };
+    let opts = ImportOptions::default();
+    // Inside Mitsuba's d65 texture, with its scale: exactly heron's meaning, no warning.
+    let d65 = r#"<texture type="d65" name="radiance"><float name="scale" value="4"/><ref id="checks" name="nested"/></texture>"#;
+    let imp = import_mitsuba_str(&xml(d65), Path::new("a.xml"), &opts).unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    let e = emissions(&imp);
+    assert_eq!(e[0]["texture"].as_str(), Some("checks"));
+    assert_eq!(e[0]["scale"].as_float(), Some(4.0));
+    assert!(imp.table()["textures"]["checks"]["type"].as_str() == Some("checkerboard"));
+    // A bare texture: the same texture, scale 1, and a warning naming the line.
+    let imp = import_mitsuba_str(
+        &xml(r#"<ref id="checks" name="radiance"/>"#),
+        Path::new("a.xml"),
+        &opts,
+    )
+    .unwrap();
+    assert_eq!(emissions(&imp)[0]["texture"].as_str(), Some("checks"));
+    assert_eq!(imp.warnings.len(), 1, "{:?}", imp.warnings);
+    let w = imp.warnings[0].to_string();
+    assert!(w.contains("a.xml: line") && w.contains("D65"), "{w}");
+    // The converted scene loads and its light is textured.
+    let dir = tempfile::tempdir().unwrap();
+    let toml = dir.path().join("a.toml");
+    std::fs::write(&toml, imp.to_toml(dir.path())).unwrap();
+    let s = heron::scene::load_scene(&toml).unwrap();
+    assert!(s
+        .lights
+        .iter()
+        .any(|l| matches!(l, Light::Area(a) if a.is_textured())));
+}
+
+#[test]
+fn pbrt_image_area_lights_import_as_textured_emission() {
+    use heron::scene::import::{import_pbrt_str, ImportOptions};
+    let pbrt = |params: &str| {
+        format!(
+            "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\nFilm \"rgb\" \"integer xresolution\" [ 40 ] \"integer yresolution\" [ 20 ]\nWorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" {params}\nShape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\nAttributeEnd\n"
+        )
+    };
+    let opts = ImportOptions::default();
+    let imp = import_pbrt_str(
+        &pbrt("\"string filename\" \"glow.png\" \"float scale\" 2"),
+        Path::new("a.pbrt"),
+        &opts,
+    )
+    .unwrap();
+    assert!(imp.warnings.is_empty(), "{:?}", imp.warnings);
+    let e = &emissions(&imp)[0];
+    assert_eq!(e["scale"].as_float(), Some(2.0));
+    let t = &imp.table()["textures"][e["texture"].as_str().unwrap()];
+    assert_eq!(t["file"].as_str(), Some("glow.png"));
+    // pbrt-v4 looks the image up at (u, 1 − v).
+    assert_eq!(t["to_uv"][1][1].as_float(), Some(-1.0));
+    assert_eq!(t["to_uv"][1][2].as_float(), Some(1.0));
+    // An EXR and `power` warn, naming the file and line; L with filename is an error.
+    let imp = import_pbrt_str(
+        &pbrt("\"string filename\" \"glow.exr\" \"float power\" 10"),
+        Path::new("a.pbrt"),
+        &opts,
+    )
+    .unwrap();
+    let w: Vec<String> = imp.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(w.iter().all(|w| w.contains("a.pbrt: line 7")), "{w:?}");
+    let e = import_pbrt_str(
+        &pbrt("\"string filename\" \"glow.png\" \"rgb L\" [1 1 1]"),
+        Path::new("a.pbrt"),
+        &opts,
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(e.contains("both \"L\" and \"filename\""), "{e}");
+}
