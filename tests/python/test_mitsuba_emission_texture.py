@@ -6,11 +6,15 @@ scale }`), the two linear sRGB images held to each other region by region with t
 helpers and criterion of test_mitsuba_xml.py (whole-image z beyond the films' 0.2% floor
 per channel, Bonferroni 1% over the three; every 16-pixel region within 3%).
 
-128 × 96 at 128 spp: measured whole-image z within ±1.5 and the largest region difference
-about 1.5% (the uplifts' metamerism on the saturated squares); each render takes a few
-seconds. With heron given the squares swapped (color0 ↔ color1) the same measures reject
-it (test_swapped_squares_fail_the_comparison): the squares seen directly differ by a
-factor of nine in red.
+128 × 96 at 128 spp: measured whole-image z 0 (within the films' floor) in each channel
+and the largest region difference 2.2% (a region straddling the light's edge and the
+squares' saturated colours, where the two uplifts' metamerism shows); both renders and
+the comparison take 5 s. With heron given the squares swapped (color0 ↔ color1) the same
+measures reject it (test_swapped_squares_fail_the_comparison; measured largest region
+difference 571%).
+
+The light has no BSDF: Mitsuba 3 makes such an emitter's surface black
+(src/render/shape.cpp), and so does heron's importer.
 """
 from __future__ import annotations
 
