@@ -32,8 +32,8 @@ pub struct Interaction {
     pub material: u32,
     /// The shape hit (its Embree geometry ID).
     pub shape: u32,
-    /// Texture coordinates, computed only for a textured material (zero otherwise;
-    /// [`Shape::uv`]).
+    /// Texture coordinates, computed only for a textured material or a textured
+    /// emission (zero otherwise; [`Shape::uv`]).
     pub uv: glam::Vec2,
 }
 

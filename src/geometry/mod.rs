@@ -38,12 +38,37 @@ impl Mesh {
     /// The texture coordinates at barycentrics (b1, b2) of triangle `prim`.
     #[inline]
     pub fn uv(&self, prim: u32, b1: f32, b2: f32) -> glam::Vec2 {
-        if self.uvs.is_empty() {
-            return glam::Vec2::new(b1, b2);
-        }
-        let [ta, tb, tc] = self.uvs[prim as usize];
-        ta * (1.0 - b1 - b2) + tb * b1 + tc * b2
+        triangle_uv(&self.uvs, prim, b1, b2)
     }
+}
+
+/// The texture coordinates at barycentrics (b1, b2) of triangle `prim` of a mesh whose
+/// per-corner coordinates are `uvs` (empty: (b1, b2) themselves); [`Mesh::uv`], and an
+/// emitting mesh's sampled points (`light::area`).
+#[inline]
+pub fn triangle_uv(uvs: &[[glam::Vec2; 3]], prim: u32, b1: f32, b2: f32) -> glam::Vec2 {
+    if uvs.is_empty() {
+        return glam::Vec2::new(b1, b2);
+    }
+    let [ta, tb, tc] = uvs[prim as usize];
+    ta * (1.0 - b1 - b2) + tb * b1 + tc * b2
+}
+
+/// A sphere's texture coordinates in the direction `d` from its centre: Mitsuba 3's
+/// (φ/2π, θ/π) about +z, φ = atan2(y, x) in [0, 2π), θ from +z
+/// (`src/shapes/sphere.cpp`). [`Shape::uv`], and an emitting sphere's sampled points.
+#[inline]
+pub fn sphere_uv(d: Vec3) -> glam::Vec2 {
+    let d = d.normalize_or_zero();
+    let mut phi = d.y.atan2(d.x);
+    if phi < 0.0 {
+        phi += 2.0 * std::f32::consts::PI;
+    }
+    let theta = d.x.hypot(d.y).atan2(d.z);
+    glam::Vec2::new(
+        phi * (0.5 * std::f32::consts::FRAC_1_PI),
+        theta * std::f32::consts::FRAC_1_PI,
+    )
 }
 
 #[derive(Clone, Debug)]
@@ -72,6 +97,9 @@ pub struct Shape {
     /// Whether it is only a medium's boundary (a medium and no material): index-matched,
     /// rays pass it without refraction or reflection.
     pub interface: bool,
+    /// Whether its area light's emission is a texture, so that a hit needs its uv
+    /// (`Scene::interaction`) even when its material is not textured.
+    pub textured_emission: bool,
 }
 
 impl Shape {
@@ -83,6 +111,7 @@ impl Shape {
             light: NO_LIGHT,
             medium: NO_MEDIUM,
             interface: false,
+            textured_emission: false,
         }
     }
 
@@ -93,18 +122,7 @@ impl Shape {
     #[inline]
     pub fn uv(&self, p: Vec3, prim: u32, b1: f32, b2: f32) -> glam::Vec2 {
         match &self.kind {
-            ShapeKind::Sphere { center, .. } => {
-                let d = (p - *center).normalize_or_zero();
-                let mut phi = d.y.atan2(d.x);
-                if phi < 0.0 {
-                    phi += 2.0 * std::f32::consts::PI;
-                }
-                let theta = d.x.hypot(d.y).atan2(d.z);
-                glam::Vec2::new(
-                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
-                    theta * std::f32::consts::FRAC_1_PI,
-                )
-            }
+            ShapeKind::Sphere { center, .. } => sphere_uv(p - *center),
             ShapeKind::Mesh(m) => m.uv(prim, b1, b2),
         }
     }

@@ -97,7 +97,7 @@ impl PixelIntegrator for LightTracer {
         // tracer skips its `sample_visible_emitters` so).
         if let (Some(n), false) = (le.normal, settings.hide_emitters) {
             if let Some(cs) = cam.sample_wi(le.origin) {
-                let emitted = scene.lights[start.index].l(n, cs.wi, wl);
+                let emitted = scene.lights[start.index].l(n, cs.wi, le.uv, wl);
                 if !emitted.is_zero() {
                     let k = n.dot(cs.wi).abs() * cs.we / (cs.pdf * pmf * le.pdf_pos);
                     let beam = T::emitted(ctx, start.index, cs.wi, wl);

@@ -634,7 +634,7 @@ fn surface_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
         NO_LIGHT
     };
     if emitter != NO_LIGHT {
-        let le = scene.lights[emitter as usize].l(it.n_outward, wo, wl);
+        let le = scene.lights[emitter as usize].l(it.n_outward, wo, it.uv, wl);
         if !le.is_zero() {
             let (prev_p, dir) = (s.prev_p, ray.dir);
             let sp = SurfacePoint {

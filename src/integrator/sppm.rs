@@ -165,7 +165,7 @@ pub fn camera_path<const N: usize>(
         out.length += hit.t * ray.dir.length();
         let emitter = scene.shapes[hit.geom_id as usize].light;
         if emitter != NO_LIGHT && !hidden {
-            out.l += beta * scene.lights[emitter as usize].l(it.n_outward, -ray.dir, wl);
+            out.l += beta * scene.lights[emitter as usize].l(it.n_outward, -ray.dir, it.uv, wl);
         }
         let u_light = sampler.get_1d();
         let u_light_point = sampler.get_2d();
@@ -314,7 +314,7 @@ impl<const N: usize> Vertex<'_, N> {
             return zero;
         }
         let (it, _) = scene.interaction(&ray, &hit, ctx.offset.is_robust());
-        let le = scene.lights[light as usize].l(it.n_outward, -dir, wl);
+        let le = scene.lights[light as usize].l(it.n_outward, -dir, it.uv, wl);
         if le.is_zero() {
             return zero;
         }

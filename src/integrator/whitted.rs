@@ -140,7 +140,7 @@ impl StepIntegrator for Whitted {
         if on(K, EMITTERS) {
             let emitter = scene.shapes[hit.geom_id as usize].light;
             if emitter != NO_LIGHT && !hidden {
-                let c = s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, wl);
+                let c = s.beta * scene.lights[emitter as usize].l(it.n_outward, wo, it.uv, wl);
                 t.found(&mut s.l, c, emitter as usize, ray.dir);
             }
         }

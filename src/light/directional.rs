@@ -45,6 +45,7 @@ impl DirectionalLight {
             pdf_pos,
             pdf_dir: 1.0,
             normal: Some(self.direction),
+            uv: Vec2::ZERO,
         }
     }
 

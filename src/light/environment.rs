@@ -289,6 +289,7 @@ impl EnvironmentLight {
             pdf_pos,
             pdf_dir,
             normal: Some(-w),
+            uv: Vec2::ZERO,
         })
     }
 

@@ -22,7 +22,7 @@ pub mod sampler;
 pub mod spot;
 pub mod sun;
 
-pub use area::{AreaLight, AreaShape, SurfacePoint};
+pub use area::{AreaLight, AreaShape, EmissionTexture, SurfacePoint};
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
 pub use envmap::{EnvMap, EnvMapping};
@@ -106,6 +106,9 @@ pub struct LightLeSample<const N: usize> {
     /// disk of a light at infinity), so that the flux of the ray is
     /// L |cos| / (pdf_pos pdf_dir); None for point and spot lights.
     pub normal: Option<Vec3>,
+    /// Texture coordinates of the origin on a textured area light (zero otherwise), for
+    /// the emission toward another direction ([`Light::l`]).
+    pub uv: Vec2,
 }
 
 /// The scene's bounding sphere.
@@ -194,17 +197,20 @@ impl Light {
     }
 
     /// Radiance an emitting surface of this light sends from a point with outward
-    /// normal `n` into direction `w` (pbrt-v4 `Light::L`); zero for lights without a
-    /// surface. Integrators read emission here, whatever the light.
+    /// normal `n` and texture coordinates `uv` (read by a textured emission only: the
+    /// interaction's uv, which `Scene::interaction` computes for such a shape) into
+    /// direction `w` (pbrt-v4 `Light::L`); zero for lights without a surface.
+    /// Integrators read emission here, whatever the light.
     #[inline]
     pub fn l<const N: usize>(
         &self,
         n: Vec3,
         w: Vec3,
+        uv: Vec2,
         wl: &SampledWavelengths<N>,
     ) -> SampledSpectrum<N> {
         match self {
-            Light::Area(a) => a.l(n, w, wl),
+            Light::Area(a) => a.l(n, w, uv, wl),
             _ => SampledSpectrum::zero(),
         }
     }

@@ -53,6 +53,7 @@ impl PointLight {
             pdf_pos: 1.0,
             pdf_dir: UNIFORM_SPHERE_PDF,
             normal: None,
+            uv: Vec2::ZERO,
         }
     }
 

@@ -88,6 +88,7 @@ impl SpotLight {
             pdf_pos: 1.0,
             pdf_dir: uniform_cone_pdf(omc),
             normal: None,
+            uv: Vec2::ZERO,
         })
     }
 

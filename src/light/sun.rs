@@ -171,6 +171,7 @@ impl SunLight {
             pdf_pos,
             pdf_dir: 1.0 / self.solid_angle(),
             normal: Some(normal),
+            uv: Vec2::ZERO,
         }
     }
 

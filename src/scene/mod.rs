@@ -170,7 +170,9 @@ impl Scene {
         let shape = &self.shapes[hit.geom_id as usize];
         let material = &self.materials[shape.material as usize];
         let mut it = Interaction::new(ray, hit, shape, robust);
-        if material.is_textured() {
+        // A textured material, or a textured emission (read by the integrators through
+        // `Light::l` at `it.uv`).
+        if material.is_textured() || shape.textured_emission {
             it.uv = shape.uv(it.position, hit.prim_id, hit.u, hit.v);
         }
         (it, material)

@@ -317,7 +317,7 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             return scene.escaped_radiance(-w, self.wl);
         }
         match scene.lights.get(v.light as usize) {
-            Some(light) => light.l(v.n, w, self.wl),
+            Some(light) => light.l(v.n, w, v.uv, self.wl),
             None => SampledSpectrum::zero(),
         }
     }

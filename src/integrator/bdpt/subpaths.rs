@@ -147,6 +147,9 @@ impl<'a, const N: usize> Bdpt<'a, N> {
             le.normal.unwrap_or(Vec3::ZERO)
         };
         v.infinite = light.is_infinite();
+        // Where on a textured area light the path starts, for its emission toward a
+        // camera vertex (`le`).
+        v.uv = le.uv;
         v.beta = le.l;
         v.pdf_fwd = le.pdf_pos * pmf;
         // A delta light's vertex is not a delta *vertex*: the light itself cannot be

@@ -63,6 +63,7 @@ use std::fmt::Write as _;
 
 mod coefficient;
 mod colour;
+mod emission;
 mod leaves;
 mod metal;
 mod show;
@@ -70,6 +71,7 @@ mod texture;
 
 pub use coefficient::Coefficient;
 pub use colour::{Colour, Emission, Reflectance};
+pub use emission::ShapeEmission;
 pub use leaves::{
     Direction3, IorSpec, Point2, Point3, PositiveCount, PositiveNumber, Resolution, UnitNumber,
 };
@@ -522,7 +524,7 @@ impl ShapeFile {
         &["sphere", "triangle", "plane", "quad", "mesh", "waves"];
 
     /// The entry's material name, emission and two-sidedness.
-    pub fn emission(&self) -> (Option<&String>, Option<&Emission>, Option<bool>) {
+    pub fn emission(&self) -> (Option<&String>, Option<&ShapeEmission>, Option<bool>) {
         match self {
             ShapeFile::Sphere(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
             ShapeFile::Triangle(x) => (x.material.as_ref(), x.emission.as_ref(), x.two_sided),
@@ -539,7 +541,7 @@ impl ShapeFile {
         &mut self,
     ) -> (
         &mut Option<String>,
-        &mut Option<Emission>,
+        &mut Option<ShapeEmission>,
         &mut Option<bool>,
     ) {
         match self {
@@ -601,7 +603,7 @@ pub struct SphereFile {
     pub material: Option<String>,
     /// Radiance emitted from the surface: the shape becomes an area light.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<Emission>,
+    pub emission: Option<ShapeEmission>,
     /// Emit from both sides (default: only the side the outward normal points to).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
@@ -619,7 +621,7 @@ pub struct TriangleFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<Emission>,
+    pub emission: Option<ShapeEmission>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
@@ -639,7 +641,7 @@ pub struct PlaneFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<Emission>,
+    pub emission: Option<ShapeEmission>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
@@ -657,7 +659,7 @@ pub struct QuadFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<Emission>,
+    pub emission: Option<ShapeEmission>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).
@@ -684,7 +686,7 @@ pub struct WavesFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<Emission>,
+    pub emission: Option<ShapeEmission>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only, which a sheet of
@@ -758,7 +760,7 @@ pub struct MeshFile {
     pub flip_tex_coords: Option<bool>,
     /// Radiance emitted by every triangle of the mesh: it becomes an area light.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<Emission>,
+    pub emission: Option<ShapeEmission>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
     /// A participating medium inside the shape (closed shapes only).

@@ -2,14 +2,17 @@
 //! optional portal, spot), and one area light per emitting shape after them.
 use super::errors::fmt_points;
 use super::shapes::{cross_overflows, is_degenerate};
+use super::textures::Textures;
 use crate::geometry::{Shape, ShapeKind};
 use crate::light::{
     AreaLight, AreaShape, DirectionalLight, Light, LightPolarization, PointLight, Portal,
     SpotLight, SunLight,
 };
 use crate::scene::file::{
-    fmt_f32, LightFile, LightPolarizationFile, ShapeFile, SpotLightFile, SunLightFile,
+    fmt_f32, LightFile, LightPolarizationFile, ShapeEmission, ShapeFile, SpotLightFile,
+    SunLightFile,
 };
+use crate::spectrum::DenseSpectrum;
 
 /// The file's lights, in file order.
 pub(super) fn build_lights(entries: &[LightFile]) -> Result<Vec<Light>, String> {
@@ -143,24 +146,47 @@ fn spot(at: &str, s: &SpotLightFile) -> Result<SpotLight, String> {
 }
 
 /// Appends one area light per emitting shape (emission above zero somewhere) to `lights`
-/// and gives the shape its index. `shape_entry` is each shape's entry in `entries`.
+/// and gives the shape its index. `shape_entry` is each shape's entry in `entries`. A
+/// textured emission (`{ texture = "NAME", scale = S }`) is the named tree from
+/// `textures` times D65 at Y = 1 times S ([`crate::scene::file::ShapeEmission`]); its
+/// shape then computes uv at its hits.
 pub(super) fn add_area_lights(
     entries: &[ShapeFile],
     shape_entry: &[usize],
     shapes: &mut [Shape],
     lights: &mut Vec<Light>,
-) {
+    textures: &mut Textures,
+    inputs: &mut Vec<String>,
+) -> Result<(), String> {
     for (k, shape) in shapes.iter_mut().enumerate() {
         let (_, emission, two_sided) = entries[shape_entry[k]].emission();
-        let Some(e) = emission else { continue };
-        if e.0.max_value() <= 0.0 {
-            continue;
-        }
+        let (spectrum, texture) = match emission {
+            None => continue,
+            Some(ShapeEmission::Colour(e)) => {
+                if e.0.max_value() <= 0.0 {
+                    continue;
+                }
+                (e.spectrum(), None)
+            }
+            Some(ShapeEmission::Texture { texture, scale }) => {
+                let at = format!("shapes[{}].emission", shape_entry[k]);
+                let tree = textures.tree(&at, texture, inputs)?;
+                if *scale <= 0.0 {
+                    continue;
+                }
+                (
+                    crate::spectrum::uplift::named("D65")
+                        .unwrap_or_else(|| DenseSpectrum::constant(1.0))
+                        .scaled(*scale as f32),
+                    Some(tree),
+                )
+            }
+        };
         let two_sided = two_sided.unwrap_or(false);
         let area = match &shape.kind {
             ShapeKind::Sphere { center, radius } => AreaLight::new(
                 k as u32,
-                e.spectrum(),
+                spectrum,
                 two_sided,
                 AreaShape::Sphere {
                     center: *center,
@@ -169,7 +195,7 @@ pub(super) fn add_area_lights(
             ),
             ShapeKind::Mesh(m) => AreaLight::triangles(
                 k as u32,
-                e.spectrum(),
+                spectrum,
                 two_sided,
                 m.indices
                     .iter()
@@ -177,7 +203,19 @@ pub(super) fn add_area_lights(
                     .collect(),
             ),
         };
+        let area = match texture {
+            None => area,
+            Some(tree) => {
+                shape.textured_emission = true;
+                let uvs = match &shape.kind {
+                    ShapeKind::Mesh(m) => m.uvs.clone(),
+                    ShapeKind::Sphere { .. } => Vec::new(),
+                };
+                area.with_texture(tree, uvs)
+            }
+        };
         shape.light = lights.len() as u32;
         lights.push(Light::Area(area));
     }
+    Ok(())
 }

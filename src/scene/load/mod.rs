@@ -162,7 +162,15 @@ pub(crate) fn build(
     shapes::check_bounds(&shapes, &entry).map_err(err)?;
     let mut lights = lights::build_lights(&file.lights).map_err(err)?;
     let light_polarization = lights::build_light_polarization(&file.lights).map_err(err)?;
-    lights::add_area_lights(&file.shapes, &entry, &mut shapes, &mut lights);
+    lights::add_area_lights(
+        &file.shapes,
+        &entry,
+        &mut shapes,
+        &mut lights,
+        &mut textures::Textures::new(&file.textures, &base_dir),
+        &mut inputs,
+    )
+    .map_err(err)?;
     let background = file
         .background
         .as_ref()

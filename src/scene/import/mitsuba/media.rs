@@ -180,7 +180,8 @@ fn tidied(c: ColourValue) -> ColourValue {
 impl<'a> Converter<'a> {
     /// The material of shape `n` (a `kind`) from its BSDF (None: Mitsuba's default),
     /// whether that BSDF is `null`, its emission and its interior medium: `Some(None)`
-    /// for an index-matched boundary around the medium, `None` for a shape that is not
+    /// for an index-matched boundary around the medium or an emitter without a BSDF
+    /// (black, as Mitsuba 3 makes it), `None` for a shape that is not
     /// rendered at all (a `null` surface with neither a medium nor an emitter is
     /// invisible). A medium heron cannot hold in this shape is dropped, with a warning.
     pub(super) fn surface(
@@ -189,7 +190,7 @@ impl<'a> Converter<'a> {
         kind: &str,
         material: Option<String>,
         null: bool,
-        emission: &Option<Emission>,
+        emission: &Option<crate::scene::file::ShapeEmission>,
         medium: &mut Option<MediumFile>,
     ) -> Result<Option<Option<String>>, Diagnostic> {
         if medium.is_some() {
@@ -224,9 +225,13 @@ impl<'a> Converter<'a> {
                 "a null BSDF on an area emitter: heron's emitting surface reflects as Mitsuba's default BSDF",
             ))?;
         }
-        Ok(Some(Some(match material {
-            Some(m) => m,
-            None => self.default_material(),
-        })))
+        Ok(Some(match material {
+            Some(m) => Some(m),
+            // Mitsuba 3 gives an emitter without a BSDF a black diffuse one
+            // (`Shape::Shape` in src/render/shape.cpp): heron's black emitter, no
+            // material; other shapes its diffuse 0.5.
+            None if emission.is_some() && !null => None,
+            None => Some(self.default_material()),
+        }))
     }
 }

@@ -1,7 +1,7 @@
 //! Mitsuba 3's shapes (with their area emitters) and emitters as heron's shapes and
 //! lights.
 use super::*;
-use crate::scene::file::{DirectionalLightFile, PointLightFile, SpotLightFile};
+use crate::scene::file::{DirectionalLightFile, PointLightFile, ShapeEmission, SpotLightFile};
 
 impl<'a> Converter<'a> {
     pub(super) fn shape(&mut self, n: &'a Node) -> Result<(), Diagnostic> {
@@ -243,20 +243,67 @@ impl<'a> Converter<'a> {
 
     // ---- emitters ---------------------------------------------------------------
 
+    /// An area emitter's `radiance` given as a texture: a `bitmap` or `checkerboard`
+    /// (nested or by `ref`; a `d65` texture around one, with its `scale`) becomes the
+    /// shape's `{ texture = "NAME", scale = S }`, which heron emits times D65 at Y = 1.
+    /// That is Mitsuba's `d65` around the texture, and its RGB variants' reading of a
+    /// bare one (a texel of 1 is sRGB white); its spectral variants emit a bare
+    /// texture's reflectance spectrum unlit, white being equal energy, so a bare one
+    /// warns. Another texture warns and emits the default radiance 1.
+    fn radiance_texture(&mut self, t: &'a Node) -> Result<ShapeEmission, Diagnostic> {
+        let (inner, scale) = if t.attr("type") == Some("d65") {
+            let tp = self.props(t);
+            let scale = tp.float("scale")?.unwrap_or(1.0);
+            let nested = tp.objects(&["texture"]);
+            let Some(inner) = nested.first() else {
+                return Err(t.diag("d65: expected a nested <texture> (heron's textured emission is a texture times D65)"));
+            };
+            let inner = self.resolve(inner)?;
+            self.finish(&tp)?;
+            if !(scale >= 0.0 && (scale as f32).is_finite()) {
+                return Err(t.diag(format!(
+                    "d65: scale: expected a finite number ≥ 0, got {scale}"
+                )));
+            }
+            (inner, scale)
+        } else {
+            (t, 1.0)
+        };
+        let Some(name) = self.texture(inner)? else {
+            return Ok(ColourValue::Grey(1.0).emission().into());
+        };
+        if !std::ptr::eq(inner, t) {
+            return Ok(ShapeEmission::Texture {
+                texture: name,
+                scale,
+            });
+        }
+        self.warn(t.diag(
+            "area radiance texture: emitted times D65 (a texel of 1 is sRGB white, as in Mitsuba's RGB variants and under a <texture type=\"d65\">); Mitsuba's spectral variants emit a bare texture's spectrum without an illuminant",
+        ))?;
+        Ok(ShapeEmission::Texture {
+            texture: name,
+            scale: 1.0,
+        })
+    }
+
     /// Converts an emitter; inside a shape (`shape` given) it returns the area light's
     /// radiance for the shape's `emission`.
     pub(super) fn emitter(
         &mut self,
         n: &'a Node,
         shape: Option<&Node>,
-    ) -> Result<Option<Emission>, Diagnostic> {
+    ) -> Result<Option<ShapeEmission>, Diagnostic> {
         let kind = Self::plugin(n)?;
         let p = self.props(n);
         let out = match (kind, shape) {
-            ("area", Some(_)) => {
-                let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
-                Some(l.emission())
-            }
+            ("area", Some(_)) => match self.texture_node(&p, "radiance")? {
+                Some(t) => Some(self.radiance_texture(t)?),
+                None => {
+                    let l = self.colour(&p, "radiance", ColourValue::Grey(1.0))?;
+                    Some(l.emission().into())
+                }
+            },
             ("area", None) => return Err(n.diag("an area emitter must be inside a <shape>")),
             (_, Some(s)) => {
                 return Err(n.diag(format!(

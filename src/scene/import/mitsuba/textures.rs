@@ -31,7 +31,11 @@ fn uv_matrix(m: DMat4) -> Option<UvMatrix> {
 impl<'a> Converter<'a> {
     /// The texture element parameter `name` names (nested or by `ref`), if it names one;
     /// the parameter is marked read.
-    fn texture_node(&mut self, p: &Props<'a>, name: &str) -> Result<Option<&'a Node>, Diagnostic> {
+    pub(super) fn texture_node(
+        &mut self,
+        p: &Props<'a>,
+        name: &str,
+    ) -> Result<Option<&'a Node>, Diagnostic> {
         let Some(n) = p
             .node
             .children
@@ -177,7 +181,7 @@ impl<'a> Converter<'a> {
 
     /// The `[textures]` table of texture element `t` (converted once), or None (with a
     /// warning) for a kind heron has not.
-    fn texture(&mut self, t: &'a Node) -> Result<Option<String>, Diagnostic> {
+    pub(super) fn texture(&mut self, t: &'a Node) -> Result<Option<String>, Diagnostic> {
         if let Some(name) = self.texture_of.get(&(t as *const Node)) {
             return Ok(Some(name.clone()));
         }

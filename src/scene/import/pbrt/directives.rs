@@ -451,13 +451,75 @@ impl Conv {
                 self.g.material = Some(m);
             }
             _ => {
-                let l = self.emission(path, p, "L", 1.0)?;
                 let scale = p.float("scale").unwrap_or(1.0);
                 let two = p.string("twosided") == Some("true");
-                self.g.area = Some((scaled(l, scale).emission(), two));
+                let emission = match p.string("filename").filter(|f| !f.is_empty()) {
+                    Some(f) => {
+                        let f = f.to_string();
+                        self.area_image(path, line, p, &f, scale)?
+                    }
+                    None => {
+                        let l = self.emission(path, p, "L", 1.0)?;
+                        scaled(l, scale).emission().into()
+                    }
+                };
+                self.g.area = Some((emission, two));
             }
         }
         Ok(())
+    }
+
+    /// A diffuse area light's `filename`: the image as a `[textures]` table (pbrt-v4's
+    /// `DiffuseAreaLight` looks it up at (u, 1 − v), bilinear, each texel's RGB an
+    /// illuminant spectrum of the sRGB space, D65 at Y = 1, times `scale`), the shape's
+    /// `{ texture, scale }`. heron's image texels are clamped to [0, 1] (a warning for
+    /// the formats that hold more), and `power` is not applied to an image (a warning).
+    fn area_image(
+        &mut self,
+        path: &Path,
+        line: u32,
+        p: &Params,
+        f: &str,
+        scale: f64,
+    ) -> Result<crate::scene::file::ShapeEmission, Diagnostic> {
+        if p.get("L").is_some() {
+            return Err(self.diag(path, line, "AreaLightSource \"diffuse\": both \"L\" and \"filename\" are given (pbrt-v4 refuses that)"));
+        }
+        if !(scale >= 0.0 && (scale as f32).is_finite()) {
+            return Err(self.diag(path, line, format!("AreaLightSource \"diffuse\": scale: expected a finite number ≥ 0 with an image, got {scale}")));
+        }
+        let full = self.base_of(path).join(f);
+        let file = crate::scene::import::mitsuba::relative_to(&full, &self.base)
+            .to_string_lossy()
+            .replace('\\', "/");
+        let ext = file.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
+        if matches!(ext.as_str(), "exr" | "pfm" | "hdr") {
+            self.warn(self.diag(path, line, format!("AreaLightSource \"diffuse\": filename {f:?}: heron's image textures hold texels in [0, 1], so brighter texels are clamped to 1 (scale still multiplies the light)")))?;
+        }
+        if let Some(q) = p.get("power") {
+            let _ = q;
+            self.warn(self.diag(path, line, "AreaLightSource \"diffuse\": power is not applied to an image light (pbrt-v4 normalises by the image's mean luminance), ignored"))?;
+        }
+        let mut name = "arealight-image".to_string();
+        let mut k = 1;
+        while self.textures.contains_key(&name) {
+            k += 1;
+            name = format!("arealight-image-{k}");
+        }
+        self.textures.insert(
+            name.clone(),
+            TextureFile::Image(crate::scene::file::ImageTextureFile {
+                file,
+                encoding: None,
+                scale: None,
+                invert: None,
+                to_uv: Some([[1.0, 0.0, 0.0], [0.0, -1.0, 1.0]]),
+            }),
+        );
+        Ok(crate::scene::file::ShapeEmission::Texture {
+            texture: name,
+            scale,
+        })
     }
 
     fn import(&mut self, d: &Directive) -> Result<(), Diagnostic> {

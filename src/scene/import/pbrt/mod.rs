@@ -42,7 +42,7 @@ struct Graphics {
     ctm: DMat4,
     material: Option<String>,
     /// The area light's radiance and two-sidedness.
-    area: Option<(Emission, bool)>,
+    area: Option<(crate::scene::file::ShapeEmission, bool)>,
     reverse: bool,
     /// `MediumInterface`'s inside and outside medium names ("" for none).
     inside: String,
@@ -90,7 +90,7 @@ struct ShapeDef {
     ctm: DMat4,
     reverse: bool,
     material: String,
-    area: Option<(Emission, bool)>,
+    area: Option<(crate::scene::file::ShapeEmission, bool)>,
     /// The medium names of the `MediumInterface` current at the shape.
     inside: String,
     outside: String,
