@@ -25,6 +25,7 @@ the two renderers parted by 1.7–2% on both rectangles and up to 3% near the li
 """
 import pathlib
 
+from test_mitsuba_textures import two_panels
 from test_mitsuba_xml import agreement, render_heron, render_mitsuba, same
 from heronrun import REPO
 
@@ -34,28 +35,7 @@ SPP = 64
 
 
 def scene(a0: str, a1: str) -> str:
-    return f"""<scene version="3.0.0">
-    <default name="width" value="160"/>
-    <default name="height" value="96"/>
-    <default name="spp" value="64"/>
-    <integrator type="path"><integer name="max_depth" value="5"/></integrator>
-    <sensor type="perspective">
-        <float name="fov" value="50"/>
-        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
-        <film type="hdrfilm">
-            <integer name="width" value="$width"/><integer name="height" value="$height"/>
-            <rfilter type="box"/>
-        </film>
-    </sensor>
-    <emitter type="constant"><rgb name="radiance" value="0.5, 0.5, 0.5"/></emitter>
-    <shape type="sphere">
-        <point name="center" x="-1" y="2" z="3"/><float name="radius" value="0.3"/>
-        <emitter type="area"><rgb name="radiance" value="30, 30, 30"/></emitter>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale x="1.1" y="1.1"/><translate x="-1.2"/></transform>
-        <bsdf type="roughconductor">
+    return two_panels(f"""        <bsdf type="roughconductor">
             <float name="eta" value="0.2"/>
             <float name="k" value="3.0"/>
             <string name="distribution" value="ggx"/>
@@ -64,18 +44,11 @@ def scene(a0: str, a1: str) -> str:
                 <float name="color1" value="{a1}"/>
                 <transform name="to_uv"><scale x="2" y="2"/></transform>
             </texture>
-        </bsdf>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale x="1.1" y="1.1"/><translate x="1.2"/></transform>
-        <bsdf type="plastic">
+        </bsdf>""", f"""        <bsdf type="plastic">
             <texture type="bitmap" name="diffuse_reflectance">
                 <string name="filename" value="{PNG}"/>
             </texture>
-        </bsdf>
-    </shape>
-</scene>
-"""
+        </bsdf>""", sky="0.5, 0.5, 0.5", light=(-1, 2, 3))
 
 
 def _write(tmp: pathlib.Path, name: str, text: str) -> pathlib.Path:

@@ -32,7 +32,12 @@ SPP = 64
 C0, C1 = "0.75, 0.3, 0.1", "0.1, 0.25, 0.6"
 
 
-def scene(jpeg: pathlib.Path, color0: str, color1: str) -> str:
+def two_panels(left: str, right: str, sky: str = "0.8, 0.8, 0.8", light=(2, 3, 4)) -> str:
+    """A Mitsuba scene of two 2.2-wide rectangles side by side (centres x = −1.2 and 1.2)
+    with the BSDFs `left` and `right`, under a constant sky of radiance `sky` and a
+    sphere light of radius 0.3 at `light`, seen from z = 4 (160×96, 64 spp, the path
+    tracer to depth 5); the texture side by sides share it."""
+    x, y, z = light
     return f"""<scene version="3.0.0">
     <default name="width" value="160"/>
     <default name="height" value="96"/>
@@ -47,31 +52,35 @@ def scene(jpeg: pathlib.Path, color0: str, color1: str) -> str:
             <rfilter type="box"/>
         </film>
     </sensor>
-    <emitter type="constant"><rgb name="radiance" value="0.8, 0.8, 0.8"/></emitter>
+    <emitter type="constant"><rgb name="radiance" value="{sky}"/></emitter>
     <shape type="sphere">
-        <point name="center" x="2" y="3" z="4"/><float name="radius" value="0.3"/>
+        <point name="center" x="{x}" y="{y}" z="{z}"/><float name="radius" value="0.3"/>
         <emitter type="area"><rgb name="radiance" value="30, 30, 30"/></emitter>
     </shape>
     <shape type="rectangle">
         <transform name="to_world"><scale x="1.1" y="1.1"/><translate x="-1.2"/></transform>
-        <bsdf type="diffuse">
-            <texture type="bitmap" name="reflectance">
-                <string name="filename" value="{jpeg}"/>
-            </texture>
-        </bsdf>
+{left}
     </shape>
     <shape type="rectangle">
         <transform name="to_world"><scale x="1.1" y="1.1"/><translate x="1.2"/></transform>
-        <bsdf type="diffuse">
+{right}
+    </shape>
+</scene>
+"""
+
+
+def scene(jpeg: pathlib.Path, color0: str, color1: str) -> str:
+    return two_panels(f"""        <bsdf type="diffuse">
+            <texture type="bitmap" name="reflectance">
+                <string name="filename" value="{jpeg}"/>
+            </texture>
+        </bsdf>""", f"""        <bsdf type="diffuse">
             <texture type="checkerboard" name="reflectance">
                 <rgb name="color0" value="{color0}"/>
                 <rgb name="color1" value="{color1}"/>
                 <transform name="to_uv"><scale x="4" y="2"/><translate x="0.1"/></transform>
             </texture>
-        </bsdf>
-    </shape>
-</scene>
-"""
+        </bsdf>""")
 
 
 def _jpeg(tmp: pathlib.Path) -> pathlib.Path:
