@@ -327,6 +327,27 @@ fn medium_coefficients_take_numbers_rgb_and_samples() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The mean over a 32 × 32 image looking down −z of f(cos θ), θ each pixel's ray from
+/// the axis: each pixel's mean over its area by 4 × 4 points (what a slab of the
+/// thickness in f renders, exactly, seen through every pixel).
+fn image_mean_over_cos(cam: &heron::camera::Camera, f: &dyn Fn(f64) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for y in 0..32 {
+        for x in 0..32 {
+            for sy in 0..4 {
+                for sx in 0..4 {
+                    let w = cam.direction(
+                        x as f32 + (sx as f32 + 0.5) / 4.0,
+                        y as f32 + (sy as f32 + 0.5) / 4.0,
+                    );
+                    sum += f(-w.z as f64);
+                }
+            }
+        }
+    }
+    sum / (32 * 32 * 16) as f64
+}
+
 /// E_n(x) = ∫₁^∞ e^{−xt} t^{−n} dt, by the midpoint rule on t = 1/μ, μ ∈ (0, 1]:
 /// E_n(x) = ∫₀¹ μ^{n−2} e^{−x/μ} dμ.
 fn exponential_integral(n: i32, x: f64) -> f64 {
@@ -379,29 +400,12 @@ material = "sheet"
             ),
         )
     };
-    // exp(−σ_a d / cos θ) per pixel direction, as the slab test (4 × 4 points a pixel).
-    let mean_over_pixels = |f: &dyn Fn(f64) -> f64| {
-        let cam = &scene(
-            r#"type = "thin-dielectric"
+    let cam = scene(
+        r#"type = "thin-dielectric"
 ior = 1.0"#,
-        )
-        .camera;
-        let mut sum = 0.0;
-        for y in 0..32 {
-            for x in 0..32 {
-                for sy in 0..4 {
-                    for sx in 0..4 {
-                        let w = cam.direction(
-                            x as f32 + (sx as f32 + 0.5) / 4.0,
-                            y as f32 + (sy as f32 + 0.5) / 4.0,
-                        );
-                        sum += f(-w.z as f64);
-                    }
-                }
-            }
-        }
-        sum / (32 * 32 * 16) as f64
-    };
+    )
+    .camera;
+    let mean_over_pixels = |f: &dyn Fn(f64) -> f64| image_mean_over_cos(&cam, f);
     // An index-1 sheet reflects nothing and lets everything through: the slab as if
     // the sheet were not there.
     let clear = mean_over_pixels(&|cos| (-sigma_a * 1.5 / cos).exp());
@@ -463,23 +467,7 @@ medium = {{ type = "henyey-greenstein", sigma_a = {sigma_a}, sigma_s = 0.0 }}
     );
     // Pixels see the slab at up to 10° off its normal: the path length there is
     // 1.5/cos, so the expected value is the image's mean of exp(−σ_a 1.5 / cos θ).
-    let cam = &scene.camera;
-    let mut expected = 0.0;
-    for y in 0..32 {
-        for x in 0..32 {
-            // The pixel's mean over its area, by 4 × 4 points.
-            for sy in 0..4 {
-                for sx in 0..4 {
-                    let w = cam.direction(
-                        x as f32 + (sx as f32 + 0.5) / 4.0,
-                        y as f32 + (sy as f32 + 0.5) / 4.0,
-                    );
-                    expected += (-sigma_a * 1.5 / (-w.z as f64)).exp();
-                }
-            }
-        }
-    }
-    expected /= (32 * 32 * 16) as f64;
+    let expected = image_mean_over_cos(&scene.camera, &|cos| (-sigma_a * 1.5 / cos).exp());
     assert_mean(&run(&scene, 256), expected, 0.005, "slab transmittance");
     let _ = std::fs::remove_dir_all(&dir);
 }
