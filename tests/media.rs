@@ -327,6 +327,30 @@ fn medium_coefficients_take_numbers_rgb_and_samples() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A purely absorbing slab z ∈ [−1.5, 0] (σ_a per unit, 100 wide) in front of a uniform
+/// environment of radiance 1, seen from z = 2 down −z by a 32 × 32 pinhole of d = 4, with
+/// `extra` TOML (tables: more shapes, `[render]`, materials) after it.
+fn absorbing_slab(dir: &Path, sigma_a: f64, extra: &str) -> Scene {
+    write_box(dir, "slab.obj", [-50.0, -50.0, -1.5], [50.0, 50.0, 0.0]);
+    load_in(
+        dir,
+        &format!(
+            r#"
+background = 1.0
+[camera]
+eye = [0.0, 0.0, 2.0]
+look_at = [0.0, 0.0, 0.0]
+d = 4.0
+resolution = [32, 32]
+[[shapes]]
+type = "mesh"
+file = "slab.obj"
+medium = {{ type = "henyey-greenstein", sigma_a = {sigma_a}, sigma_s = 0.0 }}
+{extra}"#
+        ),
+    )
+}
+
 /// The mean over a 32 × 32 image looking down −z of f(cos θ), θ each pixel's ray from
 /// the axis: each pixel's mean over its area by 4 × 4 points (what a slab of the
 /// thickness in f renders, exactly, seen through every pixel).
@@ -369,33 +393,23 @@ fn a_sheet_inside_a_medium_leaves_the_path_in_it() {
     // Once, the path tracer took crossing any surface against its normal as entering
     // that shape's (here: no) medium, so the slab's far half went unattenuated.
     let dir = temp_dir("sheet-in-slab");
-    write_box(&dir, "slab.obj", [-50.0, -50.0, -1.5], [50.0, 50.0, 0.0]);
     let sigma_a = 0.8f64;
     let scene = |material: &str| {
-        load_in(
+        absorbing_slab(
             &dir,
+            sigma_a,
             &format!(
                 r#"
-background = 1.0
-[camera]
-eye = [0.0, 0.0, 2.0]
-look_at = [0.0, 0.0, 0.0]
-d = 4.0
-resolution = [32, 32]
-[render]
-max_depth = 8
-[materials.sheet]
-{material}
-[[shapes]]
-type = "mesh"
-file = "slab.obj"
-medium = {{ type = "henyey-greenstein", sigma_a = {sigma_a}, sigma_s = 0.0 }}
 [[shapes]]
 type = "quad"
 origin = [-40.0, -40.0, -0.75]
 edge1 = [80.0, 0.0, 0.0]
 edge2 = [0.0, 80.0, 0.0]
 material = "sheet"
+[render]
+max_depth = 8
+[materials.sheet]
+{material}
 "#
             ),
         )
@@ -446,25 +460,8 @@ fn slab_transmittance_is_exponential() {
     // front of an environment of radiance 1: L = exp(−σ_a d). The path tracer samples
     // the free flight with σ_t, so each sample is 0 or 1 and the mean converges to T.
     let dir = temp_dir("slab");
-    write_box(&dir, "slab.obj", [-50.0, -50.0, -1.5], [50.0, 50.0, 0.0]);
     let sigma_a = 0.8f64;
-    let scene = load_in(
-        &dir,
-        &format!(
-            r#"
-background = 1.0
-[camera]
-eye = [0.0, 0.0, 2.0]
-look_at = [0.0, 0.0, 0.0]
-d = 4.0
-resolution = [32, 32]
-[[shapes]]
-type = "mesh"
-file = "slab.obj"
-medium = {{ type = "henyey-greenstein", sigma_a = {sigma_a}, sigma_s = 0.0 }}
-"#
-        ),
-    );
+    let scene = absorbing_slab(&dir, sigma_a, "");
     // Pixels see the slab at up to 10° off its normal: the path length there is
     // 1.5/cos, so the expected value is the image's mean of exp(−σ_a 1.5 / cos θ).
     let expected = image_mean_over_cos(&scene.camera, &|cos| (-sigma_a * 1.5 / cos).exp());
