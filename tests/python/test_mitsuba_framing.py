@@ -26,6 +26,16 @@ from heronrun import require_heron_bin
 SPP = 64
 SIZES = [(96, 96), (128, 96), (160, 90)]
 
+# The emitting rectangle both framing tests measure (off centre, 1.8 × 1.2, black
+# where light falls on it), and the scene's end.
+RECTANGLE = """    <shape type="rectangle">
+        <transform name="to_world"><scale x="0.9" y="0.6" z="1"/><translate x="0.6" y="0.35" z="0"/></transform>
+        <emitter type="area"><rgb name="radiance" value="1, 1, 1"/></emitter>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0, 0, 0"/></bsdf>
+    </shape>
+</scene>
+"""
+
 SCENE = """<scene version="3.0.0">
     <integrator type="path"><integer name="max_depth" value="2"/></integrator>
     <sensor type="perspective">
@@ -37,13 +47,7 @@ SCENE = """<scene version="3.0.0">
             <rfilter type="box"/>
         </film>
     </sensor>
-    <shape type="rectangle">
-        <transform name="to_world"><scale x="0.9" y="0.6" z="1"/><translate x="0.6" y="0.35" z="0"/></transform>
-        <emitter type="area"><rgb name="radiance" value="1, 1, 1"/></emitter>
-        <bsdf type="diffuse"><rgb name="reflectance" value="0, 0, 0"/></bsdf>
-    </shape>
-</scene>
-"""
+""" + RECTANGLE
 
 
 def _write(tmp: pathlib.Path, w: int, h: int, camera: str = "") -> pathlib.Path:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from test_mitsuba_framing import frame
+from test_mitsuba_framing import RECTANGLE, frame
 from test_mitsuba_xml import render_heron, render_mitsuba
 
 SPP = 64
@@ -41,13 +41,7 @@ SCENE = """<scene version="3.0.0">
             <rfilter type="box"/>
         </film>
     </sensor>
-    <shape type="rectangle">
-        <transform name="to_world"><scale x="0.9" y="0.6" z="1"/><translate x="0.6" y="0.35" z="0"/></transform>
-        <emitter type="area"><rgb name="radiance" value="1, 1, 1"/></emitter>
-        <bsdf type="diffuse"><rgb name="reflectance" value="0, 0, 0"/></bsdf>
-    </shape>
-</scene>
-"""
+""" + RECTANGLE
 
 
 def _xml(tmp_path):
