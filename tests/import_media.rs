@@ -7,7 +7,7 @@
 //! tests/python/test_mitsuba_media.py.
 mod common;
 
-use heron::medium::Medium;
+use heron::medium::{Medium, Optics};
 use heron::scene::import::{import_scene, ImportOptions, Imported};
 use heron::scene::load::load_imported;
 use heron::spectrum::uplift::rgb_to_reflectance;
@@ -69,8 +69,10 @@ trait CloneMedia {
 impl CloneMedia for Vec<Medium> {
     fn clone_media(&self) -> Vec<Medium> {
         self.iter()
-            .map(|m| match m {
-                Medium::HenyeyGreenstein(h) => Medium::HenyeyGreenstein(h.clone()),
+            .map(|m| match &m.optics {
+                Optics::HenyeyGreenstein(h) => {
+                    Medium::homogeneous(Optics::HenyeyGreenstein(h.clone()))
+                }
                 other => panic!("expected a Henyey-Greenstein medium, got {other:?}"),
             })
             .collect()
@@ -136,7 +138,7 @@ fn mitsuba_homogeneous_media_fill_null_cubes_and_glass_spheres() {
     // Both load: the cube is closed around its medium.
     let media = media_of(&imp);
     assert_eq!(media.len(), 2);
-    let Medium::HenyeyGreenstein(h) = &media[0] else {
+    let Optics::HenyeyGreenstein(h) = &media[0].optics else {
         unreachable!()
     };
     assert!(h.sigma_t.eval(450.0) > h.sigma_t.eval(650.0) * 0.5);
@@ -290,7 +292,8 @@ fn a_converted_medium_scene_reads_back_the_same() {
     std::fs::write(&p, &toml_text).unwrap();
     let again = heron::scene::load::load_scene(Path::new(&p)).unwrap_or_else(|e| panic!("{e}"));
     let first = media_of(&imp);
-    let (Medium::HenyeyGreenstein(a), Medium::HenyeyGreenstein(b)) = (&first[0], &again.media[0])
+    let (Optics::HenyeyGreenstein(a), Optics::HenyeyGreenstein(b)) =
+        (&first[0].optics, &again.media[0].optics)
     else {
         unreachable!()
     };

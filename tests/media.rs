@@ -25,7 +25,7 @@ use common::render::{mean_se, mean_se_y};
 use glam::{Vec2, Vec3};
 use heron::film::Film;
 use heron::light::Light;
-use heron::medium::{HgMedium, LorenzMieMedium, Medium, MieSpec, PopulationNode};
+use heron::medium::{HgMedium, LorenzMieMedium, Medium, MieSpec, Optics, PopulationNode};
 use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{Scene, SceneParts};
@@ -45,7 +45,7 @@ fn mie(radius_m: f64, absorption: bool) -> Medium {
 }
 
 fn mie_cut(radius_m: f64, absorption: bool, forward_cutoff_deg: f64) -> Medium {
-    Medium::LorenzMie(LorenzMieMedium::new(MieSpec {
+    Medium::homogeneous(Optics::LorenzMie(LorenzMieMedium::new(MieSpec {
         population: vec![PopulationNode {
             radius_m,
             number_density: 1.0,
@@ -53,7 +53,7 @@ fn mie_cut(radius_m: f64, absorption: bool, forward_cutoff_deg: f64) -> Medium {
         absorption,
         lambda_step_nm: 10.0,
         forward_cutoff_deg,
-    }))
+    })))
 }
 
 fn chi2_phase(name: &str, m: &Medium, lambda: f32, domain: &Spherical) -> Outcome {
@@ -79,16 +79,16 @@ fn chi2_phase(name: &str, m: &Medium, lambda: f32, domain: &Spherical) -> Outcom
 #[test]
 fn phase_sampling_passes_chi_square() {
     let d_in = Vec3::new(0.3, -0.5, 0.8).normalize();
-    let hg = Medium::HenyeyGreenstein(HgMedium::new(
+    let hg = Medium::homogeneous(Optics::HenyeyGreenstein(HgMedium::new(
         DenseSpectrum::constant(0.0),
         DenseSpectrum::constant(1.0),
         0.7,
-    ));
-    let back = Medium::HenyeyGreenstein(HgMedium::new(
+    )));
+    let back = Medium::homogeneous(Optics::HenyeyGreenstein(HgMedium::new(
         DenseSpectrum::constant(0.0),
         DenseSpectrum::constant(1.0),
         -0.4,
-    ));
+    )));
     // 0.5 µm drops (x ≈ 4–9): a smooth, anisotropic phase function over the sphere.
     let small = mie(0.5e-6, true);
     // 10 µm drops (x ≈ 75–175): the diffraction peak (first zero near 3.8/x ≈ 0.03 rad)
@@ -110,7 +110,7 @@ fn mie_table_resolves_the_forward_peak_and_normalises() {
     // which is 1 when the angle grid resolves the function (the diffraction peak holds
     // about half of it): within 1% for fog and rain drops.
     for r in [10e-6, 0.25e-3] {
-        let Medium::LorenzMie(m) = mie(r, true) else {
+        let Optics::LorenzMie(m) = mie(r, true).optics else {
             unreachable!()
         };
         for (i, &v) in m.phase.raw_integral.iter().enumerate() {
@@ -298,8 +298,8 @@ fn medium_coefficients_take_numbers_rgb_and_samples() {
             &format!(r#"{{ type = "henyey-greenstein", sigma_a = 0.1, sigma_s = {sigma} }}"#),
             "",
         );
-        load_scene_from_str(&text, &dir.join("c.toml")).map(|s| match &s.media[0] {
-            Medium::HenyeyGreenstein(m) => m.clone(),
+        load_scene_from_str(&text, &dir.join("c.toml")).map(|s| match &s.media[0].optics {
+            Optics::HenyeyGreenstein(m) => m.clone(),
             other => panic!("{other:?}"),
         })
     };
@@ -599,7 +599,7 @@ irradiance = 1.0
             a_m * 1e3
         ),
     );
-    let Medium::LorenzMie(m) = &slab.media[0] else {
+    let Optics::LorenzMie(m) = &slab.media[0].optics else {
         unreachable!()
     };
     let cos_g = -travel.z as f64;
@@ -1082,7 +1082,7 @@ fn drop_size_distributions_fill_the_medium() {
         )
     };
     let coefficients = |scene: &Scene, lambda: f32| {
-        let Medium::LorenzMie(m) = &scene.media[0] else {
+        let Optics::LorenzMie(m) = &scene.media[0].optics else {
             panic!("not a Lorenz-Mie medium")
         };
         (m.sigma_t.eval(lambda) as f64, m.sigma_s.eval(lambda) as f64)

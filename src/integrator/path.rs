@@ -89,7 +89,9 @@ use crate::geometry::{Interaction, Ray, SpawnPoint};
 use crate::light::SurfacePoint;
 use crate::math::warp::power_heuristic;
 use crate::math::Frame;
-use crate::medium::{Medium, NO_MEDIUM};
+use crate::math::Rng;
+use crate::medium::tracking::{delta_tracking, Flight, Weights};
+use crate::medium::{Density, Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene, NO_LIGHT};
 use crate::settings::{on, KernelFlags, MediumNee, Packets, EMITTERS, ESCAPE, MEDIA, SHADOWS};
@@ -274,6 +276,9 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
 ) -> Segment {
     let (ctx, wl) = (tc.ctx, tc.wl);
     let m = &ctx.scene.media[s.medium as usize];
+    if let Some(density) = &m.density {
+        return heterogeneous_segment::<N, K, S, T>(tc, s, ray, h, m, density);
+    }
     let sigma_t = m.sigma_t(wl);
     let u_dist = tc.sampler.get_1d();
     let forced = on(K, SHADOWS) && ctx.settings.medium_nee == MediumNee::Forced;
@@ -341,12 +346,88 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
     s.beta *= m.sigma_s(wl) * tr / pdf;
     let r_before = s.r_u;
     s.r_u *= sigma_t * tr / pdf;
+    medium_vertex::<N, K, S, T>(tc, s, ray, m, t, forced.then_some((r_before, r_light)))
+}
+
+/// The segment of `ray` inside a heterogeneous medium up to `h`: delta tracking of the
+/// hero's free flight through the density's majorants (`medium::tracking`), the null
+/// collisions' weights and rescaled probabilities updated there, then the surface or a
+/// real collision, where the light is sampled (next-event estimation at the collision:
+/// [`MediumNee::Forced`]'s point drawn within the segment needs the segment's
+/// transmittance in closed form, which a heterogeneous medium has not) and the
+/// direction drawn as in a homogeneous medium. Reads the free flight's number (its first
+/// distance; the rest come from a stream keyed by the ray) and then, at a collision, the
+/// five numbers of a vertex.
+#[inline(always)]
+fn heterogeneous_segment<
+    const N: usize,
+    const K: KernelFlags,
+    S: ShadowSink<N>,
+    T: Transport<N>,
+>(
+    tc: &mut Tracer<N, S, T>,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    h: &Hit,
+    m: &Medium,
+    density: &Density,
+) -> Segment {
+    let wl = tc.wl;
+    let k = m.sigma_t(wl);
+    let u_dist = tc.sampler.get_1d();
+    let (o, d) = (ray.origin, ray.dir);
+    let mut rng = Rng::keyed(&[o.x, o.y, o.z, d.x, d.y, d.z, h.t, u_dist]);
+    let mut w = Weights {
+        beta: s.beta,
+        r_u: s.r_u,
+        r_l: s.r_l,
+    };
+    let flight = delta_tracking(density, (o, d, h.t), k, u_dist, &mut rng, &mut w);
+    (s.beta, s.r_u, s.r_l) = (w.beta, w.r_u, w.r_l);
+    match flight {
+        Flight::Escaped { tr } => {
+            let pdf = tr.0[0];
+            if !(pdf > 0.0) {
+                return Segment::Ended;
+            }
+            s.beta *= tr / pdf;
+            s.r_u *= tr / pdf;
+            // Ratio tracking passes the last stretch with the same T̄.
+            s.r_l *= tr / pdf;
+            Segment::Crossed
+        }
+        Flight::Collided { t, rho, tr } => {
+            let pdf = tr.0[0] * rho * k.0[0];
+            if !(pdf > 0.0) {
+                return Segment::Ended;
+            }
+            s.beta *= m.sigma_s(wl) * (tr * (rho / pdf));
+            s.r_u *= k * (tr * (rho / pdf));
+            medium_vertex::<N, K, S, T>(tc, s, ray, m, t, None)
+        }
+    }
+}
+
+/// A scattering event at distance `t` along `ray` in medium `m`, the path's weight and
+/// r_u already holding the collision's density: the light sample (at the collision,
+/// unless `forced` carries the forced light sample's (r_u before the collision, its
+/// distance ratio), which r_l then takes), the new direction and Russian roulette.
+#[inline(always)]
+fn medium_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
+    tc: &mut Tracer<N, S, T>,
+    s: &mut PathState<N>,
+    ray: &mut Ray,
+    m: &Medium,
+    t: f32,
+    forced: Option<(SampledSpectrum<N>, SampledSpectrum<N>)>,
+) -> Segment {
+    let (ctx, wl) = (tc.ctx, tc.wl);
     if s.depth == ctx.settings.max_depth || s.beta.is_zero() {
         return Segment::Ended;
     }
     s.depth += 1;
     let p = ray.at(t);
-    let (u_light, u_light_point) = if forced {
+    let (u_light, u_light_point) = if forced.is_some() {
         (0.0, Vec2::ZERO)
     } else {
         (tc.sampler.get_1d(), tc.sampler.get_2d())
@@ -355,7 +436,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
     let u_dir = tc.sampler.get_2d();
     let u_rr = tc.sampler.get_1d();
     let alive = s.bsdf_ctx.companions_alive;
-    if on(K, SHADOWS) && !forced {
+    if on(K, SHADOWS) && forced.is_none() {
         let v = MediumVertex {
             p,
             dir: ray.dir,
@@ -378,10 +459,9 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
         return Segment::Ended;
     }
     s.beta *= pv / pdf;
-    s.r_l = if forced {
-        r_before * r_light / pdf
-    } else {
-        s.r_u / pdf
+    s.r_l = match forced {
+        Some((r_before, r_light)) => r_before * r_light / pdf,
+        None => s.r_u / pdf,
     };
     s.r_u *= q / pdf;
     s.specular_bounce = false;

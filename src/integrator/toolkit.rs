@@ -17,7 +17,8 @@ use crate::film::tile::SampleValue;
 use crate::film::Splats;
 use crate::geometry::{Ray, SpawnPoint};
 use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
-use crate::math::Frame;
+use crate::math::{Frame, Rng};
+use crate::medium::tracking::ratio_tracking;
 use crate::medium::{Medium, NO_MEDIUM};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -175,6 +176,9 @@ pub(crate) struct TransmittanceWalk<const N: usize> {
     /// The next query.
     pub q: RayQuery,
     tr: SampledSpectrum<N>,
+    /// The light technique's relative density of the null vertices ratio tracking made
+    /// in heterogeneous media (`medium::tracking`); 1 through homogeneous ones.
+    a: SampledSpectrum<N>,
     medium: u32,
     wi: Vec3,
     dist: f32,
@@ -186,8 +190,9 @@ pub(crate) struct TransmittanceWalk<const N: usize> {
 pub(crate) enum WalkStep<const N: usize> {
     /// A boundary crossed: the walk goes on with its next query.
     Next,
-    /// The target reached, with the transmittance along the way.
-    Done(SampledSpectrum<N>),
+    /// The target reached, with the transmittance along the way and the light
+    /// technique's relative density of its null vertices.
+    Done(SampledSpectrum<N>, SampledSpectrum<N>),
     /// Another surface, too many boundaries, or points too close to tell apart.
     Blocked,
 }
@@ -206,6 +211,7 @@ impl<const N: usize> TransmittanceWalk<N> {
         Some(TransmittanceWalk {
             q: ctx.offset.shadow(from, wi, dist, to)?,
             tr: SampledSpectrum::splat(1.0),
+            a: SampledSpectrum::splat(1.0),
             medium,
             wi,
             dist,
@@ -233,16 +239,16 @@ impl<const N: usize> TransmittanceWalk<N> {
                 if !len.is_finite() {
                     return WalkStep::Blocked;
                 }
-                self.tr *= scene.media[self.medium as usize].transmittance(len, wl);
+                self.stretch(ctx, len, wl);
             }
-            return WalkStep::Done(self.tr);
+            return WalkStep::Done(self.tr, self.a);
         };
         let g = h.geom_id as usize;
         if !scene.shapes[g].interface {
             return WalkStep::Blocked;
         }
         if self.medium != NO_MEDIUM {
-            self.tr *= scene.media[self.medium as usize].transmittance(h.t * scale, wl);
+            self.stretch(ctx, h.t * scale, wl);
         }
         let ray = Ray::new(q.origin, q.dir, q.tnear, q.tfar);
         let (it, _) = scene.interaction(&ray, &h, ctx.offset.is_robust());
@@ -272,6 +278,24 @@ impl<const N: usize> TransmittanceWalk<N> {
     }
 }
 
+impl<const N: usize> TransmittanceWalk<N> {
+    /// The stretch of length `len` of the current query inside the walk's medium:
+    /// exp(−σ_t len) in a homogeneous medium, ratio tracking in a heterogeneous one.
+    #[inline]
+    fn stretch(&mut self, ctx: &Context, len: f32, wl: &SampledWavelengths<N>) {
+        let m = &ctx.scene.media[self.medium as usize];
+        let Some(density) = &m.density else {
+            self.tr *= m.transmittance(len, wl);
+            return;
+        };
+        let (o, d) = (self.q.origin, self.q.dir.normalize());
+        let mut rng = Rng::keyed(&[o.x, o.y, o.z, d.x, d.y, d.z, len]);
+        let (tr, a) = ratio_tracking(density, (o, d, len), m.sigma_t(wl), &mut rng);
+        self.tr *= tr;
+        self.a *= a;
+    }
+}
+
 /// How a next-event contribution through media follows from the shadow ray's
 /// transmittance `tr`, kept while the packet engine walks the ray (the same arithmetic
 /// as the one-path-at-a-time code, in the same order).
@@ -285,10 +309,12 @@ pub(crate) enum Finish<const N: usize> {
         scale: f32,
     },
     /// At a medium vertex: β f tr L / d, where d is the balance heuristic's denominator
-    /// over (technique, hero) pairs: mean_λ r_u p_light for a delta light, else
-    /// mean_λ r_u (p_light + q tr), q_λ the density with which the phase-sampling
+    /// over (technique, hero) pairs: mean_λ r_u p_light a for a delta light, else
+    /// mean_λ r_u (p_light a + q tr), q_λ the density with which the phase-sampling
     /// technique reaches the vertex and leaves toward the light, relative to the light
-    /// technique's density of the vertex (`integrator::path`); nothing when d ≤ 0.
+    /// technique's density of the vertex (`integrator::path`), and a_λ the light
+    /// technique's relative density of the shadow ray's null vertices (1 without
+    /// heterogeneous media); nothing when d ≤ 0.
     Medium {
         beta: SampledSpectrum<N>,
         f: SampledSpectrum<N>,
@@ -303,7 +329,11 @@ pub(crate) enum Finish<const N: usize> {
 
 impl<const N: usize> Finish<N> {
     #[inline]
-    pub fn apply(&self, tr: SampledSpectrum<N>) -> Option<SampledSpectrum<N>> {
+    pub fn apply(
+        &self,
+        tr: SampledSpectrum<N>,
+        a: SampledSpectrum<N>,
+    ) -> Option<SampledSpectrum<N>> {
         match *self {
             Finish::Surface { beta, f, l, scale } => {
                 let f = f * tr;
@@ -320,9 +350,9 @@ impl<const N: usize> Finish<N> {
                 alive,
             } => {
                 let denom = if delta {
-                    lane_mean(r_u * pdf, alive)
+                    lane_mean(r_u * pdf * a, alive)
                 } else {
-                    lane_mean(r_u * (SampledSpectrum::splat(pdf) + q * tr), alive)
+                    lane_mean(r_u * (SampledSpectrum::splat(pdf) * a + q * tr), alive)
                 };
                 (denom > 0.0).then(|| beta * f * tr * l / denom)
             }
@@ -500,7 +530,7 @@ impl<const N: usize> ShadowSink<N> for Immediate {
             let hit = ctx.accel.intersect1(&walk.q);
             match walk.advance(ctx, hit, wl) {
                 WalkStep::Next => {}
-                WalkStep::Done(tr) => return finish.apply(tr),
+                WalkStep::Done(tr, a) => return finish.apply(tr, a),
                 WalkStep::Blocked => return None,
             }
         }
@@ -575,7 +605,7 @@ impl<const N: usize> Deferred<N> {
         };
         let c = match walk.advance(ctx, hit, wl) {
             WalkStep::Next => return true,
-            WalkStep::Done(tr) => finish.apply(tr),
+            WalkStep::Done(tr, a) => finish.apply(tr, a),
             WalkStep::Blocked => None,
         };
         if let Some(c) = c {

@@ -41,6 +41,20 @@ impl Rng {
         Rng::new(a, b)
     }
 
+    /// A stream keyed by the bits of a ray's numbers: the null-collision trackers'
+    /// (`medium::tracking`), which draw as many numbers as the ray meets tentative
+    /// collisions, so they cannot take fixed dimensions of the sampler; seeded from the
+    /// ray as pbrt-v4's `SampleT_maj` does (`RNG rng(Hash(ray.o, tMax), Hash(ray.d))`),
+    /// the same ray gives the same numbers whatever the thread.
+    #[inline]
+    pub fn keyed(keys: &[f32]) -> Self {
+        let mut a = 0x2545_F491_4F6C_DD1Du64;
+        for k in keys {
+            a = splitmix64(a ^ k.to_bits() as u64);
+        }
+        Rng::new(a, splitmix64(a ^ 0xA076_1D64_78BD_642F))
+    }
+
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;

@@ -26,10 +26,13 @@
 //! Directions: the phase functions take the angle θ between the path's propagation
 //! direction `d_in` (the ray that reached the scattering point) and the new direction;
 //! θ = 0 is forward. Being reciprocal, p is the same for light and importance.
+pub mod density;
 pub mod henyey_greenstein;
 pub mod homogeneous;
 pub mod phase_table;
+pub mod tracking;
 
+pub use density::Density;
 pub use henyey_greenstein::HgMedium;
 pub use homogeneous::{LorenzMieMedium, MieSpec, PopulationNode};
 
@@ -41,32 +44,56 @@ use phase_table::{direction_at, v_between};
 /// `Shape::medium` of a shape without a medium (defined with the shape).
 pub use crate::geometry::NO_MEDIUM;
 
-/// A participating medium.
+/// What a medium is made of: its coefficients at unit density and its phase function.
 // A scene holds a handful of media, so the variants' sizes cost nothing; boxing the
 // tabulated one would put an indirection in every phase lookup.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
-pub enum Medium {
+pub enum Optics {
     LorenzMie(LorenzMieMedium),
     HenyeyGreenstein(HgMedium),
 }
 
+/// A participating medium: its optics, homogeneous, or scaled by a density field
+/// (`density`: heterogeneous, tracked with null collisions, `tracking`).
+#[derive(Debug)]
+pub struct Medium {
+    pub optics: Optics,
+    pub density: Option<density::Density>,
+}
+
 impl Medium {
+    /// A homogeneous medium.
+    pub fn homogeneous(optics: Optics) -> Medium {
+        Medium {
+            optics,
+            density: None,
+        }
+    }
+
+    /// The Lorenz–Mie tables, if the medium is made of water drops.
+    pub fn lorenz_mie(&self) -> Option<&LorenzMieMedium> {
+        match &self.optics {
+            Optics::LorenzMie(m) => Some(m),
+            Optics::HenyeyGreenstein(_) => None,
+        }
+    }
+
     /// Extinction coefficient at each lane.
     #[inline]
     pub fn sigma_t<const N: usize>(&self, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
-        match self {
-            Medium::LorenzMie(m) => wl.eval(&m.sigma_t),
-            Medium::HenyeyGreenstein(m) => wl.eval(&m.sigma_t),
+        match &self.optics {
+            Optics::LorenzMie(m) => wl.eval(&m.sigma_t),
+            Optics::HenyeyGreenstein(m) => wl.eval(&m.sigma_t),
         }
     }
 
     /// Scattering coefficient at each lane.
     #[inline]
     pub fn sigma_s<const N: usize>(&self, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
-        match self {
-            Medium::LorenzMie(m) => wl.eval(&m.sigma_s),
-            Medium::HenyeyGreenstein(m) => wl.eval(&m.sigma_s),
+        match &self.optics {
+            Optics::LorenzMie(m) => wl.eval(&m.sigma_s),
+            Optics::HenyeyGreenstein(m) => wl.eval(&m.sigma_s),
         }
     }
 
@@ -91,9 +118,9 @@ impl Medium {
         wl: &SampledWavelengths<N>,
     ) -> SampledSpectrum<N> {
         let v = v_between(d_in, d_out);
-        match self {
-            Medium::LorenzMie(m) => m.phase.eval(v, &wl.lambda),
-            Medium::HenyeyGreenstein(m) => SampledSpectrum::splat(henyey_greenstein::hg(m.g, v)),
+        match &self.optics {
+            Optics::LorenzMie(m) => m.phase.eval(v, &wl.lambda),
+            Optics::HenyeyGreenstein(m) => SampledSpectrum::splat(henyey_greenstein::hg(m.g, v)),
         }
     }
 
@@ -110,7 +137,7 @@ impl Medium {
         d_out: Vec3,
         wl: &SampledWavelengths<N>,
     ) -> Option<([Mat4; N], Vec3)> {
-        let Medium::LorenzMie(m) = self else {
+        let Optics::LorenzMie(m) = &self.optics else {
             return None;
         };
         if !m.phase.has_matrix() {
@@ -146,9 +173,9 @@ impl Medium {
         u: Vec2,
         wl: &SampledWavelengths<N>,
     ) -> (Vec3, SampledSpectrum<N>) {
-        let (v, p) = match self {
-            Medium::LorenzMie(m) => m.phase.sample(u_node, u.x, &wl.lambda),
-            Medium::HenyeyGreenstein(m) => {
+        let (v, p) = match &self.optics {
+            Optics::LorenzMie(m) => m.phase.sample(u_node, u.x, &wl.lambda),
+            Optics::HenyeyGreenstein(m) => {
                 let (v, p) = henyey_greenstein::sample_hg(m.g, u.x);
                 (v, SampledSpectrum::splat(p))
             }

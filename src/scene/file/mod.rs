@@ -63,6 +63,7 @@ use std::fmt::Write as _;
 
 mod coefficient;
 mod colour;
+mod density;
 mod emission;
 mod leaves;
 mod metal;
@@ -71,6 +72,7 @@ mod texture;
 
 pub use coefficient::Coefficient;
 pub use colour::{Colour, Emission, Reflectance};
+pub use density::{DensityFile, GridFile, HeightFogFile, NoiseFile, RainShaftFile};
 pub use emission::ShapeEmission;
 pub use leaves::{
     Direction3, IorSpec, Point2, Point3, PositiveCount, PositiveNumber, Resolution, UnitNumber,
@@ -806,6 +808,10 @@ pub struct MediumFile {
     pub sigma_s: Option<Coefficient>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub g: Option<f32>,
+    /// A density field scaling the coefficients (a heterogeneous medium); default none
+    /// (homogeneous).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<DensityFile>,
 }
 
 /// The `type` of a [`MediumFile`] (read as a string and matched in the loader's media
@@ -967,6 +973,7 @@ mod tests {
         assert_eq!(serde_tags::<ShapeFile>(), ShapeFile::NAMES);
         assert_eq!(serde_tags::<LightFile>(), LightFile::NAMES);
         assert_eq!(serde_tags::<TextureFile>(), TextureFile::NAMES);
+        assert_eq!(serde_tags::<DensityFile>(), DensityFile::NAMES);
         // Each shape type's entry reports its own name.
         for (name, keys) in [
             ("sphere", "center = [0, 0, 0]\nradius = 1"),

@@ -318,5 +318,6 @@ pub fn hg_medium(
         sigma_a: Some(sigma_a),
         sigma_s: Some(sigma_s),
         g: Some(g as f32),
+        density: None,
     }
 }

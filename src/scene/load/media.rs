@@ -2,20 +2,32 @@
 //! or Henyey–Greenstein), checked against its type, and given to closed shapes whose
 //! surface lets light in; each distinct medium is tabulated once.
 use super::materials::Materials;
+use super::shapes::{grow_box, EMPTY_BOX};
 use super::SkyTables;
 use crate::bsdf::Material;
 use crate::geometry::Shape;
-use crate::medium::{HgMedium, LorenzMieMedium, Medium};
-use crate::scene::file::{MediumFile, MediumType, ShapeFile};
+use crate::medium::density::{Density, Field, Grid, HeightFog, Noise, RainShaft};
+use crate::medium::{HgMedium, LorenzMieMedium, Medium, Optics};
+use crate::scene::file::{DensityFile, Direction3, MediumFile, MediumType, ShapeFile};
 use crate::spectrum::DenseSpectrum;
+use glam::Vec3;
+use std::path::Path;
 
 /// Drop-size quadrature nodes of a medium's distribution when its table gives none:
 /// each node is one Lorenz–Mie tabulation (about 16 s for 0.5 mm drops).
 pub const MEDIUM_DEFAULT_NODES: usize = 8;
 
-/// What a `medium` table builds: the key path is `at` (`shapes[i].medium`).
+/// What a `medium` table builds: its optics and, for a heterogeneous medium, its
+/// density field (built once its shapes' box is known).
 #[derive(Clone, Debug, PartialEq)]
-pub(super) enum MediumPlan {
+pub(super) struct MediumPlan {
+    optics: OpticsPlan,
+    density: Option<DensityPlan>,
+}
+
+/// A medium's optics: the key path is `at` (`shapes[i].medium`).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum OpticsPlan {
     Mie(crate::medium::MieSpec),
     Hg {
         sigma_a: DenseSpectrum,
@@ -24,35 +36,55 @@ pub(super) enum MediumPlan {
     },
 }
 
-impl MediumPlan {
+impl OpticsPlan {
     /// The medium (for Lorenz–Mie, its tabulation: seconds for rain drops).
     fn build(&self) -> Medium {
         match self {
-            MediumPlan::Mie(spec) => Medium::LorenzMie(LorenzMieMedium::new(spec.clone())),
-            MediumPlan::Hg {
+            OpticsPlan::Mie(spec) => {
+                Medium::homogeneous(Optics::LorenzMie(LorenzMieMedium::new(spec.clone())))
+            }
+            OpticsPlan::Hg {
                 sigma_a,
                 sigma_s,
                 g,
-            } => Medium::HenyeyGreenstein(HgMedium::new(sigma_a.clone(), sigma_s.clone(), *g)),
+            } => Medium::homogeneous(Optics::HenyeyGreenstein(HgMedium::new(
+                sigma_a.clone(),
+                sigma_s.clone(),
+                *g,
+            ))),
         }
     }
 }
 
-/// The plan of each entry's `medium` table (None: the entry has none), checked.
-pub(super) fn plan_media(entries: &[ShapeFile]) -> Result<Vec<Option<MediumPlan>>, String> {
+/// The plan of each entry's `medium` table (None: the entry has none), checked; density
+/// grids are read from files relative to `base_dir`, which join `inputs`.
+pub(super) fn plan_media(
+    entries: &[ShapeFile],
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> Result<Vec<Option<MediumPlan>>, String> {
     entries
         .iter()
         .enumerate()
         .map(|(i, s)| {
             s.medium()
-                .map(|m| plan_medium(&format!("shapes[{i}].medium"), m))
+                .map(|m| {
+                    let at = format!("shapes[{i}].medium");
+                    let optics = plan_optics(&at, m)?;
+                    let density = m
+                        .density
+                        .as_ref()
+                        .map(|d| plan_density(&format!("{at}.density"), d, base_dir, inputs))
+                        .transpose()?;
+                    Ok(MediumPlan { optics, density })
+                })
                 .transpose()
         })
         .collect()
 }
 
-/// Checks a `medium` table against its type.
-fn plan_medium(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+/// Checks a `medium` table's optics against its type.
+fn plan_optics(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> {
     match MediumType::from_name(&m.kind) {
         Some(MediumType::Mie) => plan_mie(at, m),
         Some(MediumType::HenyeyGreenstein) => plan_hg(at, m),
@@ -77,7 +109,7 @@ fn given(name: &'static str, v: bool) -> Option<&'static str> {
 /// number density or a liquid water content. Radii are limited to 0.1 µm–1 mm: the
 /// Lorenz–Mie series has x + 4x^{1/3} + 2 terms per angle (x = 2πr/λ, 17 500 at 1 mm and
 /// 360 nm), so larger drops would take minutes to tabulate.
-fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> {
     if let Some(k) = given("sigma_a", m.sigma_a.is_some())
         .or(given("sigma_s", m.sigma_s.is_some()))
         .or(given("g", m.g.is_some()))
@@ -170,7 +202,7 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String>
             "{at}.forward_cutoff: expected degrees in [0, 10] (the diffraction peak counted as unscattered), got {cutoff}"
         ));
     }
-    Ok(MediumPlan::Mie(crate::medium::MieSpec {
+    Ok(OpticsPlan::Mie(crate::medium::MieSpec {
         population: nodes
             .iter()
             .map(|n| crate::medium::PopulationNode {
@@ -185,7 +217,7 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String>
 }
 
 /// A `type = "henyey-greenstein"` medium: σ_a, σ_s and g given.
-fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> {
+fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> {
     if let Some(k) = given("radius_mm", m.radius_mm.is_some())
         .or(given("drops", m.drops.is_some()))
         .or(given("number_density", m.number_density.is_some()))
@@ -226,7 +258,7 @@ fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<MediumPlan, String> 
             show(&m.sigma_s)
         ));
     }
-    Ok(MediumPlan::Hg {
+    Ok(OpticsPlan::Hg {
         sigma_a,
         sigma_s,
         g,
@@ -249,6 +281,7 @@ pub(super) fn assign_media(
 ) -> Result<Vec<Medium>, String> {
     let mut media: Vec<Medium> = Vec::new();
     let mut medium_plans: Vec<&MediumPlan> = Vec::new();
+    let mut boxes = Vec::new();
     for k in 0..shapes.len() {
         let i = shape_entry[k];
         let Some(plan) = &plans[i] else { continue };
@@ -287,18 +320,125 @@ pub(super) fn assign_media(
                 ))
             }
         }
-        if sky_tables == SkyTables::Skip && matches!(plan, MediumPlan::Mie(_)) {
+        if sky_tables == SkyTables::Skip && matches!(plan.optics, OpticsPlan::Mie(_)) {
             continue;
         }
         let id = match medium_plans.iter().position(|p| *p == plan) {
             Some(id) => id,
             None => {
-                media.push(plan.build());
+                media.push(plan.optics.build());
                 medium_plans.push(plan);
+                boxes.push(EMPTY_BOX);
                 media.len() - 1
             }
         };
+        boxes[id] = grow_box(boxes[id], shape);
         shape.medium = id as u32;
     }
+    // A heterogeneous medium's majorants cover the box of every shape that holds it.
+    for ((m, plan), (lo, hi)) in media.iter_mut().zip(&medium_plans).zip(boxes) {
+        if let Some(d) = &plan.density {
+            m.density = Some(d.build(lo, hi));
+        }
+    }
     Ok(media)
+}
+
+/// A density field as planned: built once the medium's box is known (noise is baked
+/// over it).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum DensityPlan {
+    Field(Field),
+    Noise(Noise),
+}
+
+impl DensityPlan {
+    fn build(&self, lo: Vec3, hi: Vec3) -> Density {
+        let field = match self {
+            DensityPlan::Field(f) => f.clone(),
+            DensityPlan::Noise(n) => Field::Grid(n.bake(lo, hi)),
+        };
+        Density::new(field, lo, hi)
+    }
+}
+
+/// Checks a `density` table: the key path is `at` (`shapes[i].medium.density`).
+fn plan_density(
+    at: &str,
+    d: &DensityFile,
+    base_dir: &Path,
+    inputs: &mut Vec<String>,
+) -> std::result::Result<DensityPlan, String> {
+    let up = |u: &Option<Direction3>| u.map_or(Vec3::Y, |u| u.unit());
+    Ok(match d {
+        DensityFile::HeightFog(f) => DensityPlan::Field(Field::HeightFog(HeightFog {
+            up: up(&f.up),
+            base: f.base.unwrap_or(0.0) as f32,
+            scale_height: f.scale_height.get(),
+        })),
+        DensityFile::RainShaft(f) => {
+            let spread = f.spread.map_or(0.0, |s| s.get() as f32);
+            if spread >= 60.0 {
+                return Err(format!(
+                    "{at}.spread: expected the cone's half-angle in degrees in [0, 60), got {spread}"
+                ));
+            }
+            DensityPlan::Field(Field::RainShaft(RainShaft {
+                center: f.center.get(),
+                up: up(&f.up),
+                radius: f.radius.get(),
+                edge: f.edge.map_or(0.0, |e| e.get() as f32),
+                spread: spread.to_radians().tan(),
+                falloff: f.falloff.map_or(f32::INFINITY, |f| f.get()),
+            }))
+        }
+        DensityFile::Noise(n) => {
+            let octaves = n.octaves.map_or(4, |o| o.0);
+            if octaves > 8 {
+                return Err(format!(
+                    "{at}.octaves: expected 1 to 8 octaves, got {octaves}"
+                ));
+            }
+            let threshold = n.threshold.map_or(0.5, |t| t.get());
+            if threshold >= 1.0 {
+                return Err(format!(
+                    "{at}.threshold: expected the clear part of the noise's range in [0, 1), got {threshold}"
+                ));
+            }
+            let resolution = n.resolution.map_or(64, |r| r.0);
+            if !(2..=512).contains(&resolution) {
+                return Err(format!(
+                    "{at}.resolution: expected 2 to 512 cells along the box's longest side, got {resolution}"
+                ));
+            }
+            DensityPlan::Noise(Noise {
+                seed: n.seed.unwrap_or(0),
+                scale: n.scale.get(),
+                octaves,
+                threshold,
+                resolution,
+            })
+        }
+        DensityFile::Grid(g) => {
+            let path = base_dir.join(&g.file);
+            let bytes = std::fs::read(&path)
+                .map_err(|e| format!("{at}.file: cannot read {}: {e}", path.display()))?;
+            inputs.push(g.file.clone());
+            let mut grid = Grid::from_vol(&bytes)
+                .map_err(|e| format!("{at}.file: {}: {e}", path.display()))?;
+            if let Some(lo) = g.min {
+                grid.lo = lo.get();
+            }
+            if let Some(hi) = g.max {
+                grid.hi = hi.get();
+            }
+            if !grid.lo.cmplt(grid.hi).all() {
+                return Err(format!(
+                    "{at}: expected min < max in each axis, got min {} and max {}",
+                    grid.lo, grid.hi
+                ));
+            }
+            DensityPlan::Field(Field::Grid(grid))
+        }
+    })
 }

@@ -140,7 +140,7 @@ pub(crate) fn build(
     // Every file the scene reads besides itself (meshes, tables), for provenance.
     let mut inputs: Vec<String> = Vec::new();
     let materials = materials::Materials::build(&file, &base_dir, &mut inputs).map_err(err)?;
-    let plans = media::plan_media(&file.shapes).map_err(err)?;
+    let plans = media::plan_media(&file.shapes, &base_dir, &mut inputs).map_err(err)?;
     let mut warnings: Vec<String> = Vec::new();
     let (mut shapes, entry) = shapes::build_shapes(
         path,

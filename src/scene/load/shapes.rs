@@ -322,12 +322,12 @@ pub fn scene_bounds(shapes: &[Shape]) -> crate::light::SceneBounds {
 }
 
 /// A bounding box (lo, hi); lo > hi when empty.
-type Box3 = (Vec3, Vec3);
+pub(super) type Box3 = (Vec3, Vec3);
 
-const EMPTY_BOX: Box3 = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+pub(super) const EMPTY_BOX: Box3 = (Vec3::INFINITY, Vec3::NEG_INFINITY);
 
 /// `b` grown to hold shape `s`.
-fn grow_box((mut lo, mut hi): Box3, s: &Shape) -> Box3 {
+pub(super) fn grow_box((mut lo, mut hi): Box3, s: &Shape) -> Box3 {
     match &s.kind {
         ShapeKind::Sphere { center, radius } => {
             lo = lo.min(*center - Vec3::splat(*radius));

@@ -1,0 +1,86 @@
+//! `density = { type = ..., ... }` in a shape's `medium`: the field that scales the
+//! medium's coefficients (`medium::density`), tagged by `type`.
+use super::*;
+
+/// A medium's density field.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(tag = "type", rename_all = "kebab-case")]
+pub enum DensityFile {
+    HeightFog(HeightFogFile),
+    RainShaft(RainShaftFile),
+    Noise(NoiseFile),
+    Grid(GridFile),
+}
+
+impl DensityFile {
+    /// The `type` values, in declaration order (`tests::names_are_the_serde_tags`).
+    pub const NAMES: &'static [&'static str] = &["height-fog", "rain-shaft", "noise", "grid"];
+}
+
+/// ρ = exp(−(h − base)/scale_height), h the height along `up`.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeightFogFile {
+    /// The height where ρ = 1; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<f64>,
+    pub scale_height: PositiveNumber,
+    /// The direction of increasing height; default [0, 1, 0] (heron's scenes are y-up).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Direction3>,
+}
+
+/// Rain under a cloud base, in a vertical cylinder or a downward-widening cone.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RainShaftFile {
+    /// A point on the axis at the cloud base.
+    pub center: Point3,
+    /// The radius at the cloud base.
+    pub radius: PositiveNumber,
+    /// The width of the soft edge; default 0 (a sharp edge).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge: Option<NonNegativeNumber>,
+    /// The cone's half-angle in degrees, in [0, 60); default 0 (a cylinder).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spread: Option<NonNegativeNumber>,
+    /// The e-folding depth of the rain's thinning below the cloud base; default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub falloff: Option<PositiveNumber>,
+    /// The direction of increasing height; default [0, 1, 0].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Direction3>,
+}
+
+/// Seeded fractal value noise, thresholded, baked into a grid over the medium's box.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseFile {
+    /// The largest features' size in scene units.
+    pub scale: PositiveNumber,
+    /// Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u32>,
+    /// Octaves in 1..=8; default 4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub octaves: Option<PositiveCount>,
+    /// The part of the noise's range that is clear air, in [0, 1); default 0.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<UnitNumber>,
+    /// Cells of the baked grid along the box's longest side, in 2..=512; default 64.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<PositiveCount>,
+}
+
+/// A grid of densities from a Mitsuba `.vol` file, placed in the box `min`–`max` (default
+/// the box in the file's header).
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridFile {
+    /// The `.vol` file, relative to the scene file.
+    pub file: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<Point3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<Point3>,
+}
