@@ -11,6 +11,7 @@
 #   scripts/callgrind_loop.sh [HERON_BINARY...]     (default: target/release/heron)
 #   SPP=64 SIZE=128 scripts/callgrind_loop.sh ...   (per-sample cost at a real sample count)
 #   FLAGS="--packets paths" scripts/callgrind_loop.sh  (extra render flags)
+#   SCENES="fogbow rain-curtain" scripts/callgrind_loop.sh  (other scenes of scenes/)
 #
 # SPP (default 4) is the samples per pixel; SIZE, if set, renders a SIZE×SIZE copy of each
 # scene (the Sobol' sampler's per-pixel work is shared by a pixel's samples, so 4 spp
@@ -26,20 +27,22 @@ bins=("$@")
 [ ${#bins[@]} -gt 0 ] || bins=(target/release/heron)
 spp=${SPP:-4}
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-for scene in default cornell-box; do
+# The scenes' copies sit beside them, so that the files they name (meshes) resolve.
+trap 'rm -rf "$tmp" scenes/.callgrind-*.toml' EXIT
+scenes=(${SCENES:-default cornell-box})
+for scene in "${scenes[@]}"; do
   if [ -n "${SIZE:-}" ]; then
     sed -E "s/^resolution = \[[0-9]+, *[0-9]+\]/resolution = [$SIZE, $SIZE]/" \
-      "scenes/$scene.toml" >"$tmp/$scene.toml"
+      "scenes/$scene.toml" >"scenes/.callgrind-$scene.toml"
   else
-    cp "scenes/$scene.toml" "$tmp/$scene.toml"
+    cp "scenes/$scene.toml" "scenes/.callgrind-$scene.toml"
   fi
 done
 for bin in "${bins[@]}"; do
-  for scene in default cornell-box; do
+  for scene in "${scenes[@]}"; do
     valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --collect-atstart=no \
       --toggle-collect='*render_passes*' --toggle-collect='*::render_tile' \
-      "$bin" render "$tmp/$scene.toml" -o "$tmp/cg.exr" --spp "$spp" --threads 1 --quiet \
+      "$bin" render "scenes/.callgrind-$scene.toml" -o "$tmp/cg.exr" --spp "$spp" --threads 1 --quiet \
       --no-png ${FLAGS:-} >"$tmp/out" 2>"$tmp/log"
     ir=$(grep -E '^(summary|totals):' "$tmp/cg.out" | head -n 1 | awk '{print $2}')
     px=$(cat "$tmp/out" "$tmp/log" | grep -oE ': [0-9]+x[0-9]+ at' | head -n 1 | grep -oE '[0-9]+x[0-9]+' || true)

@@ -161,7 +161,7 @@ fn mitsuba_media_heron_cannot_hold_are_warnings_at_their_line() {
     <shape type="sphere">
         <point name="center" x="3" y="0" z="0"/>
         <bsdf type="dielectric"/>
-        <medium type="heterogeneous" name="interior"/>
+        <medium type="custom" name="interior"/>
     </shape>"#,
         ),
     );
@@ -180,7 +180,7 @@ fn mitsuba_media_heron_cannot_hold_are_warnings_at_their_line() {
         "{w:?}"
     );
     assert!(
-        said(&imp, 19, "medium \"heterogeneous\" is not supported"),
+        said(&imp, 19, "medium \"custom\" is not supported"),
         "{w:?}"
     );
     assert_eq!(w.len(), 4, "{w:?}");

@@ -744,7 +744,19 @@ fn colour_and_luminance_noise_fall_as_one_over_n() {
     // gave 1.26 for y in single scattering; samples all alike would give 16. (The
     // Sobol' sampler does not make it fail: it lowers Y's ratio to 0.84 and leaves the
     // colour's at 1.04–1.06, the heavy tails being high-dimensional.)
-    let dir = temp_dir("noise");
+    let n = 1.0 / (2.0 * std::f64::consts::PI * 1e-10);
+    assert_noise_falls_as_one_over_n(
+        "noise",
+        &format!(
+            "{{ type = \"mie\", radius_mm = 0.01, number_density = {n}, forward_cutoff = 5 }}"
+        ),
+    );
+}
+
+/// The check of `colour_and_luminance_noise_fall_as_one_over_n` on a 100 m slab of the
+/// medium `medium` (a TOML table), in a folder of its own named `name`.
+fn assert_noise_falls_as_one_over_n(name: &str, medium: &str) {
+    let dir = temp_dir(name);
     write_box(
         &dir,
         "fog.obj",
@@ -752,7 +764,6 @@ fn colour_and_luminance_noise_fall_as_one_over_n() {
         [500.0, 500.0, 0.0],
     );
     let (travel, _) = sun_view(30.0, 30.0);
-    let n = 1.0 / (2.0 * std::f64::consts::PI * 1e-10);
     let fog = |size: u32| {
         load_in(
             &dir,
@@ -772,7 +783,7 @@ irradiance = 1.0
 [[shapes]]
 type = "mesh"
 file = "fog.obj"
-medium = {{ type = "mie", radius_mm = 0.01, number_density = {n}, forward_cutoff = 5 }}
+medium = {medium}
 "#,
                 travel.x, travel.y, travel.z
             ),
@@ -820,6 +831,20 @@ medium = {{ type = "mie", radius_mm = 0.01, number_density = {n}, forward_cutoff
     }
     assert!(failures.is_empty(), "{failures:?}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn heterogeneous_colour_noise_falls_as_one_over_n() {
+    // The same check through a heterogeneous fog (issue 39): the slab's density falls
+    // by e every 20 m below its top (a height fog whose "up" points down, so that every
+    // pixel sees the same profile along its line of sight and the image stays uniform),
+    // σ_t = 1 m⁻¹ at the top. Delta tracking's null collisions and ratio tracking's
+    // estimates are in every path; their weights must not correlate a pixel's samples.
+    let n = 1.0 / (2.0 * std::f64::consts::PI * 1e-10);
+    assert_noise_falls_as_one_over_n(
+        "noise-het",
+        &format!("{{ type = \"mie\", radius_mm = 0.01, number_density = {n}, forward_cutoff = 5, density = {{ type = \"height-fog\", up = [0, 0, -1], scale_height = 20 }} }}"),
+    );
 }
 
 #[test]

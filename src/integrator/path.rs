@@ -71,9 +71,14 @@
 //!   (truncated) forward peak, hundreds of times its mean, and the first vertex's phase
 //!   sample seldom points there. The guide samples those directions in proportion.
 //!
-//! Transmittance in heron's media is exact (homogeneous: exp(−σ_t ℓ) per stretch, through
-//! index-matched boundaries), so ratio tracking, which estimates it in heterogeneous
-//! media, has nothing to add here.
+//! Transmittance in homogeneous media is exact (exp(−σ_t ℓ) per stretch, through
+//! index-matched boundaries). In a heterogeneous medium (a `density` field,
+//! `medium::tracking`) free flights are delta tracking against the density's majorant
+//! grid and shadow rays ratio tracking, each null collision updating the weights and
+//! r_u, r_l as Miller et al. 2019 and pbrt-v4 §14.2 do, so the balance heuristic between
+//! light and phase sampling holds across null vertices; there the light is sampled at
+//! real collisions, since a forced collision needs the segment's transmittance in closed
+//! form.
 use super::capabilities::{Capabilities, Support};
 use super::toolkit::{
     lane_mean, light_pdf, roulette, sample_light, Finish, PathState, ShadowSink, TransmittanceWalk,

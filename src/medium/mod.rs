@@ -6,9 +6,13 @@
 //!   (`phase_table`);
 //! - `henyey_greenstein`: constant σ_a, σ_s and the Henyey–Greenstein phase function.
 //!
-//! Both are homogeneous, so the transmittance over a distance d is exactly
+//! Either is homogeneous, so that the transmittance over a distance d is exactly
 //! T(λ) = exp(−σ_t(λ) d) and free-flight sampling with the hero's σ_t has no majorant
-//! to bound (the majorant is σ_t itself; `integrator::path`).
+//! to bound (the majorant is σ_t itself; `integrator::path`), or heterogeneous: a
+//! `density` field (`density`: height fog, a rain shaft, noise, a grid) scales its
+//! coefficients, and the path tracer tracks null collisions against the field's
+//! majorant grid (`tracking`: delta tracking for free flights, ratio tracking for
+//! shadow rays, with the lanes' spectral MIS).
 //!
 //! In a scene (`medium = { ... }` on a shape, `scene/file.rs`): the shape must be closed
 //! (a sphere, or a mesh whose every edge is shared by two triangles) and is either

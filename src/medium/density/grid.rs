@@ -1,10 +1,22 @@
-//! A density grid: values at the centres of a box's cells, trilinear between them and
-//! clamped to the edge cells outside (Mitsuba 3's `gridvolume` with its default
-//! `filter_type = "trilinear"`, `wrap_mode = "clamp"`: dr::Texture's cell-centred
-//! lookup), and Mitsuba's binary `.vol` format (`src/render/volumegrid.cpp`): "VOL",
+//! A density grid: values at the centres of a box's cells, trilinear between them, and
+//! outside the cells' centres either clamped to the edge cells (Mitsuba 3's
+//! `gridvolume` with its default `filter_type = "trilinear"`, `wrap_mode = "clamp"`:
+//! dr::Texture's cell-centred lookup) or blended with zeros and 0 outside the box
+//! (pbrt-v4's `SampledGrid::Lookup`, src/pbrt/util/containers.h, whose `uniformgrid`
+//! medium has no density outside its bounds); and Mitsuba's binary `.vol` format (`src/render/volumegrid.cpp`): "VOL",
 //! version 3, encoding 1 (float32), x, y and z resolutions and the channel count as
 //! little-endian int32, the box as six float32 (min then max), then the values, x fastest.
 use glam::Vec3;
+
+/// What a grid is outside its cells' centres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Edge {
+    /// The edge cells' values continue (Mitsuba 3).
+    #[default]
+    Clamp,
+    /// Zeros beyond the edge cells, and 0 outside the box (pbrt-v4).
+    Zero,
+}
 
 /// Values on a grid of cells over a box.
 #[derive(Clone, Debug, PartialEq)]
@@ -16,6 +28,7 @@ pub struct Grid {
     pub hi: Vec3,
     /// One value per cell, x fastest, then y, then z.
     pub values: Vec<f32>,
+    pub edge: Edge,
 }
 
 /// The largest grid a `.vol` file may hold (values), so a corrupt header cannot ask for
@@ -26,6 +39,12 @@ impl Grid {
     /// The value at cell (x, y, z), clamped to the grid.
     #[inline]
     fn at(&self, x: isize, y: isize, z: isize) -> f32 {
+        let inside = |v: isize, n: usize| (0..n as isize).contains(&v);
+        if self.edge == Edge::Zero
+            && !(inside(x, self.res[0]) && inside(y, self.res[1]) && inside(z, self.res[2]))
+        {
+            return 0.0;
+        }
         let c = |v: isize, n: usize| v.clamp(0, n as isize - 1) as usize;
         let (x, y, z) = (c(x, self.res[0]), c(y, self.res[1]), c(z, self.res[2]));
         self.values[(z * self.res[1] + y) * self.res[0] + x]
@@ -42,6 +61,9 @@ impl Grid {
     /// The trilinear value at `p`.
     #[inline]
     pub fn eval(&self, p: Vec3) -> f32 {
+        if self.edge == Edge::Zero && !(p.cmpge(self.lo).all() && p.cmple(self.hi).all()) {
+            return 0.0;
+        }
         let c = self.cell_coords(p);
         let f = c.floor();
         let t = c - f;
@@ -155,6 +177,7 @@ impl Grid {
             lo,
             hi,
             values,
+            edge: Edge::Clamp,
         };
         g.check()?;
         Ok(g)
@@ -206,6 +229,7 @@ mod tests {
             lo: Vec3::ZERO,
             hi: Vec3::new(4.0, 3.0, 2.0),
             values,
+            edge: Edge::Clamp,
         }
     }
 
@@ -217,6 +241,16 @@ mod tests {
         // Beyond the last centre the edge cell's value holds.
         assert_eq!(g.eval(Vec3::new(-5.0, 0.1, 0.2)), 0.0);
         assert_eq!(g.eval(Vec3::new(9.0, 9.0, 9.0)), 3.0 + 20.0 + 100.0);
+        // pbrt's edge: half the edge value midway between the last centre and the wall,
+        // nothing beyond the box.
+        let z = Grid {
+            edge: Edge::Zero,
+            ..g
+        };
+        assert!((z.eval(Vec3::new(0.25, 0.5, 0.5)) - 0.0).abs() < 1e-6);
+        let v = z.eval(Vec3::new(3.75, 0.5, 0.5));
+        assert!((v - 0.75 * 3.0).abs() < 1e-5, "{v}");
+        assert_eq!(z.eval(Vec3::new(4.01, 0.5, 0.5)), 0.0);
     }
 
     #[test]

@@ -80,6 +80,11 @@ impl Majorants {
         Majorants { lo, hi, cell, max }
     }
 
+    /// The box the majorants cover.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        (self.lo, self.hi)
+    }
+
     /// The largest majorant.
     pub fn peak(&self) -> f32 {
         self.max.iter().copied().fold(0.0, f32::max)
@@ -182,11 +187,11 @@ mod tests {
         let m = Majorants::new(&f, Vec3::splat(-1.0), Vec3::splat(1.0));
         let o = Vec3::new(-3.0, -0.3, 0.2);
         let d = Vec3::new(1.0, 0.4, -0.2).normalize();
-        let mut last = None;
+        let mut last: Option<f32> = None;
         let mut total = 0.0;
         m.walk(o, d, 100.0, |a, b, maj| {
             if let Some(l) = last {
-                assert!((a - l as f32).abs() < 1e-5, "gap {l} .. {a}");
+                assert!((a - l).abs() < 1e-5, "gap {l} .. {a}");
             }
             // Every point of the stretch is under its majorant.
             for k in 0..=8 {

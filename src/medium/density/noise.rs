@@ -7,7 +7,9 @@
 //! n(x) = Σ_{o<O} g^o v(2^o x/s) / Σ_{o<O} g^o with v the lattice values (a hash of the
 //! seed and the lattice point, in [0, 1)) interpolated with the quintic fade
 //! 6t⁵ − 15t⁴ + 10t³, s the feature size and g = 1/2; then ρ = max(0, n − c)/(1 − c) with
-//! c the threshold.
+//! c the threshold. With `taper`, n is first multiplied by 1 − r², r the distance from
+//! the box's centre in units of the ellipsoid the box circumscribes (0 at and beyond
+//! it), so a cloud fades out inside its box instead of being cut by the box's walls.
 use super::grid::Grid;
 use glam::Vec3;
 
@@ -22,6 +24,8 @@ pub struct Noise {
     pub threshold: f32,
     /// Cells of the baked grid along the box's longest side.
     pub resolution: u32,
+    /// Whether the noise fades to 0 at the ellipsoid inscribed in the box.
+    pub taper: bool,
 }
 
 /// The lattice value at (i, j, k) in [0, 1).
@@ -57,8 +61,8 @@ impl Noise {
         lerp(plane(k), plane(k + 1), w)
     }
 
-    /// The thresholded fractal noise at `p`.
-    pub fn eval(&self, p: Vec3) -> f32 {
+    /// The thresholded fractal noise at `p`, times `weight` before the threshold.
+    pub fn eval(&self, p: Vec3, weight: f32) -> f32 {
         let (mut sum, mut norm, mut amp, mut freq) = (0.0, 0.0, 1.0, 1.0 / self.scale);
         for o in 0..self.octaves {
             sum += amp * self.value(p * freq, o);
@@ -66,7 +70,7 @@ impl Noise {
             amp *= 0.5;
             freq *= 2.0;
         }
-        ((sum / norm - self.threshold) / (1.0 - self.threshold)).max(0.0)
+        ((weight * sum / norm - self.threshold) / (1.0 - self.threshold)).max(0.0)
     }
 
     /// The noise baked at the centres of a grid over [lo, hi], `resolution` cells along
@@ -85,7 +89,12 @@ impl Noise {
                         (y as f32 + 0.5) / res[1] as f32,
                         (z as f32 + 0.5) / res[2] as f32,
                     );
-                    values.push(self.eval(lo + size * t));
+                    let weight = if self.taper {
+                        (1.0 - (2.0 * t - Vec3::ONE).length_squared()).max(0.0)
+                    } else {
+                        1.0
+                    };
+                    values.push(self.eval(lo + size * t, weight));
                 }
             }
         }
@@ -94,6 +103,7 @@ impl Noise {
             lo,
             hi,
             values,
+            edge: super::grid::Edge::Clamp,
         }
     }
 }

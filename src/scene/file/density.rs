@@ -70,15 +70,31 @@ pub struct NoiseFile {
     /// Cells of the baked grid along the box's longest side, in 2..=512; default 64.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<PositiveCount>,
+    /// Fade the noise out toward the ellipsoid inscribed in the medium's box; default
+    /// false.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub taper: Option<bool>,
 }
 
-/// A grid of densities from a Mitsuba `.vol` file, placed in the box `min`–`max` (default
-/// the box in the file's header).
+/// A grid of densities at the centres of its cells: from a Mitsuba `.vol` file, placed in
+/// the box `min`–`max` (default the box in the file's header), or written as `values`
+/// (x fastest, then y, then z) with its `resolution`, `min` and `max`.
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GridFile {
     /// The `.vol` file, relative to the scene file.
-    pub file: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// `[nx, ny, nz]` of `values`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<[PositiveCount; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values: Option<Vec<f64>>,
+    /// Beyond the cells' centres: `"clamp"` (the edge cells' values continue, Mitsuba 3's
+    /// default) or `"zero"` (zeros beyond the edge cells and nothing outside the box,
+    /// pbrt-v4's); default clamp.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outside: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min: Option<Point3>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -6,7 +6,7 @@ use super::shapes::{grow_box, EMPTY_BOX};
 use super::SkyTables;
 use crate::bsdf::Material;
 use crate::geometry::Shape;
-use crate::medium::density::{Density, Field, Grid, HeightFog, Noise, RainShaft};
+use crate::medium::density::{grid::Edge, Density, Field, Grid, HeightFog, Noise, RainShaft};
 use crate::medium::{HgMedium, LorenzMieMedium, Medium, Optics};
 use crate::scene::file::{DensityFile, Direction3, MediumFile, MediumType, ShapeFile};
 use crate::spectrum::DenseSpectrum;
@@ -362,6 +362,44 @@ impl DensityPlan {
     }
 }
 
+/// A grid written in the scene: `values` with its `resolution`, `min` and `max`.
+fn inline_grid(
+    at: &str,
+    g: &crate::scene::file::GridFile,
+    values: &[f64],
+) -> std::result::Result<Grid, String> {
+    let Some(res) = g.resolution else {
+        return Err(format!(
+            "{at}.resolution: missing required key (expected [nx, ny, nz] of the values)"
+        ));
+    };
+    let res = res.map(|n| n.0 as usize);
+    let count = res[0] * res[1] * res[2];
+    if values.len() != count {
+        return Err(format!(
+            "{at}.values: expected {count} values for a {} x {} x {} grid, got {}",
+            res[0],
+            res[1],
+            res[2],
+            values.len()
+        ));
+    }
+    let (Some(lo), Some(hi)) = (g.min, g.max) else {
+        return Err(format!(
+            "{at}.min: missing required key (a grid written as values needs its box, min and max)"
+        ));
+    };
+    let grid = Grid {
+        res,
+        lo: lo.get(),
+        hi: hi.get(),
+        values: values.iter().map(|&v| v as f32).collect(),
+        edge: Edge::Clamp,
+    };
+    grid.check().map_err(|e| format!("{at}.values: {e}"))?;
+    Ok(grid)
+}
+
 /// Checks a `density` table: the key path is `at` (`shapes[i].medium.density`).
 fn plan_density(
     at: &str,
@@ -377,7 +415,7 @@ fn plan_density(
             scale_height: f.scale_height.get(),
         })),
         DensityFile::RainShaft(f) => {
-            let spread = f.spread.map_or(0.0, |s| s.get() as f32);
+            let spread = f.spread.map_or(0.0, |s| s.get());
             if spread >= 60.0 {
                 return Err(format!(
                     "{at}.spread: expected the cone's half-angle in degrees in [0, 60), got {spread}"
@@ -387,7 +425,7 @@ fn plan_density(
                 center: f.center.get(),
                 up: up(&f.up),
                 radius: f.radius.get(),
-                edge: f.edge.map_or(0.0, |e| e.get() as f32),
+                edge: f.edge.map_or(0.0, |e| e.get()),
                 spread: spread.to_radians().tan(),
                 falloff: f.falloff.map_or(f32::INFINITY, |f| f.get()),
             }))
@@ -417,15 +455,36 @@ fn plan_density(
                 octaves,
                 threshold,
                 resolution,
+                taper: n.taper.unwrap_or(false),
             })
         }
         DensityFile::Grid(g) => {
-            let path = base_dir.join(&g.file);
-            let bytes = std::fs::read(&path)
-                .map_err(|e| format!("{at}.file: cannot read {}: {e}", path.display()))?;
-            inputs.push(g.file.clone());
-            let mut grid = Grid::from_vol(&bytes)
-                .map_err(|e| format!("{at}.file: {}: {e}", path.display()))?;
+            let mut grid = match (&g.file, &g.values) {
+                (Some(file), None) => {
+                    if g.resolution.is_some() {
+                        return Err(format!(
+                            "{at}.resolution: applies to values written in the scene, not to a file (whose header gives it)"
+                        ));
+                    }
+                    let path = base_dir.join(file);
+                    let bytes = std::fs::read(&path)
+                        .map_err(|e| format!("{at}.file: cannot read {}: {e}", path.display()))?;
+                    inputs.push(file.clone());
+                    Grid::from_vol(&bytes)
+                        .map_err(|e| format!("{at}.file: {}: {e}", path.display()))?
+                }
+                (None, Some(values)) => inline_grid(at, g, values)?,
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "{at}: expected one of file (a .vol grid) or values, got both"
+                    ))
+                }
+                (None, None) => {
+                    return Err(format!(
+                        "{at}.file: missing required key (expected a .vol file, or values with their resolution, min and max)"
+                    ))
+                }
+            };
             if let Some(lo) = g.min {
                 grid.lo = lo.get();
             }
@@ -438,6 +497,15 @@ fn plan_density(
                     grid.lo, grid.hi
                 ));
             }
+            grid.edge = match g.outside.as_deref() {
+                None | Some("clamp") => Edge::Clamp,
+                Some("zero") => Edge::Zero,
+                Some(o) => {
+                    return Err(format!(
+                        "{at}.outside: expected one of clamp, zero, got {o:?}"
+                    ))
+                }
+            };
             DensityPlan::Field(Field::Grid(grid))
         }
     })

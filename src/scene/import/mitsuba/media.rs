@@ -4,8 +4,18 @@
 //! single-scattering albedo; heron by σ_a and σ_s, so σ_s(λ) = albedo(λ) σ_t(λ) and
 //! σ_a = σ_t − σ_s. An RGB parameter is uplifted as Mitsuba 3.9's parser does it, as
 //! a bounded reflectance ([`mitsuba_spectrum`]), and the product written as samples.
+//!
+//! Mitsuba 3's `heterogeneous` medium (src/media/heterogeneous.cpp) with its σ_t a
+//! `gridvolume` (src/volumes/grid.cpp) becomes the same medium with a `grid` density
+//! (`medium::density::grid`): the grid's values are the density, `scale` (times a
+//! `constvolume` or plain σ_t, 1 for a grid) its coefficient, and the grid is placed in
+//! the box `to_world` maps the unit cube to (or the file's own box under
+//! `use_grid_bbox`). heron's grids are trilinear, clamped and axis-aligned, Mitsuba's
+//! defaults; other filter and wrap modes, a rotated grid and a grid albedo (heron's
+//! density scales σ_a and σ_s alike: the grid's mean is used) warn.
 use super::*;
-use crate::scene::file::{Coefficient, Colour, MediumFile};
+use crate::medium::density::Grid;
+use crate::scene::file::{Coefficient, Colour, DensityFile, GridFile, MediumFile, Point3};
 
 /// Wavelength step (nm) of the table written when σ_t or the albedo is RGB (or both
 /// vary with wavelength): the product is written as samples; both are
@@ -20,9 +30,9 @@ impl<'a> Converter<'a> {
         let n = self.resolve(n)?;
         let kind = Self::plugin(n)?;
         let p = self.props(n);
-        if kind != "homogeneous" {
+        if kind != "homogeneous" && kind != "heterogeneous" {
             self.warn(n.diag(format!(
-                "medium {kind:?} is not supported (homogeneous is); the shape is left without a medium"
+                "medium {kind:?} is not supported (homogeneous, heterogeneous are); the shape is left without a medium"
             )))?;
             for c in &n.children {
                 if let Some(name) = c.attr("name") {
@@ -32,8 +42,24 @@ impl<'a> Converter<'a> {
             p.objects(&["phase", "volume"]);
             return Ok(None);
         }
-        let sigma_t = self.coefficient(&p, "sigma_t", 1.0)?;
-        let albedo = self.coefficient(&p, "albedo", 0.75)?;
+        let (sigma_t, density, albedo) = if kind == "heterogeneous" {
+            let (sigma_t, density) = self.volume(&p, "sigma_t", 1.0)?;
+            let (albedo, grid) = self.volume(&p, "albedo", 0.75)?;
+            let albedo = match grid {
+                Some(g) => {
+                    let mean = self.grid_mean(&p, &g)?;
+                    self.warn(p.get("albedo").unwrap_or(n).diag(format!(
+                        "albedo: a grid albedo is not supported (heron's density scales absorption and scattering alike); its mean {mean} is used"
+                    )))?;
+                    ColourValue::Grey(schema::tidy(mean))
+                }
+                None => albedo,
+            };
+            (sigma_t, density, albedo)
+        } else {
+            let sigma_t = self.coefficient(&p, "sigma_t", 1.0)?;
+            (sigma_t, None, self.coefficient(&p, "albedo", 0.75)?)
+        };
         let scale = p.float("scale")?.unwrap_or(1.0);
         if !(scale >= 0.0 && scale.is_finite()) {
             return Err(n.diag(format!("scale: expected a finite number >= 0, got {scale}")));
@@ -47,7 +73,127 @@ impl<'a> Converter<'a> {
         let g = self.phase(&p)?;
         self.finish(&p)?;
         let (sigma_a, sigma_s) = split(&sigma_t, &albedo, scale);
-        Ok(Some(schema::hg_medium(sigma_a, sigma_s, g)))
+        let mut m = schema::hg_medium(sigma_a, sigma_s, g);
+        m.density = density.map(DensityFile::Grid);
+        Ok(Some(m))
+    }
+
+    /// A heterogeneous medium's parameter `name`: a number, `<rgb>`, `<spectrum>` or a
+    /// `constvolume` of one (the value, no grid), or a `gridvolume` (1 and the grid).
+    fn volume(
+        &mut self,
+        p: &Props<'a>,
+        name: &str,
+        default: f64,
+    ) -> Result<(ColourValue, Option<GridFile>), Diagnostic> {
+        let Some(v) = p.get(name).filter(|v| v.tag == "volume") else {
+            return Ok((self.coefficient(p, name, default)?, None));
+        };
+        let q = self.props(v);
+        match Self::plugin(v)? {
+            "constvolume" => {
+                let c = self.coefficient(&q, "value", 1.0)?;
+                self.finish(&q)?;
+                Ok((c, None))
+            }
+            "gridvolume" => {
+                let g = self.grid_volume(v, &q)?;
+                self.finish(&q)?;
+                Ok((ColourValue::Grey(1.0), Some(g)))
+            }
+            other => {
+                self.warn(v.diag(format!(
+                    "{name}: volume {other:?} is not supported (constvolume, gridvolume are); the default {default} is used"
+                )))?;
+                for c in &v.children {
+                    if let Some(k) = c.attr("name") {
+                        q.get(k);
+                    }
+                }
+                Ok((ColourValue::Grey(default), None))
+            }
+        }
+    }
+
+    /// A `gridvolume` as heron's grid density: its file (checked here, so that a bad
+    /// grid is named at its element) and its box.
+    fn grid_volume(&mut self, v: &'a Node, q: &Props<'a>) -> Result<GridFile, Diagnostic> {
+        let Some(file) = q.string("filename")? else {
+            return Err(v.diag("expected <string name=\"filename\" value=\"…\"/>"));
+        };
+        let path = self.find(v, file);
+        let bytes = std::fs::read(&path)
+            .map_err(|e| v.diag(format!("filename: cannot read {}: {e}", path.display())))?;
+        let grid = Grid::from_vol(&bytes)
+            .map_err(|e| v.diag(format!("filename: {}: {e}", path.display())))?;
+        for (k, want) in [("filter_type", "trilinear"), ("wrap_mode", "clamp")] {
+            if let Some(m) = q.string(k)? {
+                if m != want {
+                    self.warn(v.diag(format!(
+                        "{k}: {m:?} is not supported (heron's grids are {want}); {want} is used"
+                    )))?;
+                }
+            }
+        }
+        for k in ["raw", "accel"] {
+            q.get(k);
+        }
+        let to_world = q.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        let (lo, hi) = if q.boolean("use_grid_bbox")?.unwrap_or(false) {
+            (grid.lo.as_dvec3(), grid.hi.as_dvec3())
+        } else {
+            (DVec3::ZERO, DVec3::ONE)
+        };
+        let m = to_world.to_cols_array_2d();
+        let axis_aligned = (0..3).all(|c| (0..3).all(|r| (r == c) == (m[c][r] != 0.0)))
+            && (0..3).all(|i| m[i][i] > 0.0);
+        if !axis_aligned {
+            self.warn(v.diag(
+                "to_world: heron's grids are axis-aligned; the grid fills the box around its rotated or mirrored one",
+            ))?;
+        }
+        let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for i in 0..8 {
+            let c = DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let w = to_world.transform_point3(c);
+            a = a.min(w);
+            b = b.max(w);
+        }
+        let tidy = |v: DVec3| {
+            Point3(DVec3::new(
+                schema::tidy(v.x),
+                schema::tidy(v.y),
+                schema::tidy(v.z),
+            ))
+        };
+        Ok(GridFile {
+            file: Some(
+                relative_to(&path, &self.base)
+                    .to_string_lossy()
+                    .into_owned(),
+            ),
+            resolution: None,
+            values: None,
+            min: Some(tidy(a)),
+            max: Some(tidy(b)),
+            outside: None,
+        })
+    }
+
+    /// The mean of a grid file's values.
+    fn grid_mean(&self, p: &Props<'a>, g: &GridFile) -> Result<f64, Diagnostic> {
+        let path = self.base.join(g.file.as_deref().unwrap_or_default());
+        let bytes = std::fs::read(&path).map_err(|e| {
+            p.node
+                .diag(format!("albedo: cannot read {}: {e}", path.display()))
+        })?;
+        let grid = Grid::from_vol(&bytes)
+            .map_err(|e| p.node.diag(format!("albedo: {}: {e}", path.display())))?;
+        Ok(grid.values.iter().map(|&v| v as f64).sum::<f64>() / grid.values.len() as f64)
     }
 
     /// A medium's `sigma_t` or `albedo`: a number, `<rgb>` or `<spectrum>` pairs, ≥ 0

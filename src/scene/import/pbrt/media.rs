@@ -6,9 +6,17 @@
 //! the camera is outside every medium, so a shape's inside medium becomes its
 //! `medium`; an outside medium (fog around the scene, a camera in water) is not
 //! rendered, with a warning.
+//!
+//! A `uniformgrid` medium (`GridMedium::Create`: `density` values, x fastest, on an
+//! `nx` × `ny` × `nz` grid over the box `p0`–`p1` in the medium's space, the CTM at
+//! `MakeNamedMedium`; σ_a, σ_s, `scale` and `g` as the homogeneous one's) becomes the same
+//! medium with a `grid` density written in the scene, its box the CTM's image of
+//! `p0`–`p1` and `outside = "zero"` (pbrt's `SampledGrid` is 0 beyond its cells and its
+//! medium empty outside its bounds). A rotated box warns (heron's grids are
+//! axis-aligned), as do an emitting grid's `Le`, `Lescale` and `temperature`.
 use super::tokens::Params;
 use super::*;
-use crate::scene::file::{Coefficient, MediumFile};
+use crate::scene::file::{Coefficient, DensityFile, GridFile, MediumFile, Point3, PositiveCount};
 
 /// The material name a shape gets from `Material "interface"`: no heron material is
 /// made; the shape is a medium's index-matched boundary, or invisible around no medium.
@@ -25,11 +33,11 @@ impl Conv {
         p: &Params,
     ) -> Result<(), Diagnostic> {
         let ty = p.string("type").unwrap_or("").to_string();
-        if ty != "homogeneous" {
+        if ty != "homogeneous" && ty != "uniformgrid" {
             for q in &p.0 {
                 q.used.set(true);
             }
-            self.warn(self.diag(path, line, format!("MakeNamedMedium {name:?}: type {ty:?} is not supported (homogeneous is); shapes inside it get no medium")))?;
+            self.warn(self.diag(path, line, format!("MakeNamedMedium {name:?}: type {ty:?} is not supported (homogeneous, uniformgrid are); shapes inside it get no medium")))?;
             self.media.insert(name.to_string(), None);
             return Ok(());
         }
@@ -68,16 +76,109 @@ impl Conv {
                 format!("MakeNamedMedium {name:?}: g: expected a mean cosine in (-1, 1), got {g}");
             return Err(self.diag(path, line, m));
         }
-        if p.get("Le").is_some() {
-            p.get("Lescale");
-            let m = format!("MakeNamedMedium {name:?}: an emitting medium (Le) is not supported; it does not emit");
+        if p.get("Le").is_some() || p.get("temperature").is_some() {
+            for k in [
+                "Lescale",
+                "temperatureoffset",
+                "temperaturecutoff",
+                "temperaturescale",
+            ] {
+                p.get(k);
+            }
+            let m = format!("MakeNamedMedium {name:?}: an emitting medium (Le, temperature) is not supported; it does not emit");
             self.warn(self.diag(path, line, m))?;
         }
-        self.media.insert(
-            name.to_string(),
-            Some(schema::hg_medium(sigma_a, sigma_s, g)),
-        );
+        let mut medium = schema::hg_medium(sigma_a, sigma_s, g);
+        if ty == "uniformgrid" {
+            medium.density = Some(DensityFile::Grid(self.uniform_grid(path, line, name, p)?));
+        }
+        self.media.insert(name.to_string(), Some(medium));
         Ok(())
+    }
+
+    /// A `uniformgrid`'s densities and box (module docs), checked as pbrt checks them.
+    fn uniform_grid(
+        &mut self,
+        path: &Path,
+        line: u32,
+        name: &str,
+        p: &Params,
+    ) -> Result<GridFile, Diagnostic> {
+        let err = |m: String| self.diag(path, line, format!("MakeNamedMedium {name:?}: {m}"));
+        let density = p.get("density").map(|q| q.nums.clone()).unwrap_or_default();
+        if density.is_empty() {
+            return Err(err("no \"density\" values for a uniformgrid medium".into()));
+        }
+        let n = |k: &str| -> Result<u32, Diagnostic> {
+            let v = p.float(k).unwrap_or(1.0);
+            if v >= 1.0 && v.fract() == 0.0 && v <= u32::MAX as f64 {
+                Ok(v as u32)
+            } else {
+                Err(err(format!("{k}: expected an integer >= 1, got {v}")))
+            }
+        };
+        let (nx, ny, nz) = (n("nx")?, n("ny")?, n("nz")?);
+        let count = nx as u64 * ny as u64 * nz as u64;
+        if density.len() as u64 != count {
+            return Err(err(format!(
+                "density: expected nx*ny*nz = {count} values, got {}",
+                density.len()
+            )));
+        }
+        if let Some(v) = density.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            return Err(err(format!(
+                "density: expected values finite and >= 0, got {v}"
+            )));
+        }
+        let point = |k: &str, d: DVec3| -> Result<DVec3, Diagnostic> {
+            match p.get(k) {
+                None => Ok(d),
+                Some(q) if q.nums.len() == 3 => Ok(DVec3::new(q.nums[0], q.nums[1], q.nums[2])),
+                Some(q) => Err(err(format!(
+                    "{k}: expected 3 numbers, got {}",
+                    q.nums.len()
+                ))),
+            }
+        };
+        let (p0, p1) = (point("p0", DVec3::ZERO)?, point("p1", DVec3::ONE)?);
+        if !p0.cmplt(p1).all() {
+            return Err(err(format!(
+                "p0, p1: expected p0 < p1 in each axis, got {p0} and {p1}"
+            )));
+        }
+        let m = self.g.ctm.to_cols_array_2d();
+        let axis_aligned = (0..3).all(|c| (0..3).all(|r| (r == c) == (m[c][r] != 0.0)))
+            && (0..3).all(|i| m[i][i] > 0.0);
+        if !axis_aligned {
+            let m = format!("MakeNamedMedium {name:?}: heron's grids are axis-aligned; the grid fills the box around its rotated or mirrored one");
+            self.warn(self.diag(path, line, m))?;
+        }
+        let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for i in 0..8 {
+            let c = DVec3::new(
+                if i & 1 == 0 { p0.x } else { p1.x },
+                if i & 2 == 0 { p0.y } else { p1.y },
+                if i & 4 == 0 { p0.z } else { p1.z },
+            );
+            let w = self.g.ctm.transform_point3(c);
+            a = a.min(w);
+            b = b.max(w);
+        }
+        let tidy = |v: DVec3| {
+            Point3(DVec3::new(
+                schema::tidy(v.x),
+                schema::tidy(v.y),
+                schema::tidy(v.z),
+            ))
+        };
+        Ok(GridFile {
+            file: None,
+            resolution: Some([PositiveCount(nx), PositiveCount(ny), PositiveCount(nz)]),
+            values: Some(density),
+            min: Some(tidy(a)),
+            max: Some(tidy(b)),
+            outside: Some("zero".into()),
+        })
     }
 
     /// `MediumInterface "inside" ["outside"]` (one name: both sides).
