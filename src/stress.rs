@@ -625,7 +625,8 @@ pub fn medium_case(index: usize, m: &crate::medium::Medium, rays: u64, seed: u64
             for i in 0..n {
                 let wl =
                     SampledWavelengths::<LANES>::sample(WavelengthSampler::Visible, rng.uniform());
-                let k = m.sigma_t(&wl);
+                let k = m.majorant_sigma_t(&wl);
+                let at = |p| m.extinction_at(p, &wl);
                 let inside =
                     lo + (hi - lo) * Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
                 let (o, d) = match i % 3 {
@@ -663,7 +664,8 @@ pub fn medium_case(index: usize, m: &crate::medium::Medium, rays: u64, seed: u64
                     r_u: one,
                     r_l: one,
                 };
-                let flight = delta_tracking(density, (o, d, len), k, rng.uniform(), rng, &mut w);
+                let u0 = rng.uniform();
+                let flight = delta_tracking(density, (o, d, len), k, at, u0, rng, &mut w);
                 let (tr, t) = match flight {
                     Flight::Collided { t, tr, .. } => (tr, t),
                     Flight::Escaped { tr } => (tr, 0.0),
@@ -677,7 +679,7 @@ pub fn medium_case(index: usize, m: &crate::medium::Medium, rays: u64, seed: u64
                     });
                     continue;
                 }
-                let (tr, a) = ratio_tracking(density, (o, d, len), k, rng);
+                let (tr, a) = ratio_tracking(density, (o, d, len), k, at, rng);
                 if !(ok(&tr) && ok(&a)) {
                     r.fail(Failure::NonFinite, || {
                         format!(

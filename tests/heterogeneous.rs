@@ -96,7 +96,8 @@ fn check_tracking(what: &str, density: &Density, (o, d, len): (Vec3, Vec3, f32),
     let mut rng = Rng::new(11, 3);
     let ratio: Vec<[f64; 4]> = (0..n)
         .map(|_| {
-            let (tr, _) = ratio_tracking(density, (o, d, len), k, &mut rng);
+            let (tr, _) =
+                ratio_tracking(density, (o, d, len), k, |p| k * density.eval(p), &mut rng);
             tr.0.map(|v| v as f64)
         })
         .collect();
@@ -116,7 +117,8 @@ fn check_tracking(what: &str, density: &Density, (o, d, len): (Vec3, Vec3, f32),
                 r_l: one,
             };
             let u0 = rng.uniform();
-            match delta_tracking(density, (o, d, len), k, u0, &mut rng, &mut w) {
+            let at = |p| k * density.eval(p);
+            match delta_tracking(density, (o, d, len), k, at, u0, &mut rng, &mut w) {
                 Flight::Escaped { tr } => (w.beta * tr * (1.0 / tr.0[0])).0.map(|v| v as f64),
                 Flight::Collided { .. } => [0.0; 4],
             }
@@ -169,7 +171,8 @@ fn tracking_matches_closed_form_transmittance() {
                 r_l: one,
             };
             let u0 = rng.uniform();
-            match delta_tracking(&density, (a, d, len), k, u0, &mut rng, &mut w) {
+            let at = |p| k * density.eval(p);
+            match delta_tracking(&density, (a, d, len), k, at, u0, &mut rng, &mut w) {
                 Flight::Collided { t, .. } => Some(t),
                 Flight::Escaped { .. } => None,
             }
@@ -399,5 +402,110 @@ fn tracking_stays_finite_and_non_negative_under_stress() {
         assert_eq!(r.rays, 30_000);
         assert_eq!(r.failures(), 0, "{:?}", r.first);
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A sphere of radius 1 holding 2 µm drops below and 0.5 µm drops aloft, blending
+/// from height `from` to `to` (`extra`: more keys of the medium).
+fn two_populations(from: f64, to: f64, extra: &str) -> String {
+    format!(
+        r#"{{ type = "mie", radius_mm = 0.002, number_density = 4e10, aloft = {{ radius_mm = 0.0005, number_density = 6e11, from = {from}, to = {to} }}{extra} }}"#
+    )
+}
+
+#[test]
+fn drops_that_vary_with_height_mix_their_populations() {
+    // Issue 39, part 3. The coefficients: the drops below under `from`, the drops aloft
+    // over `to`, and halfway up (the smoothstep's midpoint) the mean of the two.
+    let dir = temp_dir("aloft");
+    let scene = load_in(&dir, &lit_sphere(&two_populations(-0.5, 0.5, ""))).unwrap();
+    let m = &scene.media[0];
+    let wl = heron::spectrum::SampledWavelengths::<4>::new([450.0, 500.0, 600.0, 700.0], [1.0; 4]);
+    let below = m.sigma_t(&wl);
+    let aloft = m.aloft.as_ref().unwrap();
+    let (t_low, _, s_low) = m.coefficients_at(Vec3::new(0.0, -0.8, 0.0), &wl);
+    let (t_high, _, s_high) = m.coefficients_at(Vec3::new(0.0, 0.8, 0.0), &wl);
+    let (t_mid, _, s_mid) = m.coefficients_at(Vec3::new(0.3, 0.0, 0.1), &wl);
+    let up = m.extinction_at(Vec3::new(0.0, 0.8, 0.0), &wl);
+    assert_eq!((s_low, s_high, s_mid), (0.0, 1.0, 0.5));
+    for i in 0..4 {
+        let a = (t_high.0[i], up.0[i]);
+        assert_eq!(t_low.0[i], below.0[i]);
+        assert_eq!(a.0, a.1);
+        assert!((t_mid.0[i] - 0.5 * (below.0[i] + a.0)).abs() < 1e-5 * a.0);
+        // The two populations differ (else the test would not see a mix-up).
+        assert!(
+            (a.0 / below.0[i] - 1.0).abs() > 0.05,
+            "{a:?} {}",
+            below.0[i]
+        );
+    }
+    let _ = aloft;
+
+    // Energy: without absorption the mixture conserves it (white furnace, L = 1), with
+    // the populations changing across the sphere. 32² × 64 spp: standard error ~0.2%.
+    let furnace = load_in(
+        &dir,
+        &common::scenes::furnace_sphere(&two_populations(-0.5, 0.5, ", absorption = false"), ""),
+    )
+    .unwrap();
+    let (mean, se) = mean_se_y(&run(&furnace, 64));
+    println!("two-population furnace: {mean:.5} ± {se:.5}");
+    assert!(
+        se < 0.003 && (mean - 1.0).abs() < 0.005 && (mean - 1.0).abs() < 4.0 * se.max(1e-4),
+        "{mean} ± {se}"
+    );
+
+    // All aloft (the blend ends below the sphere): the image of the drops aloft alone,
+    // by region z-test (4×4-pixel regions, Šidák over the image at α = 0.01).
+    let all_aloft = load_in(&dir, &lit_sphere(&two_populations(-3.0, -2.0, ""))).unwrap();
+    let alone = load_in(
+        &dir,
+        &lit_sphere(r#"{ type = "mie", radius_mm = 0.0005, number_density = 6e11 }"#),
+    )
+    .unwrap();
+    let c = compare_xyz(&run(&all_aloft, 128), &run(&alone, 128), 4, 0.01, None);
+    let report = c.report("all aloft", "aloft drops alone", 10);
+    println!("{report}");
+    assert!(c.same(), "{report}");
+    // And it is not the image of the drops below.
+    let below_alone = load_in(
+        &dir,
+        &lit_sphere(r#"{ type = "mie", radius_mm = 0.002, number_density = 4e10 }"#),
+    )
+    .unwrap();
+    let c = compare_xyz(
+        &run(&all_aloft, 128),
+        &run(&below_alone, 128),
+        4,
+        0.01,
+        None,
+    );
+    assert!(!c.same(), "{}", c.report("all aloft", "drops below", 10));
+
+    // Errors name the key.
+    let e = load_in(
+        &dir,
+        &lit_sphere(r#"{ type = "henyey-greenstein", sigma_s = 1.0, aloft = { radius_mm = 0.001, number_density = 1e9, from = 0, to = 1 } }"#),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("shapes[0].medium.aloft: applies to type = \"mie\""),
+        "{e}"
+    );
+    let e = load_in(&dir, &lit_sphere(&two_populations(1.0, 0.5, ""))).unwrap_err();
+    assert!(
+        e.contains("shapes[0].medium.aloft: expected heights from < to"),
+        "{e}"
+    );
+    let e = load_in(
+        &dir,
+        &lit_sphere(r#"{ type = "mie", radius_mm = 0.002, number_density = 4e10, aloft = { number_density = 1e9, from = 0, to = 1 } }"#),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("shapes[0].medium.aloft.radius_mm: missing required key"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

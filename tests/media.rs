@@ -25,7 +25,9 @@ use common::render::{mean_se, mean_se_y};
 use glam::{Vec2, Vec3};
 use heron::film::Film;
 use heron::light::Light;
-use heron::medium::{HgMedium, LorenzMieMedium, Medium, MieSpec, Optics, PopulationNode};
+use heron::medium::{
+    HgMedium, LorenzMieMedium, Medium, MediumPoint, MieSpec, Optics, PopulationNode,
+};
 use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::{Scene, SceneParts};
@@ -35,7 +37,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Chi-square tests in this file (the Bonferroni divisor).
-const CHI2_TESTS: usize = 4;
+const CHI2_TESTS: usize = 5;
 /// Samples per chi-square test: 10⁶ (as tests/lights.rs: a density wrong by ~4% over a
 /// tenth of the mass is rejected), plus every sample's pdf checked against `phase`.
 const SAMPLES: usize = 1_000_000;
@@ -56,7 +58,7 @@ fn mie_cut(radius_m: f64, absorption: bool, forward_cutoff_deg: f64) -> Medium {
     })))
 }
 
-fn chi2_phase(name: &str, m: &Medium, lambda: f32, domain: &Spherical) -> Outcome {
+fn chi2_phase(name: &str, m: MediumPoint, lambda: f32, domain: &Spherical) -> Outcome {
     let wl = SampledWavelengths::<1>::new([lambda], [1.0]);
     let d_in = Vec3::new(0.3, -0.5, 0.8).normalize();
     // A sample within f32 rounding of a bin edge of the Lorenz–Mie table is evaluated
@@ -94,11 +96,35 @@ fn phase_sampling_passes_chi_square() {
     // 10 µm drops (x ≈ 75–175): the diffraction peak (first zero near 3.8/x ≈ 0.03 rad)
     // seen in a cone of 0.1 rad about the forward direction.
     let fog = mie(10e-6, true);
+    // Drops that vary with height (issue 39): where a tenth of the 0.5 µm drops have
+    // become 2 µm drops, which then do about 60% of the scattering, the phase function
+    // is the populations' mixture and its sampling picks a population by the hero's
+    // share: sampled as evaluated.
+    let mixed = Medium {
+        aloft: Some(heron::medium::Aloft {
+            optics: mie(2e-6, true).optics,
+            up: Vec3::Y,
+            from: 0.0,
+            to: 1.0,
+        }),
+        ..mie(0.5e-6, true)
+    };
     let outcomes = vec![
-        chi2_phase("hg g=0.7", &hg, 550.0, &Spherical::sphere(d_in)),
-        chi2_phase("hg g=-0.4", &back, 550.0, &Spherical::sphere(d_in)),
-        chi2_phase("mie 0.5 um", &small, 553.0, &Spherical::sphere(d_in)),
-        chi2_phase("mie 10 um peak", &fog, 487.0, &Spherical::cone(d_in, 0.1)),
+        chi2_phase("hg g=0.7", hg.at(0.0), 550.0, &Spherical::sphere(d_in)),
+        chi2_phase("hg g=-0.4", back.at(0.0), 550.0, &Spherical::sphere(d_in)),
+        chi2_phase("mie 0.5 um", small.at(0.0), 553.0, &Spherical::sphere(d_in)),
+        chi2_phase(
+            "mie 10 um peak",
+            fog.at(0.0),
+            487.0,
+            &Spherical::cone(d_in, 0.1),
+        ),
+        chi2_phase(
+            "mie 0.5 + 2 um",
+            mixed.at(0.1),
+            553.0,
+            &Spherical::sphere(d_in),
+        ),
     ];
     assert_eq!(outcomes.len(), CHI2_TESTS);
     assert_all(&outcomes);

@@ -74,7 +74,8 @@
 //! Transmittance in homogeneous media is exact (exp(−σ_t ℓ) per stretch, through
 //! index-matched boundaries). In a heterogeneous medium (a `density` field,
 //! `medium::tracking`) free flights are delta tracking against the density's majorant
-//! grid and shadow rays ratio tracking, each null collision updating the weights and
+//! grid and shadow rays ratio tracking (also through a medium whose drops vary with
+//! height, `Medium::aloft`), each null collision updating the weights and
 //! r_u, r_l as Miller et al. 2019 and pbrt-v4 §14.2 do, so the balance heuristic between
 //! light and phase sampling holds across null vertices; there the light is sampled at
 //! real collisions, since a forced collision needs the segment's transmittance in closed
@@ -96,7 +97,7 @@ use crate::math::warp::power_heuristic;
 use crate::math::Frame;
 use crate::math::Rng;
 use crate::medium::tracking::{delta_tracking, Flight, Weights};
-use crate::medium::{Density, Medium, NO_MEDIUM};
+use crate::medium::{Density, Medium, MediumPoint, NO_MEDIUM};
 use crate::sampler::Sampler;
 use crate::scene::{Features, Scene, NO_LIGHT};
 use crate::settings::{on, KernelFlags, MediumNee, Packets, EMITTERS, ESCAPE, MEDIA, SHADOWS};
@@ -284,6 +285,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
     if let Some(density) = &m.density {
         return heterogeneous_segment::<N, K, S, T>(tc, s, ray, h, m, density);
     }
+    let mp = m.at(0.0);
     let sigma_t = m.sigma_t(wl);
     let u_dist = tc.sampler.get_1d();
     let forced = on(K, SHADOWS) && ctx.settings.medium_nee == MediumNee::Forced;
@@ -308,10 +310,10 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
                 u: u_forced,
             };
             if let Some((ld, wi, light)) =
-                forced_direct_light(tc, s, m, &f, (u_light, u_light_point))
+                forced_direct_light(tc, s, mp, &f, (u_light, u_light_point))
             {
                 let v = Vertex::Medium {
-                    medium: m,
+                    medium: mp,
                     d_in: ray.dir,
                 };
                 tc.lit(&mut s.l, ld, Scatter::new(&v, wi, wi), light);
@@ -351,7 +353,7 @@ fn medium_segment<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tra
     s.beta *= m.sigma_s(wl) * tr / pdf;
     let r_before = s.r_u;
     s.r_u *= sigma_t * tr / pdf;
-    medium_vertex::<N, K, S, T>(tc, s, ray, m, t, forced.then_some((r_before, r_light)))
+    medium_vertex::<N, K, S, T>(tc, s, ray, mp, t, forced.then_some((r_before, r_light)))
 }
 
 /// The segment of `ray` inside a heterogeneous medium up to `h`: delta tracking of the
@@ -378,7 +380,7 @@ fn heterogeneous_segment<
     density: &Density,
 ) -> Segment {
     let wl = tc.wl;
-    let k = m.sigma_t(wl);
+    let k = m.majorant_sigma_t(wl);
     let u_dist = tc.sampler.get_1d();
     let (o, d) = (ray.origin, ray.dir);
     let mut rng = Rng::keyed(&[o.x, o.y, o.z, d.x, d.y, d.z, h.t, u_dist]);
@@ -387,7 +389,8 @@ fn heterogeneous_segment<
         r_u: s.r_u,
         r_l: s.r_l,
     };
-    let flight = delta_tracking(density, (o, d, h.t), k, u_dist, &mut rng, &mut w);
+    let at = |p| m.extinction_at(p, wl);
+    let flight = delta_tracking(density, (o, d, h.t), k, at, u_dist, &mut rng, &mut w);
     (s.beta, s.r_u, s.r_l) = (w.beta, w.r_u, w.r_l);
     match flight {
         Flight::Escaped { tr } => {
@@ -401,19 +404,21 @@ fn heterogeneous_segment<
             s.r_l *= tr / pdf;
             Segment::Crossed
         }
-        Flight::Collided { t, rho, tr } => {
-            let pdf = tr.0[0] * rho * k.0[0];
+        Flight::Collided { t, sigma_t, tr } => {
+            let pdf = tr.0[0] * sigma_t.0[0];
             if !(pdf > 0.0) {
                 return Segment::Ended;
             }
-            s.beta *= m.sigma_s(wl) * (tr * (rho / pdf));
-            s.r_u *= k * (tr * (rho / pdf));
-            medium_vertex::<N, K, S, T>(tc, s, ray, m, t, None)
+            let (_, sigma_s, aloft) = m.coefficients_at(ray.at(t), wl);
+            s.beta *= sigma_s * tr / pdf;
+            s.r_u *= sigma_t * tr / pdf;
+            medium_vertex::<N, K, S, T>(tc, s, ray, m.at(aloft), t, None)
         }
     }
 }
 
-/// A scattering event at distance `t` along `ray` in medium `m`, the path's weight and
+/// A scattering event at distance `t` along `ray` in medium `m` (with its population of
+/// drops there), the path's weight and
 /// r_u already holding the collision's density: the light sample (at the collision,
 /// unless `forced` carries the forced light sample's (r_u before the collision, its
 /// distance ratio), which r_l then takes), the new direction and Russian roulette.
@@ -422,7 +427,7 @@ fn medium_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Tran
     tc: &mut Tracer<N, S, T>,
     s: &mut PathState<N>,
     ray: &mut Ray,
-    m: &Medium,
+    m: MediumPoint,
     t: f32,
     forced: Option<(SampledSpectrum<N>, SampledSpectrum<N>)>,
 ) -> Segment {
@@ -527,7 +532,7 @@ struct ForcedSample<const N: usize> {
 fn forced_direct_light<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
     tc: &mut Tracer<N, S, T>,
     s: &PathState<N>,
-    m: &Medium,
+    m: MediumPoint,
     f: &ForcedSample<N>,
     u: (f32, Vec2),
 ) -> Option<(SampledSpectrum<N>, Vec3, usize)> {
@@ -544,7 +549,7 @@ fn forced_direct_light<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
     if !(p_hero > 0.0) {
         return None;
     }
-    let beta = s.beta * m.sigma_s(wl) * tr / p_hero;
+    let beta = s.beta * m.medium.sigma_s(wl) * tr / p_hero;
     if beta.is_zero() {
         return None;
     }
@@ -593,7 +598,7 @@ fn sun_guide(ctx: &Context, depth: u32) -> Option<(Vec3, f32)> {
 fn direction_density<const N: usize>(
     ctx: &Context,
     depth: u32,
-    m: &Medium,
+    m: MediumPoint,
     wi: Vec3,
     phase: SampledSpectrum<N>,
     wl: &SampledWavelengths<N>,
@@ -616,7 +621,7 @@ fn direction_density<const N: usize>(
 fn sample_direction<const N: usize>(
     ctx: &Context,
     depth: u32,
-    m: &Medium,
+    m: MediumPoint,
     d_in: Vec3,
     u_node: f32,
     u_dir: Vec2,
@@ -662,7 +667,7 @@ struct MediumVertex<const N: usize> {
 fn light_from_medium<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
     t: &mut Tracer<N, S, T>,
     s: &PathState<N>,
-    m: &Medium,
+    m: MediumPoint,
     v: &MediumVertex<N>,
     (u_light, u_light_point): (f32, Vec2),
 ) -> Option<(SampledSpectrum<N>, Vec3, usize)> {

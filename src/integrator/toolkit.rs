@@ -19,7 +19,7 @@ use crate::geometry::{Ray, SpawnPoint};
 use crate::light::{LightLeSample, LightLiSample, SurfacePoint};
 use crate::math::{Frame, Rng};
 use crate::medium::tracking::ratio_tracking;
-use crate::medium::{Medium, NO_MEDIUM};
+use crate::medium::{MediumPoint, NO_MEDIUM};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::{Vec2, Vec3};
@@ -290,7 +290,14 @@ impl<const N: usize> TransmittanceWalk<N> {
         };
         let (o, d) = (self.q.origin, self.q.dir.normalize());
         let mut rng = Rng::keyed(&[o.x, o.y, o.z, d.x, d.y, d.z, len]);
-        let (tr, a) = ratio_tracking(density, (o, d, len), m.sigma_t(wl), &mut rng);
+        let k = m.majorant_sigma_t(wl);
+        let (tr, a) = ratio_tracking(
+            density,
+            (o, d, len),
+            k,
+            |p| m.extinction_at(p, wl),
+            &mut rng,
+        );
         self.tr *= tr;
         self.a *= a;
     }
@@ -452,7 +459,7 @@ pub(crate) enum Vertex<'a> {
         wo_local: Vec3,
     },
     Medium {
-        medium: &'a Medium,
+        medium: MediumPoint<'a>,
         d_in: Vec3,
     },
 }

@@ -3,16 +3,15 @@
 //! path integral formulation of light transport", ACM TOG 38(4); pbrt-v4 §14.1's
 //! `SampleT_maj` and the rescaled path probabilities r_u, r_l of §14.2).
 //!
-//! The medium's extinction is σ_t(x, λ) = ρ(x) k_λ (k: σ_t at density 1) and the
-//! majorant grid gives ρ̄ ≥ ρ per cell, so the lanes' majorants σ̄_λ = ρ̄ k_λ all bound
-//! their σ_t and the null coefficients σ_n,λ = (ρ̄ − ρ) k_λ are ≥ 0 in every lane (no
-//! negative weights, whatever the hero). Tentative collisions are drawn with the hero's
-//! majorant (lane 0) and T̄_λ = exp(−k_λ ∫ρ̄) is each lane's majorant transmittance
-//! since the last one.
+//! The medium's extinction σ_t(x, λ) is bounded per lane by ρ̄ k_λ, with ρ̄ ≥ ρ the
+//! density's majorant per cell and k_λ ≥ σ_t at unit density for every population of
+//! drops the medium holds (`Medium::majorant_sigma_t`), so the null coefficients
+//! σ_n,λ = ρ̄ k_λ − σ_t(x, λ) are ≥ 0 in every lane (no negative weights, whatever the
+//! hero). Tentative collisions are drawn with the hero's majorant (lane 0) and T̄_λ =
+//! exp(−k_λ ∫ρ̄) is each lane's majorant transmittance since the last one.
 //!
 //! - **Delta tracking** ([`delta_tracking`], free flights): at a tentative collision the
-//!   event is real with probability ρ/ρ̄ (the same for every hero: the density scales
-//!   all lanes alike), else null; a null collision multiplies the path's weight and its
+//!   event is real with probability σ_t,h/σ̄_h, else null; a null collision multiplies the path's weight and its
 //!   unidirectional probability ratio r_u by T̄_λ σ_n,λ / (T̄_h σ_n,h) and its
 //!   light-sampling ratio r_l by T̄_λ σ̄_λ / (T̄_h σ_n,h): the density with which ratio
 //!   tracking would have made the same null vertex, so that next-event estimation and
@@ -45,11 +44,12 @@ pub struct Weights<const N: usize> {
 /// How a free flight ended.
 #[derive(Clone, Copy, Debug)]
 pub enum Flight<const N: usize> {
-    /// A real collision at distance `t` with density `rho`; `tr` is T̄_λ since the last
-    /// null collision, to be divided as the homogeneous flight's transmittance is.
+    /// A real collision at distance `t`, where the extinction is `sigma_t`; `tr` is T̄_λ
+    /// since the last null collision, to be divided as the homogeneous flight's
+    /// transmittance is.
     Collided {
         t: f32,
-        rho: f32,
+        sigma_t: SampledSpectrum<N>,
         tr: SampledSpectrum<N>,
     },
     /// The end of the segment reached; `tr` is T̄_λ since the last null collision.
@@ -62,13 +62,29 @@ fn majorant_tr<const N: usize>(k: SampledSpectrum<N>, tau: f32) -> SampledSpectr
     SampledSpectrum(std::array::from_fn(|i| (-k.0[i] * tau).exp()))
 }
 
-/// Delta tracking of the hero's free flight along o + t d (d unit), t ∈ [0, len], in a
-/// medium of density `density` and extinction `k` per unit density; `u0` draws the first
-/// distance and `rng` the rest. Null collisions update `w` (module docs).
+/// The majorants σ̄ = ρ̄ k and null coefficients σ̄ − σ_t (≥ 0) per lane.
+#[inline]
+fn null<const N: usize>(
+    rho_bar: f32,
+    k: SampledSpectrum<N>,
+    sigma_t: SampledSpectrum<N>,
+) -> (SampledSpectrum<N>, SampledSpectrum<N>) {
+    let bar = k * rho_bar;
+    (
+        bar,
+        SampledSpectrum(std::array::from_fn(|i| (bar.0[i] - sigma_t.0[i]).max(0.0))),
+    )
+}
+
+/// Delta tracking of the hero's free flight along o + t d (d unit), t ∈ [0, len],
+/// through a medium whose density has the majorants of `density`, whose extinction at
+/// unit density is at most `k` per lane and at a point `sigma_t_at`; `u0` draws the
+/// first distance and `rng` the rest. Null collisions update `w` (module docs).
 pub fn delta_tracking<const N: usize>(
     density: &Density,
     (o, d, len): (Vec3, Vec3, f32),
     k: SampledSpectrum<N>,
+    sigma_t_at: impl Fn(Vec3) -> SampledSpectrum<N>,
     u0: f32,
     rng: &mut Rng,
     w: &mut Weights<N>,
@@ -93,18 +109,18 @@ pub fn delta_tracking<const N: usize>(
             }
             t += step;
             tau += rho_bar * step;
-            let rho = density.eval(o + d * t).min(rho_bar);
+            let sigma_t = sigma_t_at(o + d * t);
             let tr = majorant_tr(k, tau);
-            if rng.uniform() * rho_bar < rho {
-                found = Some(Flight::Collided { t, rho, tr });
+            let (bar, n) = null(rho_bar, k, sigma_t);
+            if rng.uniform() * bar.0[0] < sigma_t.0[0] {
+                found = Some(Flight::Collided { t, sigma_t, tr });
                 return false;
             }
-            // A null collision: σ_n,λ/σ_n,h = k_λ/k_h, σ̄_λ/σ_n,h = ρ̄ k_λ/((ρ̄ − ρ) k_h).
-            let th = tr.0[0];
-            let ratio = SampledSpectrum(std::array::from_fn(|i| tr.0[i] * k.0[i] / (th * kh)));
-            w.beta *= ratio;
-            w.r_u *= ratio;
-            w.r_l *= ratio * (rho_bar / (rho_bar - rho));
+            // A null collision, of density T̄_h σ_n,h.
+            let pdf = tr.0[0] * n.0[0];
+            w.beta *= tr * n / pdf;
+            w.r_u *= tr * n / pdf;
+            w.r_l *= tr * bar / pdf;
             tau = 0.0;
         }
     });
@@ -113,13 +129,15 @@ pub fn delta_tracking<const N: usize>(
     })
 }
 
-/// Ratio tracking along o + t d (d unit), t ∈ [0, len]: each lane's transmittance
-/// estimate and the light technique's relative density of the null vertices (module
-/// docs), as (T̂, a). Stops early once every lane's estimate is 0.
+/// Ratio tracking along o + t d (d unit), t ∈ [0, len], through a medium as in
+/// [`delta_tracking`]: each lane's transmittance estimate and the light technique's
+/// relative density of the null vertices (module docs), as (T̂, a). Stops early once
+/// every lane's estimate is 0.
 pub fn ratio_tracking<const N: usize>(
     density: &Density,
     (o, d, len): (Vec3, Vec3, f32),
     k: SampledSpectrum<N>,
+    sigma_t_at: impl Fn(Vec3) -> SampledSpectrum<N>,
     rng: &mut Rng,
 ) -> (SampledSpectrum<N>, SampledSpectrum<N>) {
     let kh = k.0[0];
@@ -141,12 +159,12 @@ pub fn ratio_tracking<const N: usize>(
             }
             t += step;
             tau += rho_bar * step;
-            let rho = density.eval(o + d * t).min(rho_bar);
             let tb = majorant_tr(k, tau);
-            let th = tb.0[0];
-            let ratio = SampledSpectrum(std::array::from_fn(|i| tb.0[i] * k.0[i] / (th * kh)));
-            a *= ratio;
-            tr *= ratio * ((rho_bar - rho) / rho_bar);
+            let (bar, n) = null(rho_bar, k, sigma_t_at(o + d * t));
+            // Every tentative collision is null, of density T̄_h σ̄_h.
+            let pdf = tb.0[0] * bar.0[0];
+            a *= tb * bar / pdf;
+            tr *= tb * n / pdf;
             tau = 0.0;
             if tr.is_zero() {
                 return false;

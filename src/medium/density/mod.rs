@@ -23,6 +23,8 @@ use glam::Vec3;
 /// A density field.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Field {
+    /// ρ = 1: a medium that varies only in its drops (`Medium::aloft`).
+    Uniform,
     HeightFog(HeightFog),
     RainShaft(RainShaft),
     Grid(Grid),
@@ -33,6 +35,7 @@ impl Field {
     #[inline]
     pub fn eval(&self, p: Vec3) -> f32 {
         match self {
+            Field::Uniform => 1.0,
             Field::HeightFog(f) => f.eval(p),
             Field::RainShaft(f) => f.eval(p),
             Field::Grid(f) => f.eval(p),
@@ -42,6 +45,7 @@ impl Field {
     /// An upper bound of ρ over the box [lo, hi].
     pub fn max_in(&self, lo: Vec3, hi: Vec3) -> f32 {
         match self {
+            Field::Uniform => 1.0,
             Field::HeightFog(f) => f.max_in(lo, hi),
             Field::RainShaft(f) => f.max_in(lo, hi),
             Field::Grid(f) => f.max_in(lo, hi),

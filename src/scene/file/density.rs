@@ -17,6 +17,30 @@ impl DensityFile {
     pub const NAMES: &'static [&'static str] = &["height-fog", "rain-shaft", "noise", "grid"];
 }
 
+/// `aloft = { ... }` in a `mie` medium: a second population of drops that takes over
+/// with height, from the medium's own below `from` to this one above `to` (a smoothstep
+/// of the height along `up` between them). Its drops and their number as the medium's
+/// own keys give them.
+#[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AloftFile {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius_mm: Option<PositiveNumber>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drops: Option<crate::drops::DropsFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub number_density: Option<PositiveNumber>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub liquid_water_content: Option<PositiveNumber>,
+    /// The height below which only the medium's own drops are.
+    pub from: f64,
+    /// The height above which only these drops are.
+    pub to: f64,
+    /// The direction of increasing height; default [0, 1, 0].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Direction3>,
+}
+
 /// ρ = exp(−(h − base)/scale_height), h the height along `up`.
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]

@@ -72,7 +72,7 @@ mod texture;
 
 pub use coefficient::Coefficient;
 pub use colour::{Colour, Emission, Reflectance};
-pub use density::{DensityFile, GridFile, HeightFogFile, NoiseFile, RainShaftFile};
+pub use density::{AloftFile, DensityFile, GridFile, HeightFogFile, NoiseFile, RainShaftFile};
 pub use emission::ShapeEmission;
 pub use leaves::{
     Direction3, IorSpec, Point2, Point3, PositiveCount, PositiveNumber, Resolution, UnitNumber,
@@ -812,6 +812,9 @@ pub struct MediumFile {
     /// (homogeneous).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<DensityFile>,
+    /// Drops that vary with height (`type = "mie"`): another population aloft.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aloft: Option<AloftFile>,
 }
 
 /// The `type` of a [`MediumFile`] (read as a string and matched in the loader's media

@@ -319,5 +319,6 @@ pub fn hg_medium(
         sigma_s: Some(sigma_s),
         g: Some(g as f32),
         density: None,
+        aloft: None,
     }
 }

@@ -7,7 +7,7 @@ use super::SkyTables;
 use crate::bsdf::Material;
 use crate::geometry::Shape;
 use crate::medium::density::{grid::Edge, Density, Field, Grid, HeightFog, Noise, RainShaft};
-use crate::medium::{HgMedium, LorenzMieMedium, Medium, Optics};
+use crate::medium::{Aloft, HgMedium, LorenzMieMedium, Medium, Optics};
 use crate::scene::file::{DensityFile, Direction3, MediumFile, MediumType, ShapeFile};
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
@@ -23,6 +23,16 @@ pub const MEDIUM_DEFAULT_NODES: usize = 8;
 pub(super) struct MediumPlan {
     optics: OpticsPlan,
     density: Option<DensityPlan>,
+    aloft: Option<AloftPlan>,
+}
+
+/// A population of drops aloft (`Medium::aloft`).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct AloftPlan {
+    optics: OpticsPlan,
+    up: Vec3,
+    from: f32,
+    to: f32,
 }
 
 /// A medium's optics: the key path is `at` (`shapes[i].medium`).
@@ -76,7 +86,16 @@ pub(super) fn plan_media(
                         .as_ref()
                         .map(|d| plan_density(&format!("{at}.density"), d, base_dir, inputs))
                         .transpose()?;
-                    Ok(MediumPlan { optics, density })
+                    let aloft = m
+                        .aloft
+                        .as_ref()
+                        .map(|a| plan_aloft(&format!("{at}.aloft"), m, a))
+                        .transpose()?;
+                    Ok(MediumPlan {
+                        optics,
+                        density,
+                        aloft,
+                    })
                 })
                 .transpose()
         })
@@ -340,6 +359,18 @@ pub(super) fn assign_media(
         if let Some(d) = &plan.density {
             m.density = Some(d.build(lo, hi));
         }
+        if let Some(a) = &plan.aloft {
+            m.aloft = Some(Aloft {
+                optics: a.optics.build().optics,
+                up: a.up,
+                from: a.from,
+                to: a.to,
+            });
+            // Drops that vary make the medium heterogeneous even at a uniform density.
+            if m.density.is_none() {
+                m.density = Some(Density::new(Field::Uniform, lo, hi));
+            }
+        }
     }
     Ok(media)
 }
@@ -360,6 +391,50 @@ impl DensityPlan {
         };
         Density::new(field, lo, hi)
     }
+}
+
+/// The drops aloft of a `type = "mie"` medium `m`: checked as the medium's own drops
+/// are (the same keys, `absorption`, `lambda_step` and `forward_cutoff` shared).
+fn plan_aloft(
+    at: &str,
+    m: &MediumFile,
+    a: &crate::scene::file::AloftFile,
+) -> std::result::Result<AloftPlan, String> {
+    if MediumType::from_name(&m.kind) != Some(MediumType::Mie) {
+        return Err(format!(
+            "{at}: applies to type = \"mie\" (drops that vary with height), not to type = {:?}",
+            m.kind
+        ));
+    }
+    let drops = MediumFile {
+        kind: m.kind.clone(),
+        radius_mm: a.radius_mm,
+        drops: a.drops.clone(),
+        number_density: a.number_density,
+        liquid_water_content: a.liquid_water_content,
+        absorption: m.absorption,
+        lambda_step: m.lambda_step,
+        forward_cutoff: m.forward_cutoff,
+        sigma_a: None,
+        sigma_s: None,
+        g: None,
+        density: None,
+        aloft: None,
+    };
+    let optics = plan_mie(at, &drops)?;
+    let (from, to) = (a.from as f32, a.to as f32);
+    if !(from.is_finite() && to.is_finite() && from < to) {
+        return Err(format!(
+            "{at}: expected heights from < to (finite), got from = {} and to = {}",
+            a.from, a.to
+        ));
+    }
+    Ok(AloftPlan {
+        optics,
+        up: a.up.map_or(Vec3::Y, |u| u.unit()),
+        from,
+        to,
+    })
 }
 
 /// A grid written in the scene: `values` with its `resolution`, `min` and `max`.
