@@ -19,7 +19,6 @@ use glam::Vec3;
 use heron::math::Rng;
 use heron::medium::density::{grid::Edge, Density, Field, Grid, HeightFog};
 use heron::medium::tracking::{delta_tracking, ratio_tracking, Flight, Weights};
-use heron::render::{render, RenderOptions};
 use heron::scene::load::load_scene_from_str;
 use heron::scene::Scene;
 use heron::settings::IntegratorKind;
@@ -248,13 +247,8 @@ irradiance = 2.0
     )
 }
 
-#[test]
-fn a_constant_grid_renders_the_homogeneous_medium() {
-    // σ_t = 1.5 per unit either way: given, or as half the coefficients times a grid
-    // of density 2. Both are unbiased estimates of the same image, so heron compare's
-    // region z-test (4×4-pixel regions, Šidák over the image at α = 0.01) must find
-    // them the same; at 128 spp the regions resolve about 3% of their mean.
-    let dir = temp_dir("constant");
+/// Writes `two.vol` into `dir`: a grid of density 2 over the sphere's box.
+fn write_density_two(dir: &Path) {
     let grid = Grid {
         res: [3, 3, 3],
         lo: Vec3::splat(-1.0),
@@ -263,6 +257,16 @@ fn a_constant_grid_renders_the_homogeneous_medium() {
         edge: Edge::Clamp,
     };
     std::fs::write(dir.join("two.vol"), grid.to_vol()).unwrap();
+}
+
+#[test]
+fn a_constant_grid_renders_the_homogeneous_medium() {
+    // σ_t = 1.5 per unit either way: given, or as half the coefficients times a grid
+    // of density 2. Both are unbiased estimates of the same image, so heron compare's
+    // region z-test (4×4-pixel regions, Šidák over the image at α = 0.01) must find
+    // them the same; at 128 spp the regions resolve about 3% of their mean.
+    let dir = temp_dir("constant");
+    write_density_two(&dir);
     let hom = load_in(
         &dir,
         &lit_sphere(
@@ -358,19 +362,10 @@ fn heterogeneous_renders_do_not_depend_on_the_thread_count() {
         ),
     )
     .unwrap();
-    let bits = |threads: usize| {
-        let mut o = RenderOptions::from_scene(&scene);
-        o.settings.integrator = IntegratorKind::Path;
-        o.settings.spp = 8;
-        o.threads = threads;
-        let (film, _) = render(&scene, &o).unwrap();
-        film.xyz
-            .iter()
-            .flatten()
-            .map(|v| v.to_bits())
-            .collect::<Vec<u32>>()
-    };
-    assert_eq!(bits(1), bits(2));
+    assert_eq!(
+        common::render::path_bits(&scene, 8, 1),
+        common::render::path_bits(&scene, 8, 2)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -507,5 +502,47 @@ fn drops_that_vary_with_height_mix_their_populations() {
         e.contains("shapes[0].medium.aloft.radius_mm: missing required key"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn polarisation_in_a_heterogeneous_medium_is_the_homogeneous_one() {
+    // 2 µm drops polarise the light they scatter (their phase matrix): a constant grid
+    // of density 2 under half the drops must give the same Stokes S1 as the homogeneous
+    // medium. Mean S1 (Y) over the image's pixels, a two-sample z-test of the pixel
+    // means (independent pixels); the polarisation is resolved (|S1| > 10 standard
+    // errors), so a heterogeneous medium that dropped the matrix would fail.
+    let dir = temp_dir("polarised");
+    write_density_two(&dir);
+    let s1 = |medium: &str| {
+        let scene = load_in(&dir, &lit_sphere(medium)).unwrap();
+        let film = common::render::render_with(&scene, |o| {
+            o.settings.integrator = IntegratorKind::Path;
+            o.settings.spp = 64;
+            o.settings.polarization = true;
+        });
+        let v: Vec<f64> = film
+            .stokes
+            .as_ref()
+            .unwrap()
+            .iter()
+            .map(|s| s[0][1] as f64)
+            .collect();
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+        (m, (var / n).sqrt())
+    };
+    let (a, sa) = s1(r#"{ type = "mie", radius_mm = 0.002, number_density = 4e10 }"#);
+    let (b, sb) = s1(
+        r#"{ type = "mie", radius_mm = 0.002, number_density = 2e10, density = { type = "grid", file = "two.vol" } }"#,
+    );
+    let z = (a - b) / (sa * sa + sb * sb).sqrt();
+    println!("S1: homogeneous {a:.5} ± {sa:.5}, constant grid {b:.5} ± {sb:.5}, z {z:.2}");
+    assert!(
+        a.abs() > 10.0 * sa,
+        "the polarisation is not resolved: {a} ± {sa}"
+    );
+    assert!(z.abs() < 3.5, "z = {z}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1100,19 +1100,10 @@ direction = [0.3, -1.0, -0.4]
 irradiance = 2.0
 "#,
     );
-    let bits = |threads: usize| {
-        let mut o = RenderOptions::from_scene(&scene);
-        o.settings.integrator = IntegratorKind::Path;
-        o.settings.spp = 8;
-        o.threads = threads;
-        let (film, _) = render(&scene, &o).unwrap();
-        film.xyz
-            .iter()
-            .flatten()
-            .map(|v| v.to_bits())
-            .collect::<Vec<u32>>()
-    };
-    assert_eq!(bits(1), bits(2));
+    assert_eq!(
+        common::render::path_bits(&scene, 8, 1),
+        common::render::path_bits(&scene, 8, 2)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

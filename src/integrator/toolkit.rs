@@ -281,7 +281,7 @@ impl<const N: usize> TransmittanceWalk<N> {
 impl<const N: usize> TransmittanceWalk<N> {
     /// The stretch of length `len` of the current query inside the walk's medium:
     /// exp(−σ_t len) in a homogeneous medium, ratio tracking in a heterogeneous one.
-    #[inline]
+    #[inline(always)]
     fn stretch(&mut self, ctx: &Context, len: f32, wl: &SampledWavelengths<N>) {
         let m = &ctx.scene.media[self.medium as usize];
         let Some(density) = &m.density else {

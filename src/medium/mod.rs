@@ -91,7 +91,7 @@ impl Aloft {
 }
 
 impl Optics {
-    #[inline]
+    #[inline(always)]
     fn sigma_t<const N: usize>(&self, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
         match self {
             Optics::LorenzMie(m) => wl.eval(&m.sigma_t),
@@ -99,7 +99,7 @@ impl Optics {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn sigma_s<const N: usize>(&self, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
         match self {
             Optics::LorenzMie(m) => wl.eval(&m.sigma_s),
@@ -107,7 +107,7 @@ impl Optics {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn phase<const N: usize>(&self, v: f32, wl: &SampledWavelengths<N>) -> SampledSpectrum<N> {
         match self {
             Optics::LorenzMie(m) => m.phase.eval(v, &wl.lambda),
@@ -116,7 +116,7 @@ impl Optics {
     }
 
     /// (F12, F33, F34)/F11 per lane, None when the optics depolarise.
-    #[inline]
+    #[inline(always)]
     fn matrix<const N: usize>(&self, v: f32, wl: &SampledWavelengths<N>) -> Option<[[f32; 3]; N]> {
         let Optics::LorenzMie(m) = self else {
             return None;
@@ -127,7 +127,7 @@ impl Optics {
     }
 
     /// v = 1 − cos θ drawn from the hero's phase function, and every lane's there.
-    #[inline]
+    #[inline(always)]
     fn sample<const N: usize>(
         &self,
         u_node: f32,
@@ -340,7 +340,7 @@ impl<'a> MediumPoint<'a> {
 
     /// The phase function at each lane for propagation `d_in` scattered into `d_out`
     /// (unit vectors).
-    #[inline]
+    #[inline(always)]
     pub fn phase<const N: usize>(
         &self,
         d_in: Vec3,
@@ -349,6 +349,9 @@ impl<'a> MediumPoint<'a> {
     ) -> SampledSpectrum<N> {
         let v = v_between(d_in, d_out);
         let below = self.medium.optics.phase(v, wl);
+        if self.aloft <= 0.0 {
+            return below;
+        }
         match self.mixture(wl) {
             None => below,
             Some((aloft, c)) => mix(below, aloft.phase(v, wl), c),
@@ -362,7 +365,7 @@ impl<'a> MediumPoint<'a> {
     /// (Henyey–Greenstein, which has no matrix, and a Lorenz–Mie table without one):
     /// then only the intensity survives, diag(1, 0, 0, 0). Two populations' matrices
     /// mix as their phase functions do, each weighted by its share of p.
-    #[inline]
+    #[inline(always)]
     pub fn phase_matrix<const N: usize>(
         &self,
         d_in: Vec3,
@@ -377,7 +380,12 @@ impl<'a> MediumPoint<'a> {
         } else {
             any_perpendicular(d_in)
         };
-        let m = match self.mixture(wl) {
+        let mixture = if self.aloft > 0.0 {
+            self.mixture(wl)
+        } else {
+            None
+        };
+        let m = match mixture {
             None => std::array::from_fn(|i| sphere_mueller(r[i])),
             Some((aloft, c)) => {
                 let ra = aloft.matrix(v, wl)?;
@@ -397,7 +405,7 @@ impl<'a> MediumPoint<'a> {
     /// rescaled, between the table's wavelength nodes; `u` the angles), and every lane's
     /// phase function there; lane 0's value is the sampling pdf (solid angle): the
     /// mixture's density is the mixture's phase function.
-    #[inline]
+    #[inline(always)]
     pub fn sample_phase<const N: usize>(
         &self,
         d_in: Vec3,
@@ -406,7 +414,12 @@ impl<'a> MediumPoint<'a> {
         wl: &SampledWavelengths<N>,
     ) -> (Vec3, SampledSpectrum<N>) {
         let below = &self.medium.optics;
-        let (v, p) = match self.mixture(wl) {
+        let mixture = if self.aloft > 0.0 {
+            self.mixture(wl)
+        } else {
+            None
+        };
+        let (v, p) = match mixture {
             None => below.sample(u_node, u.x, wl),
             Some((aloft, c)) => {
                 let c0 = c.0[0];

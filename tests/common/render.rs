@@ -131,3 +131,15 @@ pub fn first_hit_mask_by(
     }
     mask
 }
+
+/// The bits of the CIE XYZ film of a path-traced render of `scene` at `spp` on
+/// `threads` threads: renders that must not depend on the thread count compare them.
+#[allow(dead_code)]
+pub fn path_bits(scene: &Scene, spp: u32, threads: usize) -> Vec<u32> {
+    let mut o = RenderOptions::from_scene(scene);
+    o.settings.integrator = IntegratorKind::Path;
+    o.settings.spp = spp;
+    o.threads = threads;
+    let (film, _) = render(scene, &o).unwrap();
+    film.xyz.iter().flatten().map(|v| v.to_bits()).collect()
+}

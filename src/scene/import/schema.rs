@@ -322,3 +322,30 @@ pub fn hg_medium(
         aloft: None,
     }
 }
+
+/// The box [lo, hi] under the affine map `m` as heron's axis-aligned grids hold it: the
+/// box around its image (`min`, `max`, tidied), and whether the map keeps it
+/// axis-aligned (a positive scale and a translation; else the importer warns).
+pub fn grid_box(
+    m: glam::DMat4,
+    lo: glam::DVec3,
+    hi: glam::DVec3,
+) -> (crate::scene::file::Point3, crate::scene::file::Point3, bool) {
+    use glam::DVec3;
+    let c = m.to_cols_array_2d();
+    let axis_aligned = (0..3).all(|j| (0..3).all(|r| (r == j) == (c[j][r] != 0.0)))
+        && (0..3).all(|i| c[i][i] > 0.0);
+    let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for i in 0..8 {
+        let corner = DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        let w = m.transform_point3(corner);
+        a = a.min(w);
+        b = b.max(w);
+    }
+    let tidy = |v: DVec3| crate::scene::file::Point3(DVec3::new(tidy(v.x), tidy(v.y), tidy(v.z)));
+    (tidy(a), tidy(b), axis_aligned)
+}

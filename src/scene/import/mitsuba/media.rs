@@ -15,7 +15,7 @@
 //! density scales σ_a and σ_s alike: the grid's mean is used) warn.
 use super::*;
 use crate::medium::density::Grid;
-use crate::scene::file::{Coefficient, Colour, DensityFile, GridFile, MediumFile, Point3};
+use crate::scene::file::{Coefficient, Colour, DensityFile, GridFile, MediumFile};
 
 /// Wavelength step (nm) of the table written when σ_t or the albedo is RGB (or both
 /// vary with wavelength): the product is written as samples; both are
@@ -144,32 +144,12 @@ impl<'a> Converter<'a> {
         } else {
             (DVec3::ZERO, DVec3::ONE)
         };
-        let m = to_world.to_cols_array_2d();
-        let axis_aligned = (0..3).all(|c| (0..3).all(|r| (r == c) == (m[c][r] != 0.0)))
-            && (0..3).all(|i| m[i][i] > 0.0);
+        let (min, max, axis_aligned) = schema::grid_box(to_world, lo, hi);
         if !axis_aligned {
             self.warn(v.diag(
                 "to_world: heron's grids are axis-aligned; the grid fills the box around its rotated or mirrored one",
             ))?;
         }
-        let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for i in 0..8 {
-            let c = DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            );
-            let w = to_world.transform_point3(c);
-            a = a.min(w);
-            b = b.max(w);
-        }
-        let tidy = |v: DVec3| {
-            Point3(DVec3::new(
-                schema::tidy(v.x),
-                schema::tidy(v.y),
-                schema::tidy(v.z),
-            ))
-        };
         Ok(GridFile {
             file: Some(
                 relative_to(&path, &self.base)
@@ -178,8 +158,8 @@ impl<'a> Converter<'a> {
             ),
             resolution: None,
             values: None,
-            min: Some(tidy(a)),
-            max: Some(tidy(b)),
+            min: Some(min),
+            max: Some(max),
             outside: None,
         })
     }

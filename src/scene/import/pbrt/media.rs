@@ -16,7 +16,7 @@
 //! axis-aligned), as do an emitting grid's `Le`, `Lescale` and `temperature`.
 use super::tokens::Params;
 use super::*;
-use crate::scene::file::{Coefficient, DensityFile, GridFile, MediumFile, Point3, PositiveCount};
+use crate::scene::file::{Coefficient, DensityFile, GridFile, MediumFile, PositiveCount};
 
 /// The material name a shape gets from `Material "interface"`: no heron material is
 /// made; the shape is a medium's index-matched boundary, or invisible around no medium.
@@ -146,37 +146,17 @@ impl Conv {
                 "p0, p1: expected p0 < p1 in each axis, got {p0} and {p1}"
             )));
         }
-        let m = self.g.ctm.to_cols_array_2d();
-        let axis_aligned = (0..3).all(|c| (0..3).all(|r| (r == c) == (m[c][r] != 0.0)))
-            && (0..3).all(|i| m[i][i] > 0.0);
+        let (min, max, axis_aligned) = schema::grid_box(self.g.ctm, p0, p1);
         if !axis_aligned {
             let m = format!("MakeNamedMedium {name:?}: heron's grids are axis-aligned; the grid fills the box around its rotated or mirrored one");
             self.warn(self.diag(path, line, m))?;
         }
-        let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for i in 0..8 {
-            let c = DVec3::new(
-                if i & 1 == 0 { p0.x } else { p1.x },
-                if i & 2 == 0 { p0.y } else { p1.y },
-                if i & 4 == 0 { p0.z } else { p1.z },
-            );
-            let w = self.g.ctm.transform_point3(c);
-            a = a.min(w);
-            b = b.max(w);
-        }
-        let tidy = |v: DVec3| {
-            Point3(DVec3::new(
-                schema::tidy(v.x),
-                schema::tidy(v.y),
-                schema::tidy(v.z),
-            ))
-        };
         Ok(GridFile {
             file: None,
             resolution: Some([PositiveCount(nx), PositiveCount(ny), PositiveCount(nz)]),
             values: Some(density),
-            min: Some(tidy(a)),
-            max: Some(tidy(b)),
+            min: Some(min),
+            max: Some(max),
             outside: Some("zero".into()),
         })
     }
