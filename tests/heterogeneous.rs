@@ -334,6 +334,16 @@ fn bad_grids_are_one_line_errors() {
         e.contains("shapes[0].medium.density.file: cannot read"),
         "{e}"
     );
+    std::fs::write(dir.join("cloud.vdb"), b" BDV").unwrap();
+    let e = load_in(
+        &dir,
+        &lit_sphere(r#"{ type = "henyey-greenstein", sigma_s = 1.0, density = { type = "grid", file = "cloud.vdb" } }"#),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("OpenVDB and NanoVDB grids are not read") && e.contains("Mitsuba .vol"),
+        "{e}"
+    );
     let e = load_in(
         &dir,
         &lit_sphere(

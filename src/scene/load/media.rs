@@ -542,6 +542,13 @@ fn plan_density(
                         ));
                     }
                     let path = base_dir.join(file);
+                    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+                    if ["vdb", "nvdb"].contains(&ext.to_ascii_lowercase().as_str()) {
+                        return Err(format!(
+                            "{at}.file: {}: OpenVDB and NanoVDB grids are not read (no maintained Rust crate reads them); expected a Mitsuba .vol grid (float32, one channel) or values written in the scene",
+                            path.display()
+                        ));
+                    }
                     let bytes = std::fs::read(&path)
                         .map_err(|e| format!("{at}.file: cannot read {}: {e}", path.display()))?;
                     inputs.push(file.clone());
