@@ -418,10 +418,10 @@ fn heterogeneous_segment<
 }
 
 /// A scattering event at distance `t` along `ray` in medium `m` (with its population of
-/// drops there), the path's weight and
-/// r_u already holding the collision's density: the light sample (at the collision,
-/// unless `forced` carries the forced light sample's (r_u before the collision, its
-/// distance ratio), which r_l then takes), the new direction and Russian roulette.
+/// drops there), the path's weight and r_u already holding the collision's density: the
+/// light sample (at the collision, unless `forced` carries the forced light sample's
+/// (r_u before the collision, its distance ratio), which r_l then takes), the new
+/// direction and Russian roulette.
 #[inline(always)]
 fn medium_vertex<const N: usize, const K: KernelFlags, S: ShadowSink<N>, T: Transport<N>>(
     tc: &mut Tracer<N, S, T>,
