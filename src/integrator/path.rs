@@ -381,9 +381,9 @@ fn heterogeneous_segment<
 ) -> Segment {
     let wl = tc.wl;
     let k = m.majorant_sigma_t(wl);
+    let mut rng = Rng::keyed(tc.sampler.stream_key(), 0);
     let u_dist = tc.sampler.get_1d();
     let (o, d) = (ray.origin, ray.dir);
-    let mut rng = Rng::keyed(&[o.x, o.y, o.z, d.x, d.y, d.z, h.t, u_dist]);
     let mut w = Weights {
         beta: s.beta,
         r_u: s.r_u,
@@ -680,7 +680,9 @@ fn light_from_medium<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
     }
     let q = v.q_scale * direction_density(ctx, v.depth, m, ls.wi, f, wl);
     let from = SpawnPoint::free(v.p);
-    let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium);
+    let key = t.sampler.stream_key();
+    let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium)
+        .map(|w| w.keyed(key));
     let finish = Finish::Medium {
         beta: v.beta,
         f,
@@ -887,7 +889,9 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>, 
     } else {
         medium_outside(s.medium, ctx.scene, v.geom)
     };
-    let walk = TransmittanceWalk::start(ctx, &it.spawn_point(), ls.wi, ls.dist, &ls.target(), from);
+    let key = t.sampler.stream_key();
+    let walk = TransmittanceWalk::start(ctx, &it.spawn_point(), ls.wi, ls.dist, &ls.target(), from)
+        .map(|w| w.keyed(key));
     let finish = Finish::Surface {
         beta: s.beta,
         f,

@@ -184,6 +184,8 @@ pub(crate) struct TransmittanceWalk<const N: usize> {
     dist: f32,
     to: SpawnPoint,
     queries: u32,
+    /// Keys ratio tracking's streams (one per stretch), `Sampler::stream_key`.
+    key: u64,
 }
 
 /// What one query of a walk found.
@@ -217,7 +219,15 @@ impl<const N: usize> TransmittanceWalk<N> {
             dist,
             to: *to,
             queries: 0,
+            key: 0,
         })
+    }
+
+    /// The walk with ratio tracking's streams keyed by `key`, the pixel sample's and
+    /// decision's (`Sampler::stream_key`).
+    #[inline]
+    pub fn keyed(self, key: u64) -> Self {
+        TransmittanceWalk { key, ..self }
     }
 
     /// Takes the closest hit `hit` of the walk's query `q`.
@@ -289,7 +299,7 @@ impl<const N: usize> TransmittanceWalk<N> {
             return;
         };
         let (o, d) = (self.q.origin, self.q.dir.normalize());
-        let mut rng = Rng::keyed(&[o.x, o.y, o.z, d.x, d.y, d.z, len]);
+        let mut rng = Rng::keyed(self.key, self.queries as u64);
         let k = m.majorant_sigma_t(wl);
         let (tr, a) = ratio_tracking(
             density,

@@ -41,18 +41,25 @@ impl Rng {
         Rng::new(a, b)
     }
 
-    /// A stream keyed by the bits of a ray's numbers: the null-collision trackers'
+    /// A stream keyed by `key` and `stream`: the null-collision trackers'
     /// (`medium::tracking`), which draw as many numbers as the ray meets tentative
-    /// collisions, so they cannot take fixed dimensions of the sampler; seeded from the
-    /// ray as pbrt-v4's `SampleT_maj` does (`RNG rng(Hash(ray.o, tMax), Hash(ray.d))`),
-    /// the same ray gives the same numbers whatever the thread.
+    /// collisions, so they cannot take fixed dimensions of the sampler. Keyed by the
+    /// pixel sample and decision (`Sampler::stream_key`) rather than by the ray's bits as
+    /// pbrt-v4's `SampleT_maj` is: the same numbers whatever the thread, and whichever
+    /// engine traced the ray.
     #[inline]
-    pub fn keyed(keys: &[f32]) -> Self {
-        let mut a = 0x2545_F491_4F6C_DD1Du64;
-        for k in keys {
-            a = splitmix64(a ^ k.to_bits() as u64);
-        }
-        Rng::new(a, splitmix64(a ^ 0xA076_1D64_78BD_642F))
+    pub fn keyed(key: u64, stream: u64) -> Self {
+        let a = splitmix64(key ^ 0x2545_F491_4F6C_DD1D);
+        Rng::new(
+            a,
+            splitmix64(a ^ stream.wrapping_mul(0xA076_1D64_78BD_642F)),
+        )
+    }
+
+    /// The state, hashed, drawing no number.
+    #[inline]
+    pub fn key(&self) -> u64 {
+        splitmix64(self.state ^ splitmix64(self.inc))
     }
 
     #[inline]

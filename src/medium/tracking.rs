@@ -25,8 +25,8 @@
 //!   the balance heuristic's denominator needs (`integrator::toolkit::Finish`).
 //!
 //! Random numbers: a tracker draws as many as its ray meets tentative collisions, from
-//! a stream keyed by the ray ([`crate::math::Rng::keyed`]); the first distance uses the
-//! sampler's number where one is given.
+//! a stream keyed by the pixel sample and decision ([`crate::math::Rng::keyed`]); the
+//! first distance uses the sampler's number where one is given.
 use super::density::Density;
 use crate::math::Rng;
 use crate::spectrum::SampledSpectrum;

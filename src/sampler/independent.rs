@@ -28,6 +28,13 @@ impl IndependentSampler {
         self.rng = Rng::for_sample(self.seed, pixel, index as u64);
     }
 
+    /// The stream's state, drawing no number: it identifies (seed, pixel, sample, the
+    /// numbers drawn so far).
+    #[inline]
+    pub fn stream_key(&self) -> u64 {
+        self.rng.key()
+    }
+
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
         self.rng.uniform()

@@ -69,6 +69,19 @@ impl Sampler {
         }
     }
 
+    /// A key of the current pixel sample and decision, drawing no number: it seeds the
+    /// streams of estimators that need as many numbers as the scene makes them (the
+    /// null-collision trackers, `medium::tracking`), so that those depend on which
+    /// sample and decision they serve and not on the last bits of a ray, which the
+    /// packet and one-ray engines may compute differently.
+    #[inline]
+    pub fn stream_key(&self) -> u64 {
+        match self {
+            Sampler::Independent(s) => s.stream_key(),
+            Sampler::Sobol(s) => s.stream_key(),
+        }
+    }
+
     /// The position within the pixel, [0, 1)².
     #[inline]
     pub fn get_pixel_2d(&mut self) -> Vec2 {

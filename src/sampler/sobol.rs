@@ -303,6 +303,12 @@ impl SobolSampler {
         }
     }
 
+    /// (pixel and sample, decision, seed) hashed, drawing no number.
+    #[inline]
+    pub fn stream_key(&self) -> u64 {
+        mix_bits(self.morton_index ^ mix_bits((self.dimension as u64) ^ self.seed_hash))
+    }
+
     /// (index in the sequence, scramble hash) for the current decision.
     #[inline]
     fn point(&mut self) -> (u32, u64) {
