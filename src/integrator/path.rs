@@ -680,9 +680,8 @@ fn light_from_medium<const N: usize, S: ShadowSink<N>, T: Transport<N>>(
     }
     let q = v.q_scale * direction_density(ctx, v.depth, m, ls.wi, f, wl);
     let from = SpawnPoint::free(v.p);
-    let key = t.sampler.stream_key();
     let walk = TransmittanceWalk::start(ctx, &from, ls.wi, ls.dist, &ls.target(), s.medium)
-        .map(|w| w.keyed(key));
+        .map(|w| w.keyed(u_light, u_light_point));
     let finish = Finish::Medium {
         beta: v.beta,
         f,
@@ -889,9 +888,8 @@ fn surface_direct_light<const N: usize, const K: KernelFlags, S: ShadowSink<N>, 
     } else {
         medium_outside(s.medium, ctx.scene, v.geom)
     };
-    let key = t.sampler.stream_key();
     let walk = TransmittanceWalk::start(ctx, &it.spawn_point(), ls.wi, ls.dist, &ls.target(), from)
-        .map(|w| w.keyed(key));
+        .map(|w| w.keyed(u_light, u_light_point));
     let finish = Finish::Surface {
         beta: s.beta,
         f,

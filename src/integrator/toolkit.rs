@@ -184,8 +184,10 @@ pub(crate) struct TransmittanceWalk<const N: usize> {
     dist: f32,
     to: SpawnPoint,
     queries: u32,
-    /// Keys ratio tracking's streams (one per stretch), `Sampler::stream_key`.
-    key: u64,
+    /// The light sample's numbers, which key ratio tracking's streams (one per
+    /// stretch): the pixel sample's and decision's own, whichever engine traced the ray,
+    /// and hashed only where a heterogeneous medium needs them.
+    key: (f32, Vec2),
 }
 
 /// What one query of a walk found.
@@ -219,15 +221,17 @@ impl<const N: usize> TransmittanceWalk<N> {
             dist,
             to: *to,
             queries: 0,
-            key: 0,
+            key: (0.0, Vec2::ZERO),
         })
     }
 
-    /// The walk with ratio tracking's streams keyed by `key`, the pixel sample's and
-    /// decision's (`Sampler::stream_key`).
+    /// The walk with ratio tracking's streams keyed by the light sample's numbers.
     #[inline]
-    pub fn keyed(self, key: u64) -> Self {
-        TransmittanceWalk { key, ..self }
+    pub fn keyed(self, u_light: f32, u_point: Vec2) -> Self {
+        TransmittanceWalk {
+            key: (u_light, u_point),
+            ..self
+        }
     }
 
     /// Takes the closest hit `hit` of the walk's query `q`.
@@ -299,7 +303,9 @@ impl<const N: usize> TransmittanceWalk<N> {
             return;
         };
         let (o, d) = (self.q.origin, self.q.dir.normalize());
-        let mut rng = Rng::keyed(self.key, self.queries as u64);
+        let (u, p) = self.key;
+        let key = (u.to_bits() as u64) << 32 | p.x.to_bits() as u64;
+        let mut rng = Rng::keyed(key, (self.queries as u64) << 32 | p.y.to_bits() as u64);
         let k = m.majorant_sigma_t(wl);
         let (tr, a) = ratio_tracking(
             density,
