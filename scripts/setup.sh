@@ -25,8 +25,10 @@ cd "$(dirname "$0")/.."
 # /etc/slurm/slurm.conf, which nothing writes).
 # python3-yaml: the system Python's PyYAML, which reads deploy/k8s/render-job.yaml in
 # test_slurm.py (the pinned .venv has no YAML parser).
+# chromium and chromium-driver: the real browser (headless) that tests/python/test_viewer.py
+# drives through Selenium to test `heron view`'s page (issue 43).
 APT_PACKAGES=(libembree-dev embree-tools pkg-config gcc python3-venv python3-pip libllvm19
-  slurm-wlm munge python3-yaml)
+  slurm-wlm munge python3-yaml chromium chromium-driver)
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
