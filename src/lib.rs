@@ -38,5 +38,6 @@ pub mod spectrum;
 pub mod stress;
 pub mod texture;
 pub mod trace;
+pub mod view;
 
 pub use error::{HeronError, Result};

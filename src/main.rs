@@ -41,6 +41,7 @@ fn main() {
         Command::Stress(args) => cli::stress::run(args),
         Command::Sky(c) => cli::sky::run(c),
         Command::Lens(args) => cli::lens::run(args),
+        Command::View(args) => cli::view::run(args),
         Command::Spectra { scene } => heron::scene::load_scene(&scene)
             .map_err(Into::into)
             .map(|s| println!("{}", heron::scene::export::spectra_json(&s))),

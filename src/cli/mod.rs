@@ -20,6 +20,7 @@ pub(crate) mod render;
 pub(crate) mod sky;
 pub(crate) mod stress;
 pub(crate) mod trace;
+pub(crate) mod view;
 
 #[derive(Parser)]
 #[command(
@@ -85,6 +86,10 @@ pub(crate) enum Command {
     /// real-ray spot diagrams per field angle and wavelength; with --out, as CSV files
     /// and PNG plots.
     Lens(lens::LensArgs),
+    /// Look at EXRs in the browser: exposure, display transform, channels (RGB, spectral
+    /// bins, S0–S3, DoLP/AoLP, standard error), a pixel's values and spectrum, A/B flip,
+    /// heron compare's z-map and the provenance; served on 127.0.0.1 only.
+    View(view::ViewArgs),
     /// The scene's spectra (reflectances, emissions, indices) on heron's 1 nm grid as
     /// JSON, for tests/python/test_mitsuba.py.
     #[command(hide = true)]

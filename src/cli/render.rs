@@ -1,10 +1,11 @@
 //! `heron render`: flags into a [`heron::session::Session`], the progress bar and
 //! Ctrl-C, then the session's output and stop report.
-use super::{load_any_scene, progress_bar, DisplayFlags, ImportArgs};
+use super::{display, load_any_scene, progress_bar, DisplayFlags, ImportArgs};
 use anyhow::{bail, Result};
 use heron::film::png::stage_png;
 use heron::session::{Output, Report, Request, Session, Stopped};
 use heron::settings::SettingsArgs;
+use heron::view::ViewImage;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -173,6 +174,13 @@ pub(crate) struct RenderArgs {
     /// heron compare. Needs at least 2 spp.
     #[arg(long)]
     variance: bool,
+    /// Watch the render in heron view: the viewer shows the samples so far at the first
+    /// pass boundary after every second (or every --preview-every), then the finished
+    /// EXR, and stays open until Ctrl-C.
+    #[arg(long)]
+    view: bool,
+    #[command(flatten)]
+    server: super::view::ServerFlags,
 }
 
 pub(crate) fn run(args: RenderArgs) -> Result<()> {
@@ -195,16 +203,30 @@ pub(crate) fn run(args: RenderArgs) -> Result<()> {
     let mut session = request.session(&scene)?;
     run_options(&args, &mut session)?;
     let stop = ctrl_c(&mut session)?;
-    if let Some(every) = preview_every {
-        let png = args.output.with_extension("png");
+    let viewer = if args.view {
+        if output.film {
+            bail!("--view: a .heronfilm output is not an image to look at (render to an .exr)");
+        }
+        Some(super::view::start(Vec::new(), &args.server)?)
+    } else {
+        None
+    };
+    let every = preview_every.or(viewer.as_ref().map(|_| Duration::from_secs(1)));
+    if let Some(every) = every {
+        let png = preview_every.map(|_| args.output.with_extension("png"));
+        let (watch, name) = (viewer.clone(), display(&args.output));
         session.opts.preview = Some((
             every,
             Arc::new(move |state: &heron::checkpoint::Checkpoint| {
+                let film = state.film.image();
                 // A preview that cannot be written is not worth the render: say so and go on.
-                if let Err(e) =
-                    stage_png(&state.film.image(), &png, &shown).and_then(|s| s.commit())
-                {
-                    eprintln!("warning: --preview-every: {e}");
+                if let Some(png) = &png {
+                    if let Err(e) = stage_png(&film, png, &shown).and_then(|s| s.commit()) {
+                        eprintln!("warning: --preview-every: {e}");
+                    }
+                }
+                if let Some(v) = &watch {
+                    v.replace(0, ViewImage::from_film(&name, &film));
                 }
             }),
         ));
@@ -242,7 +264,18 @@ pub(crate) fn run(args: RenderArgs) -> Result<()> {
     if stopped == Some(Stopped::Interrupted) {
         std::process::exit(130);
     }
-    if args.check_finite && rendered.stats.nonfinite > 0 {
+    let nonfinite = args.check_finite && rendered.stats.nonfinite > 0;
+    if let Some(v) = viewer {
+        v.replace(0, ViewImage::read_exr(&args.output)?);
+        eprintln!(
+            "heron render: the viewer shows {}; Ctrl-C to stop",
+            display(&args.output)
+        );
+        while !stop.load(Ordering::SeqCst) {
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+    if nonfinite {
         std::process::exit(3);
     }
     Ok(())

@@ -51,29 +51,27 @@ pub fn stokes_channel_name(k: usize, lambda: f32) -> String {
     format!("S{k}.{}nm", format!("{lambda:.6}").replace('.', ","))
 }
 
-/// Writes the EXR file to a temporary file, to be committed later. `provenance` goes
-/// into the header as text attributes `heron.<key>` ([`crate::provenance`]).
-pub fn stage_exr(
-    film: &Film,
-    path: &Path,
-    which: ExrChannels,
-    provenance: &Provenance,
-) -> crate::Result<Staged> {
-    let (w, h) = (film.width as usize, film.height as usize);
+/// The channels of the EXR [`stage_exr`] writes for `film`, by name, each a plane of
+/// `width × height` values row-major from the top-left: R, G, B (linear sRGB), then as
+/// `which` and the film have them X, Y, Z, the variance channels, S1–S3 in linear sRGB,
+/// the spectral S0 bins and their S1–S3. `heron view` shows a render in progress from
+/// these, so that it sees the channels the finished file will have.
+pub fn channel_planes(film: &Film, which: ExrChannels) -> Vec<(String, Vec<f32>)> {
+    let n = film.width as usize * film.height as usize;
     let rgb = film.linear_srgb();
-    let plane = |f: &dyn Fn(usize) -> f32| FlatSamples::F32((0..w * h).map(f).collect());
-    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    let plane = |f: &dyn Fn(usize) -> f32| (0..n).map(f).collect::<Vec<f32>>();
+    let mut list = Vec::new();
     for (c, name) in ["R", "G", "B"].iter().enumerate() {
-        list.push(AnyChannel::new(*name, plane(&|i| rgb[i][c])));
+        list.push((name.to_string(), plane(&|i| rgb[i][c])));
     }
     if which.xyz {
         for (c, name) in ["X", "Y", "Z"].iter().enumerate() {
-            list.push(AnyChannel::new(*name, plane(&|i| film.xyz[i][c])));
+            list.push((name.to_string(), plane(&|i| film.xyz[i][c])));
         }
     }
     if let Some(var) = &film.variance {
         for (c, name) in VARIANCE_CHANNELS.iter().enumerate() {
-            list.push(AnyChannel::new(*name, plane(&|i| var[i][c])));
+            list.push((name.to_string(), plane(&|i| var[i][c])));
         }
     }
     if let Some(stokes) = &film.stokes {
@@ -85,10 +83,41 @@ pub fn stage_exr(
             .collect();
         for (k, names) in STOKES_CHANNELS.iter().enumerate() {
             for (c, name) in names.iter().enumerate() {
-                list.push(AnyChannel::new(*name, plane(&|i| rgb[i][k][c])));
+                list.push((name.to_string(), plane(&|i| rgb[i][k][c])));
             }
         }
     }
+    if let (true, Some((bins, data))) = (which.spectral, &film.spectral) {
+        for k in 0..bins.count {
+            let name = spectral_channel_name(bins.centre(k));
+            list.push((name, plane(&|i| data[i * bins.count + k])));
+        }
+        if let Some(st) = &film.stokes_spectral {
+            let nb = bins.count;
+            for k in 1..4 {
+                for b in 0..nb {
+                    let name = stokes_channel_name(k, bins.centre(b));
+                    list.push((name, plane(&|i| st[(3 * i + k - 1) * nb + b])));
+                }
+            }
+        }
+    }
+    list
+}
+
+/// Writes the EXR file to a temporary file, to be committed later. `provenance` goes
+/// into the header as text attributes `heron.<key>` ([`crate::provenance`]).
+pub fn stage_exr(
+    film: &Film,
+    path: &Path,
+    which: ExrChannels,
+    provenance: &Provenance,
+) -> crate::Result<Staged> {
+    let (w, h) = (film.width as usize, film.height as usize);
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channel_planes(film, which)
+        .into_iter()
+        .map(|(name, plane)| AnyChannel::new(name.as_str(), FlatSamples::F32(plane)))
+        .collect();
     let mut layer_attrs = LayerAttributes::named("heron");
     for (k, v) in &provenance.0 {
         layer_attrs.other.insert(
@@ -96,14 +125,7 @@ pub fn stage_exr(
             attribute::AttributeValue::Text(Text::from(v.as_str())),
         );
     }
-    if let (true, Some((bins, data))) = (which.spectral, &film.spectral) {
-        for k in 0..bins.count {
-            let name = spectral_channel_name(bins.centre(k));
-            list.push(AnyChannel::new(
-                name.as_str(),
-                plane(&|i| data[i * bins.count + k]),
-            ));
-        }
+    if let (true, Some(_)) = (which.spectral, &film.spectral) {
         layer_attrs.other.insert(
             Text::from("spectralLayoutVersion"),
             attribute::AttributeValue::Text(Text::from("1.0")),
@@ -112,17 +134,7 @@ pub fn stage_exr(
             Text::from("emissiveUnits"),
             attribute::AttributeValue::Text(Text::from("W.m^-2.sr^-1")),
         );
-        if let Some(st) = &film.stokes_spectral {
-            let nb = bins.count;
-            for k in 1..4 {
-                for b in 0..nb {
-                    let name = stokes_channel_name(k, bins.centre(b));
-                    list.push(AnyChannel::new(
-                        name.as_str(),
-                        plane(&|i| st[(3 * i + k - 1) * nb + b]),
-                    ));
-                }
-            }
+        if film.stokes_spectral.is_some() {
             layer_attrs.other.insert(
                 Text::from("polarisationHandedness"),
                 attribute::AttributeValue::Text(Text::from("right")),

@@ -1,0 +1,132 @@
+//! What the page can show of an image, drawn here as 8-bit RGBA so that the page shows
+//! exactly what `heron display` and the PNG previews would: one display transform, in
+//! Rust, rather than a second one in the page's script.
+use super::image::ViewImage;
+use crate::compare::heat_colour;
+use crate::spectrum::display::DisplayTransform;
+
+/// Rec. 709 / sRGB luminance weights (IEC 61966-2-1's Y row): the luminance of a linear
+/// sRGB triple, for the Stokes pictures.
+const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// One way of looking at an image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// Linear sRGB through the display transform, as the PNG preview.
+    Rgb,
+    /// The standard error √variance of R, G, B, through the display transform.
+    StdErr,
+    /// S1/S0, S2/S0 or S3/S0 of the luminance, in [−1, 1]: red positive, blue negative.
+    Stokes(usize),
+    /// The degree of linear polarisation, viridis, as OUT.dolp.png.
+    Dolp,
+    /// The angle of linear polarisation, hue with brightness DoLP, as OUT.aolp.png.
+    Aolp,
+    /// One channel: grey through the exposure and the sRGB curve, or, for a signed
+    /// Stokes channel (S1–S3), red and blue for its sign at the exposure's scale.
+    Channel(usize),
+}
+
+impl View {
+    /// The views `img` has, as (id, label): what the page's channel menu lists.
+    pub fn list(img: &ViewImage) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        if img.rgb(0).is_some() {
+            out.push(("rgb".into(), "RGB (linear sRGB)".into()));
+        }
+        if img.variance().is_some() {
+            out.push(("stderr".into(), "standard error (√variance)".into()));
+        }
+        if img.stokes().is_some() {
+            for k in 1..4 {
+                out.push((format!("s{k}"), format!("S{k}/S0 (luminance)")));
+            }
+            out.push(("dolp".into(), "DoLP".into()));
+            out.push(("aolp".into(), "AoLP (brightness DoLP)".into()));
+        }
+        for (i, c) in img.channels.iter().enumerate() {
+            out.push((format!("ch{i}"), c.name.clone()));
+        }
+        out
+    }
+
+    /// The view called `id` in [`View::list`]'s terms, if `img` has it.
+    pub fn parse(id: &str, img: &ViewImage) -> Option<View> {
+        let view = match id {
+            "rgb" => View::Rgb,
+            "stderr" => View::StdErr,
+            "s1" => View::Stokes(1),
+            "s2" => View::Stokes(2),
+            "s3" => View::Stokes(3),
+            "dolp" => View::Dolp,
+            "aolp" => View::Aolp,
+            _ => View::Channel(
+                id.strip_prefix("ch")?
+                    .parse()
+                    .ok()
+                    .filter(|&i| i < img.channels.len())?,
+            ),
+        };
+        View::list(img).iter().any(|(v, _)| v == id).then_some(view)
+    }
+
+    /// The picture: `width × height` RGBA, 8 bits per channel, row-major from the top.
+    pub fn draw(self, img: &ViewImage, t: &DisplayTransform) -> Vec<u8> {
+        let n = img.pixels();
+        let colour: Vec<[u8; 3]> = match self {
+            View::Rgb => (0..n)
+                .map(|i| t.encode_u8(img.rgb(i).unwrap_or([0.0; 3])))
+                .collect(),
+            View::StdErr => {
+                let var = img.variance().expect("listed only with variance channels");
+                (0..n)
+                    .map(|i| t.encode_u8(var.map(|p| p[i].max(0.0).sqrt())))
+                    .collect()
+            }
+            View::Stokes(k) => {
+                let s = img.stokes().expect("listed only for polarised images")[k - 1];
+                (0..n)
+                    .map(|i| {
+                        let s0 = dot(img.rgb(i).unwrap_or([0.0; 3]));
+                        let sk = dot(s.map(|p| p[i]));
+                        let r = if s0 > 0.0 { sk / s0 } else { 0.0 };
+                        heat_colour(if r.is_finite() { r as f64 } else { 0.0 })
+                    })
+                    .collect()
+            }
+            View::Dolp | View::Aolp => {
+                let film = img.stokes_film().expect("listed only for polarised images");
+                if self == View::Dolp {
+                    crate::plot::stokes::dolp_rgb(&film)
+                } else {
+                    crate::plot::stokes::aolp_rgb(&film)
+                }
+            }
+            View::Channel(c) => {
+                let ch = &img.channels[c];
+                let signed = ["S1.", "S2.", "S3."].iter().any(|p| ch.name.starts_with(p));
+                let scale = t.exposure_ev().exp2() as f64;
+                ch.data
+                    .iter()
+                    .map(|&v| {
+                        if signed {
+                            let s = v as f64 * scale;
+                            heat_colour(if s.is_finite() { s } else { 0.0 })
+                        } else {
+                            t.encode_u8([v; 3])
+                        }
+                    })
+                    .collect()
+            }
+        };
+        let mut rgba = Vec::with_capacity(4 * n);
+        for c in colour {
+            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
+        }
+        rgba
+    }
+}
+
+fn dot(rgb: [f32; 3]) -> f32 {
+    LUMA[0] * rgb[0] + LUMA[1] * rgb[1] + LUMA[2] * rgb[2]
+}
