@@ -126,7 +126,8 @@ submit a sharded render from the login node; the image is byte-identical to one 
       $name/scenes/default.toml 8 /shared/runs/default --spp 4096 --seed 1
 
 deploy/slurm/submit.sh documents the options (partitions, time limits, resuming a
-task). The documentation and the source: the repository's README.md.
+task). The documentation and the source: the repository's README.md and the guide
+in its docs/.
 EOF
 
 # Deterministic archive (see the top).

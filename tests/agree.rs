@@ -44,9 +44,9 @@
 //! quarter of those samples (about two minutes on two cores), where most resolve 4%.
 //! Both print one line per pair: the regions tested, the largest |z|, and the
 //! smallest whole-image difference the test would catch; and per render the time to a
-//! relMSE of 10⁻³ estimated from its variance channels (the README's table of which
-//! integrator converges fastest). BENCHMARKS.md, "Integrators agree", records both runs
-//! and the known error the test catches when put back.
+//! relMSE of 10⁻³ estimated from its variance channels (the table of which integrator
+//! converges fastest in docs/integrators.md). BENCHMARKS.md, "Integrators agree",
+//! records both runs and the known error the test catches when put back.
 mod common;
 
 use heron::bsdf::LobeFlags;

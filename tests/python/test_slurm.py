@@ -169,9 +169,9 @@ def _render_reference(scene, flags, out: pathlib.Path) -> pathlib.Path:
 
 
 def test_slurm_array_and_merge_equal_one_render(slurm, dist_unpacked, tmp_path):
-    """The no-root path of the README: the relocatable tarball (scripts/build-dist.sh)
-    unpacked, its own deploy/slurm/submit.sh, binary and scene; the merged image equals
-    one render of the build tree's binary."""
+    """The no-root path of the guide (docs/install.md): the relocatable tarball
+    (scripts/build-dist.sh) unpacked, its own deploy/slurm/submit.sh, binary and scene;
+    the merged image equals one render of the build tree's binary."""
     outdir = tmp_path / "run"
     heron_bin = dist_unpacked / "bin" / "heron"
     scene = dist_unpacked / "scenes" / SLURM_SCENE.name
