@@ -125,7 +125,7 @@ pub enum SkyKey<'a> {
 
 /// What a sky is made of, whoever asks for it. [`SkySpec::build`] checks it against these
 /// rules and limits, the same for scene files, `heron sky profile` and
-/// `heron.sky_profile` (README.md, "Rainbows", describes them for users):
+/// `heron.sky_profile` (the guide's docs/rainbows-and-media.md describes them for users):
 ///
 /// - `model`: one of [`SkyModel::NAMES`].
 /// - The sun's angular radius: in (0°, [`MAX_SUN_RADIUS_DEG`]] (the disk average is a

@@ -28,7 +28,11 @@ hours; what a command prints is not compared, only its exit status:
   - `heron converge`: --reference-spp 16 at most, each --spp value capped at 4;
   - `heron stress`: --rays 1000 (the command's own --rays if lower);
   - `heron sky lee`: --radii 4 at most;
-  - `python` and `.venv/bin/python` at the start of a command: this interpreter.
+  - `python` and `.venv/bin/python` at the start of a command: this interpreter;
+  - `heron view` and `heron render --view` (servers that run until Ctrl-C): started with
+    --no-browser; the test waits for the address they print (and, for a render, for the
+    finished file in the viewer), asks the server for /api/images, which must list the
+    images, and then stops it with SIGINT.
 
 Time: about 80 s on the 2-core machine (measured below).
 """
@@ -236,6 +240,43 @@ def reduced(cmd: str) -> str:
     return re.sub(r"^(\.venv/bin/)?python(3)? ", f"{sys.executable} ", cmd)
 
 
+def _is_server(cmd: str) -> bool:
+    return cmd.startswith("heron view ") or (cmd.startswith("heron render ")
+                                             and re.search(r"\s--view(\s|$)", cmd) is not None)
+
+
+def _run_server(shown: str, work, env) -> tuple[int, str]:
+    """A viewer command (see the module's docstring): (0 when it served its images, else
+    1; what it printed)."""
+    import json
+    import signal
+    import urllib.request
+
+    proc = subprocess.Popen(["bash", "-c", f"exec {shown} --no-browser"], cwd=work, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        m = re.search(r"http://127\.0\.0\.1:\d+/", line)
+        if not m:
+            return 1, line + proc.stderr.read()
+        if shown.startswith("heron render "):
+            err = ""
+            while "the viewer shows" not in err:
+                more = proc.stderr.readline()
+                if not more:
+                    return 1, err
+                err += more
+        with urllib.request.urlopen(m.group(0) + "api/images", timeout=30) as r:
+            images = json.load(r)["images"]
+        return (0 if images else 1), json.dumps([i["name"] for i in images])
+    finally:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
 def _workdir(tmp_path: pathlib.Path) -> pathlib.Path:
     work = tmp_path / "work"
     work.mkdir()
@@ -271,6 +312,13 @@ def test_commands_run(path, tmp_path):
             shown = reduced(c.text)
             argv = ["bash", "-o", "pipefail", "-c", shown]
         t0 = time.monotonic()
+        if c.kind != "python" and _is_server(shown):
+            status, printed = _run_server(shown, work, env)
+            times.append((time.monotonic() - t0, shown))
+            if status != 0:
+                pytest.fail(f"{c.where()}: `{shown}` served no images:\n{printed[-3000:]}",
+                            pytrace=False)
+            continue
         try:
             proc = subprocess.run(argv, cwd=work, env=env, capture_output=True, text=True,
                                   timeout=COMMAND_TIMEOUT_S)

@@ -111,7 +111,8 @@ async function refresh() {
     draw();
     S.drawn += 1;
     const which = S.images.length > 1 ? (S.showing === S.a ? "A: " : "B: ") : "";
-    status(`${which}${img.name}  ${img.width}×${img.height}  ${S.view}  ${S.ev} EV  zoom ${S.zoom.toPrecision(3)}`);
+    const z = S.overlay ? `  ·  z-map: ${$("compare-status").textContent}` : "";
+    status(`${which}${img.name}  ${img.width}×${img.height}  ${S.view}  ${S.ev} EV  zoom ${S.zoom.toPrecision(3)}${z}`);
     const p = S.pinned || S.hover;
     if (p) inspect(p.x, p.y);
   } catch (e) {
@@ -148,10 +149,16 @@ function draw() {
     ctx.drawImage(S.overlay, 0, 0);
     ctx.globalAlpha = 1;
   }
-  if (S.pinned && S.zoom >= 4) {
-    ctx.lineWidth = 2 / S.zoom;
+  if (S.pinned) {
+    // Magnified: the pixel's outline; otherwise a ring around it, in screen pixels.
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.lineWidth = 2;
     ctx.strokeStyle = "#ff0";
-    ctx.strokeRect(S.pinned.x, S.pinned.y, 1, 1);
+    const x = S.ox + S.pinned.x * S.zoom, y = S.oy + S.pinned.y * S.zoom;
+    ctx.beginPath();
+    if (S.zoom >= 4) ctx.rect(x, y, S.zoom, S.zoom);
+    else ctx.arc(x + S.zoom / 2, y + S.zoom / 2, 7, 0, 2 * Math.PI);
+    ctx.stroke();
   }
 }
 

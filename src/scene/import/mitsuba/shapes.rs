@@ -165,7 +165,7 @@ impl<'a> Converter<'a> {
         if flip {
             self.warn(n.diag("flip_normals on a mesh is not supported, ignored"))?;
         }
-        // heron shades every mesh by its face normals (README, "Mitsuba 3 scenes").
+        // heron shades every mesh by its face normals (docs/import.md, "Mitsuba 3 scenes").
         p.get("face_normals");
         if kind == "serialized" {
             let index = match p.integer("shape_index")? {
