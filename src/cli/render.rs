@@ -207,7 +207,7 @@ pub(crate) fn run(args: RenderArgs) -> Result<()> {
         if output.film {
             bail!("--view: a .heronfilm output is not an image to look at (render to an .exr)");
         }
-        Some(super::view::start(Vec::new(), &args.server)?)
+        Some(super::view::start(Vec::new(), &args.server, false)?)
     } else {
         None
     };

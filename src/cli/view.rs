@@ -27,12 +27,17 @@ pub(crate) struct ServerFlags {
 }
 
 pub(crate) fn run(args: ViewArgs) -> Result<()> {
-    let images = args
-        .files
-        .iter()
-        .map(|f| ViewImage::read_exr(f).map_err(anyhow::Error::from))
-        .collect::<Result<Vec<_>>>()?;
-    let _viewer = start(images, &args.server)?;
+    for f in &args.files {
+        ViewImage::check_exr(f)?;
+    }
+    // The address first, the pixels after: the browser starts and loads the page while
+    // the files decode (a 4K spectral EXR takes seconds), and the page's first request
+    // for an image waits for them.
+    let viewer = start(Vec::new(), &args.server, true)?;
+    for (i, f) in args.files.iter().enumerate() {
+        viewer.replace(i, ViewImage::read_exr(f)?);
+    }
+    viewer.loaded();
     // Serving happens on the listener's thread; this one only waits for Ctrl-C.
     loop {
         std::thread::park();
@@ -40,14 +45,22 @@ pub(crate) fn run(args: ViewArgs) -> Result<()> {
 }
 
 /// Starts the server for `images` on its own thread and prints its address (and opens
-/// a browser unless told not to).
-pub(crate) fn start(images: Vec<ViewImage>, flags: &ServerFlags) -> Result<Arc<Viewer>> {
+/// a browser unless told not to). With `loading`, requests for images wait until
+/// [`Viewer::loaded`].
+pub(crate) fn start(
+    images: Vec<ViewImage>,
+    flags: &ServerFlags,
+    loading: bool,
+) -> Result<Arc<Viewer>> {
     let listener = bind(flags.port)?;
     let port = listener
         .local_addr()
         .context("the viewer's address")?
         .port();
     let viewer = Arc::new(Viewer::new(images, port));
+    if loading {
+        viewer.loading();
+    }
     let served = viewer.clone();
     std::thread::spawn(move || serve(listener, served));
     let url = format!("http://127.0.0.1:{port}/");

@@ -38,6 +38,17 @@ pub struct ViewImage {
 }
 
 impl ViewImage {
+    /// Checks that `path` is an OpenEXR file whose header can be read, without decoding
+    /// its pixels: the quick check before the viewer starts (and the decoding) goes on.
+    pub fn check_exr(path: &Path) -> Result<()> {
+        exr::meta::MetaData::read_from_file(path, false)
+            .map(|_| ())
+            .map_err(|e| HeronError::Io {
+                path: path.to_path_buf(),
+                message: format!("cannot read it as OpenEXR: {e}"),
+            })
+    }
+
     /// Every channel of the first layer of the EXR at `path` (half, float and integer
     /// samples as f32) and its provenance. Errors name the file and what was expected.
     pub fn read_exr(path: &Path) -> Result<ViewImage> {

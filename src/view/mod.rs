@@ -34,7 +34,7 @@ use crate::{HeronError, Result};
 use serde_json::{json, Value};
 use std::net::{Ipv4Addr, TcpListener};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, RwLock};
+use std::sync::{Arc, Condvar, Mutex, RwLock};
 
 pub mod http;
 pub mod image;
@@ -53,6 +53,9 @@ pub struct Viewer {
     images: RwLock<Vec<Arc<ViewImage>>>,
     generation: AtomicU64,
     port: u16,
+    /// True while the files given are still being read: requests for images wait, so
+    /// that the browser can start and load the page while a large EXR decodes.
+    loading: (Mutex<bool>, Condvar),
 }
 
 impl Viewer {
@@ -62,6 +65,25 @@ impl Viewer {
             images: RwLock::new(images.into_iter().map(Arc::new).collect()),
             generation: AtomicU64::new(0),
             port,
+            loading: (Mutex::new(false), Condvar::new()),
+        }
+    }
+
+    /// Requests for images wait from now until [`Viewer::loaded`].
+    pub fn loading(&self) {
+        *self.loading.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+    }
+
+    /// The files are read: waiting requests go on.
+    pub fn loaded(&self) {
+        *self.loading.0.lock().unwrap_or_else(|e| e.into_inner()) = false;
+        self.loading.1.notify_all();
+    }
+
+    fn wait_loaded(&self) {
+        let mut busy = self.loading.0.lock().unwrap_or_else(|e| e.into_inner());
+        while *busy {
+            busy = self.loading.1.wait(busy).unwrap_or_else(|e| e.into_inner());
         }
     }
 
@@ -132,6 +154,9 @@ impl Viewer {
             );
         }
         let parts: Vec<&str> = req.path.split('/').skip(1).collect();
+        if parts.first() == Some(&"api") {
+            self.wait_loaded();
+        }
         let answer = match parts.as_slice() {
             [""] => Ok(Response::ok("text/html; charset=utf-8", INDEX_HTML.into())),
             ["viewer.js"] => Ok(Response::ok(

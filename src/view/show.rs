@@ -4,6 +4,7 @@
 use super::image::ViewImage;
 use crate::compare::heat_colour;
 use crate::spectrum::display::DisplayTransform;
+use rayon::prelude::*;
 
 /// Rec. 709 / sRGB luminance weights (IEC 61966-2-1's Y row): the luminance of a linear
 /// sRGB triple, for the Stokes pictures.
@@ -71,60 +72,59 @@ impl View {
     }
 
     /// The picture: `width × height` RGBA, 8 bits per channel, row-major from the top.
+    /// Pixels are drawn in parallel (a 4K picture is 8.3 million of them): each is a
+    /// function of its own values only, so the bytes do not depend on the threads.
     pub fn draw(self, img: &ViewImage, t: &DisplayTransform) -> Vec<u8> {
-        let n = img.pixels();
-        let colour: Vec<[u8; 3]> = match self {
-            View::Rgb => (0..n)
-                .map(|i| t.encode_u8(img.rgb(i).unwrap_or([0.0; 3])))
-                .collect(),
+        match self {
+            View::Rgb => fill(img, |i| t.encode_u8(img.rgb(i).unwrap_or([0.0; 3]))),
             View::StdErr => {
                 let var = img.variance().expect("listed only with variance channels");
-                (0..n)
-                    .map(|i| t.encode_u8(var.map(|p| p[i].max(0.0).sqrt())))
-                    .collect()
+                fill(img, |i| t.encode_u8(var.map(|p| p[i].max(0.0).sqrt())))
             }
             View::Stokes(k) => {
                 let s = img.stokes().expect("listed only for polarised images")[k - 1];
-                (0..n)
-                    .map(|i| {
-                        let s0 = dot(img.rgb(i).unwrap_or([0.0; 3]));
-                        let sk = dot(s.map(|p| p[i]));
-                        let r = if s0 > 0.0 { sk / s0 } else { 0.0 };
-                        heat_colour(if r.is_finite() { r as f64 } else { 0.0 })
-                    })
-                    .collect()
+                fill(img, |i| {
+                    let s0 = dot(img.rgb(i).unwrap_or([0.0; 3]));
+                    let sk = dot(s.map(|p| p[i]));
+                    let r = if s0 > 0.0 { sk / s0 } else { 0.0 };
+                    heat_colour(if r.is_finite() { r as f64 } else { 0.0 })
+                })
             }
             View::Dolp | View::Aolp => {
                 let film = img.stokes_film().expect("listed only for polarised images");
-                if self == View::Dolp {
+                let colour = if self == View::Dolp {
                     crate::plot::stokes::dolp_rgb(&film)
                 } else {
                     crate::plot::stokes::aolp_rgb(&film)
-                }
+                };
+                fill(img, |i| colour[i])
             }
             View::Channel(c) => {
-                let ch = &img.channels[c];
-                let signed = ["S1.", "S2.", "S3."].iter().any(|p| ch.name.starts_with(p));
-                let scale = t.exposure_ev().exp2() as f64;
-                ch.data
+                let ch = &img.channels[c].data;
+                let signed = ["S1.", "S2.", "S3."]
                     .iter()
-                    .map(|&v| {
-                        if signed {
-                            let s = v as f64 * scale;
-                            heat_colour(if s.is_finite() { s } else { 0.0 })
-                        } else {
-                            t.encode_u8([v; 3])
-                        }
-                    })
-                    .collect()
+                    .any(|p| img.channels[c].name.starts_with(p));
+                let scale = t.exposure_ev().exp2() as f64;
+                fill(img, |i| {
+                    if signed {
+                        let s = ch[i] as f64 * scale;
+                        heat_colour(if s.is_finite() { s } else { 0.0 })
+                    } else {
+                        t.encode_u8([ch[i]; 3])
+                    }
+                })
             }
-        };
-        let mut rgba = Vec::with_capacity(4 * n);
-        for c in colour {
-            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
         }
-        rgba
     }
+}
+
+/// RGBA bytes of `img`'s size, opaque, with pixel i's colour `colour(i)`.
+fn fill(img: &ViewImage, colour: impl Fn(usize) -> [u8; 3] + Sync) -> Vec<u8> {
+    let mut rgba = vec![255u8; 4 * img.pixels()];
+    rgba.par_chunks_mut(4).enumerate().for_each(|(i, px)| {
+        px[..3].copy_from_slice(&colour(i));
+    });
+    rgba
 }
 
 fn dot(rgb: [f32; 3]) -> f32 {
