@@ -11,7 +11,10 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 const SOURCES: [&str; 5] = ["src", "spectra", "build.rs", "Cargo.toml", "Cargo.lock"];
 
 fn git(args: &[&str]) -> Option<String> {
+    // --no-optional-locks: `git status` must not refresh the index, which build.rs
+    // watches; a rewritten index would rebuild heron in every later cargo command.
     let out = Command::new("git")
+        .arg("--no-optional-locks")
         .args(args)
         .current_dir(ROOT)
         .env_remove("GIT_DIR")

@@ -6,6 +6,7 @@ use crate::film::Film;
 use crate::spectrum::color::{mat3_mul, SRGB_TO_XYZ};
 use crate::{HeronError, Result};
 use exr::prelude::*;
+use rayon::prelude::*;
 use std::path::Path;
 
 /// One channel: its EXR name and its values row-major from the top-left.
@@ -179,6 +180,48 @@ impl ViewImage {
         bins
     }
 
+    /// The channels `keep` (indices) averaged over `step × step` blocks (the last row
+    /// and column of blocks take what is left): the picture of a view at a zoom below
+    /// 1/step, from its linear values (the mean of Stokes vectors, the mean variance), as
+    /// a mipmap level is. The channels keep their names and the order of `keep`.
+    pub fn downsample(&self, step: u32, keep: &[usize]) -> ViewImage {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let s = step.max(1) as usize;
+        let (dw, dh) = (w.div_ceil(s), h.div_ceil(s));
+        let channels = keep
+            .iter()
+            .map(|&c| {
+                let src = &self.channels[c].data;
+                let mut data = vec![0f32; dw * dh];
+                data.par_chunks_mut(dw).enumerate().for_each(|(by, row)| {
+                    let ys = by * s..((by + 1) * s).min(h);
+                    for (bx, out) in row.iter_mut().enumerate() {
+                        let xs = bx * s..((bx + 1) * s).min(w);
+                        let mut sum = 0f64;
+                        for y in ys.clone() {
+                            sum += src[y * w + xs.start..y * w + xs.end]
+                                .iter()
+                                .map(|&v| v as f64)
+                                .sum::<f64>();
+                        }
+                        *out = (sum / (ys.len() * xs.len()) as f64) as f32;
+                    }
+                });
+                Channel {
+                    name: self.channels[c].name.clone(),
+                    data,
+                }
+            })
+            .collect();
+        ViewImage {
+            name: self.name.clone(),
+            width: dw as u32,
+            height: dh as u32,
+            channels,
+            provenance: Vec::new(),
+        }
+    }
+
     /// A film with this image's S0 (as XYZ) and Stokes components, for the DoLP and AoLP
     /// pictures `heron render` writes beside a polarised render (`plot::stokes`).
     pub fn stokes_film(&self) -> Option<Film> {
@@ -245,6 +288,34 @@ fn stokes_bin(name: &str) -> Option<(usize, f32)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn blocks_average_their_pixels_and_the_edge_blocks_what_is_left() {
+        let img = ViewImage {
+            name: "a".into(),
+            width: 5,
+            height: 3,
+            channels: vec![
+                Channel {
+                    name: "R".into(),
+                    data: (0..15).map(|v| v as f32).collect(),
+                },
+                Channel {
+                    name: "G".into(),
+                    data: vec![1.0; 15],
+                },
+            ],
+            provenance: Vec::new(),
+        };
+        let d = img.downsample(2, &[1, 0]);
+        assert_eq!((d.width, d.height), (3, 2));
+        assert_eq!(d.channels[0].name, "G");
+        assert_eq!(d.channels[0].data, vec![1.0; 6]);
+        // Rows 0-1 × columns 0-1: (0 + 1 + 5 + 6) / 4; the last column is one wide, the
+        // last row one high.
+        assert_eq!(d.channels[1].data, vec![3.0, 5.0, 6.5, 10.5, 12.5, 14.0]);
+        assert_eq!(img.downsample(1, &[0, 1]).channels, img.channels);
+    }
 
     #[test]
     fn spectral_channel_names_parse_with_a_comma_or_a_point() {

@@ -20,7 +20,7 @@
 //! | `/`, `/viewer.js`, `/viewer.css` | the page |
 //! | `/api/images` | the images: size, channels, views, bins, provenance (JSON) |
 //! | `/api/generation` | a counter bumped when a render in progress updates its image |
-//! | `/api/image/I/view?view=V&ev=EV&mode=hue\|clip` | view V of image I as RGBA8 |
+//! | `/api/image/I/view?view=V&ev=EV&mode=hue\|clip&step=S` | view V of image I as RGBA8, one pixel per S×S block |
 //! | `/api/image/I/channel/K` | channel K of image I as f32 LE |
 //! | `/api/image/I/pixel?x=X&y=Y` | every channel's value at (X, Y), the spectrum (JSON) |
 //! | `/api/compare/A/B` | `heron compare`'s heat map of A against B as RGBA8 |
@@ -238,10 +238,22 @@ impl Viewer {
             .map_err(|_| Response::error(400, "ev: expected a number of stops, e.g. -1.5"))?;
         let t = DisplayTransform::new(mode, ev)
             .map_err(|e| Response::error(400, format!("ev: {e}")))?;
+        let step: u32 = req
+            .get("step")
+            .unwrap_or("1")
+            .parse()
+            .ok()
+            .filter(|s| (1..=256).contains(s))
+            .ok_or_else(|| {
+                Response::error(
+                    400,
+                    "step: expected image pixels per picture pixel, 1 to 256",
+                )
+            })?;
         Ok(
-            Response::ok("application/octet-stream", view.draw(&img, &t))
-                .with_header("X-Width", img.width.to_string())
-                .with_header("X-Height", img.height.to_string()),
+            Response::ok("application/octet-stream", view.draw_scaled(&img, &t, step))
+                .with_header("X-Width", img.width.div_ceil(step).to_string())
+                .with_header("X-Height", img.height.div_ceil(step).to_string()),
         )
     }
 
@@ -451,6 +463,10 @@ mod tests {
         let brighter = get(&v, "/api/image/0/view?view=rgb&ev=1&mode=clip");
         assert_ne!(brighter.body, r.body);
         assert_eq!(get(&v, "/api/image/0/view?ev=abc").status, 400);
+        assert_eq!(get(&v, "/api/image/0/view?step=0").status, 400);
+        let half = get(&v, "/api/image/0/view?view=rgb&ev=0&mode=clip&step=2");
+        assert_eq!(half.body.len(), 2 * 1 * 4);
+        assert_eq!(&half.body[..3], &t.encode_u8([0.5, 0.25, 1.0]));
         assert_eq!(get(&v, "/api/image/0/view?view=dolp").status, 400);
         assert_eq!(get(&v, "/api/image/0/pixel?x=3&y=0").status, 400);
         let p: Value = serde_json::from_slice(&get(&v, "/api/image/0/pixel?x=2&y=1").body).unwrap();

@@ -15,6 +15,9 @@ const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 pub enum View {
     /// Linear sRGB through the display transform, as the PNG preview.
     Rgb,
+    /// CIE X, Y, Z shown as if they were R, G, B (false colour), through the display
+    /// transform: where the film's XYZ differs from its colour.
+    Xyz,
     /// The standard error √variance of R, G, B, through the display transform.
     StdErr,
     /// S1/S0, S2/S0 or S3/S0 of the luminance, in [−1, 1]: red positive, blue negative.
@@ -34,6 +37,9 @@ impl View {
         let mut out = Vec::new();
         if img.rgb(0).is_some() {
             out.push(("rgb".into(), "RGB (linear sRGB)".into()));
+        }
+        if img.triple(["X", "Y", "Z"]).is_some() {
+            out.push(("xyz".into(), "XYZ as R, G, B (false colour)".into()));
         }
         if img.variance().is_some() {
             out.push(("stderr".into(), "standard error (√variance)".into()));
@@ -55,6 +61,7 @@ impl View {
     pub fn parse(id: &str, img: &ViewImage) -> Option<View> {
         let view = match id {
             "rgb" => View::Rgb,
+            "xyz" => View::Xyz,
             "stderr" => View::StdErr,
             "s1" => View::Stokes(1),
             "s2" => View::Stokes(2),
@@ -71,12 +78,57 @@ impl View {
         View::list(img).iter().any(|(v, _)| v == id).then_some(view)
     }
 
+    /// The channels (indices into `img`) this view is drawn from.
+    pub fn inputs(self, img: &ViewImage) -> Vec<usize> {
+        let names = |ns: &[&str]| -> Vec<usize> { ns.iter().filter_map(|n| img.find(n)).collect() };
+        let colour = ["R", "G", "B", "X", "Y", "Z"];
+        match self {
+            View::Rgb if img.triple(["R", "G", "B"]).is_some() => names(&["R", "G", "B"]),
+            View::Rgb => names(&["X", "Y", "Z"]),
+            View::Xyz => names(&["X", "Y", "Z"]),
+            View::StdErr => names(&crate::film::exr::VARIANCE_CHANNELS),
+            View::Stokes(_) | View::Dolp | View::Aolp => {
+                let mut v = names(&colour);
+                v.extend(
+                    crate::film::exr::STOKES_CHANNELS
+                        .iter()
+                        .flat_map(|n| names(n)),
+                );
+                v
+            }
+            View::Channel(c) => vec![c],
+        }
+    }
+
+    /// The picture at one pixel per `step × step` block of the image (1: every pixel),
+    /// from the block means of the view's channels: what the page asks for while it
+    /// shows the image smaller than 1/step of its size (a 4K image fitted to a window),
+    /// so that opening a large file does not wait for every pixel's colour.
+    pub fn draw_scaled(self, img: &ViewImage, t: &DisplayTransform, step: u32) -> Vec<u8> {
+        if step <= 1 {
+            return self.draw(img, t);
+        }
+        let keep = self.inputs(img);
+        let small = img.downsample(step, &keep);
+        let view = match self {
+            View::Channel(_) => View::Channel(0),
+            v => v,
+        };
+        view.draw(&small, t)
+    }
+
     /// The picture: `width × height` RGBA, 8 bits per channel, row-major from the top.
     /// Pixels are drawn in parallel (a 4K picture is 8.3 million of them): each is a
     /// function of its own values only, so the bytes do not depend on the threads.
     pub fn draw(self, img: &ViewImage, t: &DisplayTransform) -> Vec<u8> {
         match self {
             View::Rgb => fill(img, |i| t.encode_u8(img.rgb(i).unwrap_or([0.0; 3]))),
+            View::Xyz => {
+                let xyz = img
+                    .triple(["X", "Y", "Z"])
+                    .expect("listed only with X, Y, Z");
+                fill(img, |i| t.encode_u8(xyz.map(|p| p[i])))
+            }
             View::StdErr => {
                 let var = img.variance().expect("listed only with variance channels");
                 fill(img, |i| t.encode_u8(var.map(|p| p[i].max(0.0).sqrt())))

@@ -145,8 +145,10 @@ def _git_version() -> tuple[str, str]:
     if top.returncode != 0 or pathlib.Path(top.stdout.strip()).resolve() != REPO.resolve():
         return "unknown", "unknown"
     head = _run(["git", "rev-parse", "HEAD"], cwd=REPO).stdout.strip()
-    status = _run(["git", "status", "--porcelain", "--untracked-files=no", "--", *SOURCES],
-                  cwd=REPO)
+    # --no-optional-locks: git status must not refresh the index, which heron's build
+    # script watches; a rewritten index would rebuild heron (two minutes) in the next test.
+    status = _run(["git", "--no-optional-locks", "status", "--porcelain", "--untracked-files=no",
+                   "--", *SOURCES], cwd=REPO)
     assert status.returncode == 0, status.stderr
     return head, ("dirty" if status.stdout.strip() else "clean")
 

@@ -10,7 +10,8 @@ const S = {
   a: 0, b: 1, showing: 0,          // A, B and which of them is on screen
   view: "rgb", ev: 0, mode: "hue",
   zoom: 1, ox: 0, oy: 0, fitted: true,
-  picture: null, overlay: null,    // offscreen canvases at the image's size
+  picture: null, overlay: null,    // offscreen canvases: the view (one pixel per step×step
+  step: 1,                         // block of the image) and the z-map (the image's size)
   pinned: null, hover: null, busy: false, queued: null,
   drawn: 0,                        // pictures drawn so far (tests wait on it)
 };
@@ -93,10 +94,17 @@ async function refresh() {
   const img = current();
   if (!img) return;
   fillViews();
-  const q = `view=${encodeURIComponent(S.view)}&ev=${S.ev}&mode=${S.mode}`;
+  if (S.fitted) fit();
+  // Shown smaller than its size, the image is fetched one pixel per block of `step`
+  // pixels (block means, drawn by the server): a 4K file fitted to a window is a
+  // sixteenth of the bytes. Zooming in past the block size fetches it again.
+  const step = wantedStep();
+  const q = `view=${encodeURIComponent(S.view)}&ev=${S.ev}&mode=${S.mode}&step=${step}`;
   try {
     const r = await fetchOk(`/api/image/${S.showing}/view?${q}`);
-    S.picture = toCanvas(await r.arrayBuffer(), img.width, img.height);
+    S.picture = toCanvas(await r.arrayBuffer(), Number(r.headers.get("X-Width")),
+                         Number(r.headers.get("X-Height")));
+    S.step = step;
     S.overlay = null;
     if ($("zmap").checked && S.images.length > 1) {
       const z = await fetchOk(`/api/compare/${S.a}/${S.b}`);
@@ -107,7 +115,6 @@ async function refresh() {
         `up to noise (max |z| ${z.headers.get("X-Heron-Max-Abs-Z")}, ` +
         `${z.headers.get("X-Heron-Tests")} tests, Šidák α = 0.01)`;
     }
-    if (S.fitted) fit();
     draw();
     S.drawn += 1;
     const which = S.images.length > 1 ? (S.showing === S.a ? "A: " : "B: ") : "";
@@ -118,6 +125,10 @@ async function refresh() {
   } catch (e) {
     status(String(e.message || e), true);
   }
+}
+
+function wantedStep() {
+  return Math.max(1, Math.min(256, Math.floor(1 / S.zoom)));
 }
 
 function fit() {
@@ -142,8 +153,9 @@ function draw() {
   if (!S.picture) return;
   // Nearest neighbour once pixels are magnified: they stay squares to inspect.
   ctx.imageSmoothingEnabled = S.zoom < 1;
-  ctx.setTransform(S.zoom, 0, 0, S.zoom, S.ox, S.oy);
+  ctx.setTransform(S.zoom * S.step, 0, 0, S.zoom * S.step, S.ox, S.oy);
   ctx.drawImage(S.picture, 0, 0);
+  ctx.setTransform(S.zoom, 0, 0, S.zoom, S.ox, S.oy);
   if (S.overlay) {
     ctx.globalAlpha = Number($("zmap-alpha").value);
     ctx.drawImage(S.overlay, 0, 0);
@@ -277,7 +289,7 @@ function wire() {
   $("ev").oninput = (e) => setEv(e.target.value);
   $("ev-num").onchange = (e) => setEv(e.target.value);
   $("mode").onchange = (e) => { S.mode = e.target.value; refresh(); };
-  $("fit").onclick = () => { fit(); draw(); };
+  $("fit").onclick = () => { fit(); if (wantedStep() < S.step) refresh(); else draw(); };
   $("one").onclick = () => zoomTo(1, $("viewport").clientWidth / 2, $("viewport").clientHeight / 2);
   $("flip").onclick = flip;
   $("b-file").onchange = (e) => { S.b = Number(e.target.value); refresh(); };
@@ -316,7 +328,7 @@ function wire() {
   window.onkeydown = (e) => {
     if (e.target.tagName === "INPUT" || e.target.tagName === "SELECT") return;
     if (e.key === "f" || e.key === "F") flip();
-    else if (e.key === "0") { fit(); draw(); }
+    else if (e.key === "0") $("fit").onclick();
     else if (e.key === "1") $("one").onclick();
     else if (e.key === "+" || e.key === "=") setEv(S.ev + 0.5);
     else if (e.key === "-") setEv(S.ev - 0.5);
@@ -332,7 +344,8 @@ function zoomTo(z, cx, cy) {
   // At whole zoom factors pixels land on whole screen pixels: no half-pixel seams.
   if (z >= 1 && Number.isInteger(z)) { S.ox = Math.round(S.ox); S.oy = Math.round(S.oy); }
   S.fitted = false;
-  draw();
+  if (wantedStep() < S.step) refresh();
+  else draw();
 }
 
 // A render in progress (heron render --view) bumps the generation as passes finish.
