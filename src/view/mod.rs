@@ -465,7 +465,8 @@ mod tests {
         assert_eq!(get(&v, "/api/image/0/view?ev=abc").status, 400);
         assert_eq!(get(&v, "/api/image/0/view?step=0").status, 400);
         let half = get(&v, "/api/image/0/view?view=rgb&ev=0&mode=clip&step=2");
-        assert_eq!(half.body.len(), 2 * 1 * 4);
+        // 3×2 pixels in 2×2 blocks: 2×1 picture pixels of 4 bytes.
+        assert_eq!(half.body.len(), 8);
         assert_eq!(&half.body[..3], &t.encode_u8([0.5, 0.25, 1.0]));
         assert_eq!(get(&v, "/api/image/0/view?view=dolp").status, 400);
         assert_eq!(get(&v, "/api/image/0/pixel?x=3&y=0").status, 400);
