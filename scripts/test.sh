@@ -8,17 +8,18 @@ cd "$(dirname "$0")/.."
 # Each phase's start time, UTC, so that a CI log shows where its minutes go.
 phase() { echo "test.sh: $(date -u +%H:%M:%S) $*"; }
 
-phase "set-up"
-scripts/setup.sh --deps
-
 # A fresh clone's index holds "racily clean" entries (files written in the second the
 # index was), which the first `git status` that may write rewrites. heron's build script
 # watches the index (for the commit and dirty state it records), so that rewrite, made by
 # whichever test ran git first, rebuilt heron in every later build (the tarball's and the
-# wheels': about four minutes of CI). Settle it once, before anything is built.
+# wheels': about four minutes of CI). Settle it once, before anything is built (the
+# set-up builds the Python module).
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
     git update-index -q --really-refresh >/dev/null 2>&1 || true
 fi
+
+phase "set-up"
+scripts/setup.sh --deps
 
 phase "release build"
 cargo build --release --locked

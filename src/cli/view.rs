@@ -30,6 +30,10 @@ pub(crate) fn run(args: ViewArgs) -> Result<()> {
     for f in &args.files {
         ViewImage::check_exr(f)?;
     }
+    // Ctrl-C ends the viewer with status 0, also where SIGINT came in ignored (a
+    // background job of a non-interactive shell inherits it so).
+    ctrlc::set_handler(|| std::process::exit(0))
+        .map_err(|e| anyhow::anyhow!("cannot install the Ctrl-C handler: {e}"))?;
     // The address first, the pixels after: the browser starts and loads the page while
     // the files decode (a 4K spectral EXR takes seconds), and the page's first request
     // for an image waits for them.

@@ -270,11 +270,14 @@ def _run_server(shown: str, work, env) -> tuple[int, str]:
             images = json.load(r)["images"]
         return (0 if images else 1), json.dumps([i["name"] for i in images])
     finally:
+        # Both servers end on Ctrl-C with status 0 (their handlers also catch a SIGINT
+        # that came in ignored, as in a background job of a non-interactive shell).
         proc.send_signal(signal.SIGINT)
         try:
             proc.wait(timeout=30)
         except subprocess.TimeoutExpired:
             proc.kill()
+            raise AssertionError(f"`{shown}` did not end on SIGINT")
 
 
 def _workdir(tmp_path: pathlib.Path) -> pathlib.Path:

@@ -139,6 +139,21 @@ def test_bad_files_get_an_error_naming_them_and_no_server(tmp_path):
         assert expect in r.stderr and "heron view: http" not in r.stdout, r.stderr
 
 
+def test_ctrl_c_ends_the_viewer_with_status_0(files):
+    """Also when SIGINT comes in ignored, as in a background job of a script."""
+    _, a, _, _ = files
+    import signal as sig
+
+    s = vd.Server(["view", str(a), "--no-browser"],
+                  preexec_fn=lambda: sig.signal(sig.SIGINT, sig.SIG_IGN))
+    try:
+        assert json.loads(get(s, "/api/images")[2])["images"]
+        s.proc.send_signal(sig.SIGINT)
+        assert s.proc.wait(timeout=30) == 0
+    finally:
+        s.close()
+
+
 @pytest.fixture(scope="module")
 def page(server):
     driver = vd.browser()

@@ -40,9 +40,10 @@ class Server:
     """`heron view FILES --no-browser` (or another heron command that opens the viewer)
     on a free port; `url` is the address it printed."""
 
-    def __init__(self, args: list[str], cwd: pathlib.Path | None = None):
+    def __init__(self, args: list[str], cwd: pathlib.Path | None = None, preexec_fn=None):
         self.proc = subprocess.Popen([str(require_heron_bin()), *args], cwd=cwd,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                     preexec_fn=preexec_fn)
         line = self.proc.stdout.readline()
         m = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
         if not m:
