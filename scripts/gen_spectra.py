@@ -101,6 +101,11 @@ def main():
     # by the Lorenz-Mie media (src/medium/homogeneous.rs) for absorption in the drops.
     write(out, "water_k_hale_querry1973.csv", ["wavelength_nm", "k"], WATER_K_HALE_QUERRY)
 
+    # Ice's complex index n + ik, Warren & Brandt (2008), 350-900 nm: typed from the
+    # compilation's table (not in colour-science). The catalogue's `ice`
+    # (spectra/ior_catalogue.toml) reads n; the halo skies and ice media use it.
+    write(out, "ice_warren_brandt2008.csv", ["wavelength_nm", "n", "k"], ICE_WARREN_BRANDT)
+
 
 # Hale, G. M. & Querry, M. R. (1973), "Optical constants of water in the 200-nm to
 # 200-um wavelength region", Appl. Opt. 12(3), 555-563, Table I (k at 25 C), every
@@ -112,6 +117,33 @@ WATER_K_HALE_QUERRY = [
     (600, 1.09e-8), (625, 1.39e-8), (650, 1.64e-8), (675, 2.23e-8), (700, 3.35e-8),
     (725, 9.15e-8), (750, 1.56e-7), (775, 1.48e-7), (800, 1.25e-7), (825, 1.82e-7),
     (850, 2.93e-7),
+]
+
+
+# Warren, S. G. & Brandt, R. E. (2008), "Optical constants of ice from the ultraviolet
+# to the microwave: A revised compilation", J. Geophys. Res. 113, D14220,
+# doi:10.1029/2007JD009744: ice Ih at -7 C, the rows from 350 to 900 nm (every 10 nm
+# from 390 nm; the compilation has 350 and 390 nm below that). The same digits are in
+# refractiveindex.info's H2O/nk/Warren-2008 table.
+ICE_WARREN_BRANDT = [
+    (350, 1.3249, 2.0e-11), (390, 1.3203, 2.0e-11), (400, 1.3194, 2.365e-11),
+    (410, 1.3185, 2.669e-11), (420, 1.3177, 3.135e-11), (430, 1.317, 4.14e-11),
+    (440, 1.3163, 6.268e-11), (450, 1.3157, 9.239e-11), (460, 1.3151, 1.325e-10),
+    (470, 1.3145, 1.956e-10), (480, 1.314, 2.861e-10), (490, 1.3135, 4.172e-10),
+    (500, 1.313, 5.889e-10), (510, 1.3126, 8.036e-10), (520, 1.3121, 1.076e-09),
+    (530, 1.3117, 1.409e-09), (540, 1.3114, 1.813e-09), (550, 1.311, 2.289e-09),
+    (560, 1.3106, 2.839e-09), (570, 1.3103, 3.461e-09), (580, 1.31, 4.159e-09),
+    (590, 1.3097, 4.93e-09), (600, 1.3094, 5.73e-09), (610, 1.3091, 6.89e-09),
+    (620, 1.3088, 8.58e-09), (630, 1.3085, 1.04e-08), (640, 1.3083, 1.22e-08),
+    (650, 1.308, 1.43e-08), (660, 1.3078, 1.66e-08), (670, 1.3076, 1.89e-08),
+    (680, 1.3073, 2.09e-08), (690, 1.3071, 2.4e-08), (700, 1.3069, 2.9e-08),
+    (710, 1.3067, 3.44e-08), (720, 1.3065, 4.03e-08), (730, 1.3062, 4.3e-08),
+    (740, 1.306, 4.92e-08), (750, 1.3059, 5.87e-08), (760, 1.3057, 7.08e-08),
+    (770, 1.3055, 8.58e-08), (780, 1.3053, 1.02e-07), (790, 1.3051, 1.18e-07),
+    (800, 1.3049, 1.34e-07), (810, 1.3047, 1.4e-07), (820, 1.3046, 1.43e-07),
+    (830, 1.3044, 1.45e-07), (840, 1.3042, 1.51e-07), (850, 1.304, 1.83e-07),
+    (860, 1.3039, 2.15e-07), (870, 1.3037, 2.65e-07), (880, 1.3035, 3.35e-07),
+    (890, 1.3033, 3.92e-07), (900, 1.3032, 4.2e-07),
 ]
 
 

@@ -11,13 +11,16 @@
 //!   splits each partial wave into the waves leaving the sphere after p internal passes
 //!   (the `mie` sky's `debye` term).
 //!
+//! - [`ice`]: hexagonal ice crystals by geometric optics (the halo sky and the ice
+//!   media): the prism, the orientations of its populations, Fresnel ray tracing inside
+//!   it with Mueller matrices, and diffraction by its projected area.
 //! - [`mueller`]: Stokes vectors and Mueller matrices (Collett 2005's convention): the
 //!   Fresnel reflection and transmission of dielectrics and conductors with their
 //!   retardance, polarisers, retarders, rotations (the closed forms the materials'
 //!   Mueller matrices for polarised transport are computed from, `crate::bsdf::polarization`).
 //!
 //! Layer 2 ("physics", `../shared/DESIGN.md`): this module imports nothing of heron's
-//! (only `num-complex`); `sky` and `medium` import it, never the reverse.
+//! (only `num-complex`, `glam` and `libm`); `sky` and `medium` import it, never the reverse.
 //!
 //! What is here and what is not: [`mie::MieSphere`] (a sphere's coefficients and
 //! efficiencies) is pure optics, so it is here. The drop population a medium is made of
@@ -27,6 +30,7 @@
 //! `crate::sky::Polarisation`) and the largest Debye term the CLI and scenes accept
 //! (`crate::sky::mie::MAX_DEBYE_TERM`) are the sky's.
 pub mod debye;
+pub mod ice;
 pub mod mie;
 pub mod mueller;
 

@@ -6,7 +6,8 @@
 //! - Cauchy: n(λ) = A + B/λ² + C/λ⁴, with λ in µm.
 //! - Tabulated: linear interpolation of (λ nm, n) samples.
 //!
-//! The named catalogue lives in spectra/ior_catalogue.toml, compiled into the binary.
+//! The named catalogue lives in spectra/ior_catalogue.toml, compiled into the binary
+//! with the tables its `table =` entries name (ice: Warren & Brandt 2008).
 use super::DenseSpectrum;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -116,7 +117,11 @@ impl Ior {
 struct CatalogueEntry {
     #[allow(dead_code)]
     source: String,
-    sellmeier: SellmeierCoefficients,
+    #[serde(default)]
+    sellmeier: Option<SellmeierCoefficients>,
+    /// A table of spectra/ with columns `wavelength_nm, n, …` ([`TABLES`]).
+    #[serde(default)]
+    table: Option<String>,
     n_d: f32,
     #[serde(default)]
     v_d: Option<f32>,
@@ -141,6 +146,39 @@ pub struct CatalogueMaterial {
 
 const CATALOGUE: &str = include_str!("../../spectra/ior_catalogue.toml");
 
+/// The tables of spectra/ the catalogue's `table =` entries may name, compiled in.
+const TABLES: [(&str, &str); 1] = [(
+    "ice_warren_brandt2008.csv",
+    include_str!("../../spectra/ice_warren_brandt2008.csv"),
+)];
+
+/// n(λ) from a compiled-in table's `n` column, linear between its rows.
+fn table_ior(name: &str) -> Ior {
+    let (_, text) = TABLES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .expect("the catalogue names a compiled-in table");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| h.trim() == "n")
+        .expect("a column n");
+    let rows: Vec<(f32, f32)> = lines
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            Some((
+                cells[0].trim().parse().ok()?,
+                cells.get(col)?.trim().parse().ok()?,
+            ))
+        })
+        .collect();
+    Ior::Table(DenseSpectrum::from_table_with(
+        &rows,
+        super::interp::Interpolation::Linear,
+    ))
+}
+
 /// The named refractive-index models of spectra/ior_catalogue.toml, by name.
 pub fn catalogue() -> &'static BTreeMap<String, CatalogueMaterial> {
     static CAT: OnceLock<BTreeMap<String, CatalogueMaterial>> = OnceLock::new();
@@ -149,8 +187,11 @@ pub fn catalogue() -> &'static BTreeMap<String, CatalogueMaterial> {
             toml::from_str(CATALOGUE).expect("spectra/ior_catalogue.toml is valid");
         raw.into_iter()
             .map(|(name, e)| {
-                let ior =
-                    Ior::sellmeier(&e.sellmeier.b, &e.sellmeier.c).expect("catalogue coefficients");
+                let ior = match (&e.sellmeier, &e.table) {
+                    (Some(s), None) => Ior::sellmeier(&s.b, &s.c).expect("catalogue coefficients"),
+                    (None, Some(t)) => table_ior(t),
+                    _ => panic!("catalogue entry {name}: expected sellmeier or table"),
+                };
                 (
                     name.clone(),
                     CatalogueMaterial {
