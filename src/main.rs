@@ -40,6 +40,7 @@ fn main() {
         Command::Info { exr } => cli::info::run(&exr),
         Command::Stress(args) => cli::stress::run(args),
         Command::Sky(c) => cli::sky::run(c),
+        Command::Halo(c) => cli::halo::run(c),
         Command::Lens(args) => cli::lens::run(args),
         Command::View(args) => cli::view::run(args),
         Command::Spectra { scene } => heron::scene::load_scene(&scene)

@@ -189,7 +189,10 @@ fn sky_drops_reach_the_tabulated_model() {
         "{BASE}\n[sky]\nmodel = \"airy\"\ndrops = {{ distribution = \"lognormal\", median_mm = 0.2, sigma = 0.2, nodes = 4 }}\n"
     );
     let scene = load_scene_from_str(&text, Path::new("drops.toml")).unwrap();
-    let table = &scene.sky.as_ref().expect("a sky").table;
+    let heron::sky::table::SkyShape::Profile(table) = &scene.sky.as_ref().expect("a sky").shape
+    else {
+        panic!("an airy sky is a profile")
+    };
     let alpha = 0.2666f64.to_radians();
     let want = heron::sky::AirySky::water(1.0, alpha).with_distribution(
         &heron::drops::DropSizeDistribution::LogNormal {

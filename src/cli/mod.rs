@@ -13,6 +13,7 @@ pub(crate) mod compare;
 pub(crate) mod converge;
 pub(crate) mod convert;
 pub(crate) mod display;
+pub(crate) mod halo;
 pub(crate) mod info;
 pub(crate) mod lens;
 pub(crate) mod merge;
@@ -81,6 +82,9 @@ pub(crate) enum Command {
     /// Rainbow skies: radiance profiles of the sky models (heron::sky).
     #[command(subcommand)]
     Sky(sky::SkyCommand),
+    /// Ice-crystal halos: profiles of the halo sky (heron::sky::halo).
+    #[command(subcommand)]
+    Halo(halo::HaloCommand),
     /// A lens prescription's optics from heron's own lens code: first order (EFL, BFL,
     /// f-number, pupils) at F, d and C, the chromatic focal shift over 400–700 nm and
     /// real-ray spot diagrams per field angle and wavelength; with --out, as CSV files

@@ -9,10 +9,21 @@
 //! bins in u, each weighted by the larger of its two ends' radiance averaged over
 //! 360–830 nm (the table interpolates linearly between nodes, so that bound never misses
 //! light), and φ is uniform. The density is then p(ω) = p_u(cos θ)/(2π).
+//!
+//! A halo sky ([`crate::sky::halo`]) depends on the direction about the sun too, so it
+//! is sampled by its table's cells over (θ, ψ), ψ unfolded over both sides of the sun's
+//! vertical: each cell weighted by the largest radiance among it and its neighbours
+//! (the table interpolates between cell centres) averaged over λ, plus the background,
+//! times sin θ; a point uniform in (θ, ψ) within the cell, so
+//! p(ω) = p(θ, ψ)/(2π² sin θ) over θ ∈ [0, π], ψ ∈ [−π, π).
 use super::envmap::EnvMap;
 use super::{LightLeSample, LightLiSample, SceneBounds};
+use crate::math::distribution::Distribution2D;
 use crate::math::warp::{uniform_sphere, UNIFORM_SPHERE_PDF};
 use crate::math::Frame;
+use crate::sky::halo::table::{Placed, N_PSI, N_THETA, PSI_STEP, THETA_STEP};
+use crate::sky::halo::FORWARD_CUT_DEG;
+use crate::sky::table::SkyShape;
 use crate::sky::SceneSky;
 use crate::spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
 use glam::{Vec2, Vec3};
@@ -28,6 +39,8 @@ pub struct EnvironmentLight {
     pub map: Option<Arc<EnvMap>>,
     /// Importance sampling of the sky in u = cos θ about the antisolar axis.
     zones: Option<Zones>,
+    /// Importance sampling of a halo sky by its cells.
+    cells: Option<Box<Cells>>,
     /// ∫ L dω, averaged over wavelength.
     power_per_area: f32,
 }
@@ -71,6 +84,93 @@ impl Zones {
     }
 }
 
+/// The cells of a halo table as a 2D distribution over (θ, ψ) ∈ [0, π] × [−π, π).
+#[derive(Clone, Debug)]
+struct Cells {
+    dist: Distribution2D,
+    placed: Placed,
+}
+
+impl Cells {
+    /// The cells of `sky`'s halo table, weighted as the module documentation says, and
+    /// ∫ L dω; None for a sky without light.
+    fn new(sky: &SceneSky, halo: &crate::sky::halo::PlacedHalo, bg: f32) -> (Option<Cells>, f32) {
+        let rows = ((LAMBDA_MAX - LAMBDA_MIN) / 5.0).round() as usize;
+        let f_mean: f32 = (0..=rows)
+            .map(|k| sky.factor.eval(LAMBDA_MIN + 5.0 * k as f32))
+            .sum::<f32>()
+            / (rows + 1) as f32;
+        // Mean over the table's rows times the factor's mean over λ: a sampling weight,
+        // not the radiance (the product's mean would weigh rows by the sun's spectrum).
+        // Inside the forward cone the sky reads the cone's edge: the cells there take
+        // the value of the first cell outside it.
+        let first_outside = (FORWARD_CUT_DEG / THETA_STEP).ceil() as usize;
+        let mean: Vec<f32> = (0..N_PSI)
+            .flat_map(|k| (0..N_THETA).map(move |j| (k, j)))
+            .map(|(k, j)| halo.table.cell_mean(k, j.max(first_outside)) * f_mean)
+            .collect();
+        let at = |k: usize, j: usize| mean[k * N_THETA + j];
+        let mut power = 0.0f64;
+        // Rows y: ψ from −180° to 180°, the mirror image of the folded table first.
+        let mut func = vec![0.0f32; 2 * N_PSI * N_THETA];
+        for y in 0..2 * N_PSI {
+            let k = if y < N_PSI { N_PSI - 1 - y } else { y - N_PSI };
+            for j in 0..N_THETA {
+                let mut m = 0.0f32;
+                for kk in k.saturating_sub(1)..=(k + 1).min(N_PSI - 1) {
+                    for jj in j.saturating_sub(1)..=(j + 1).min(N_THETA - 1) {
+                        m = m.max(at(kk, jj));
+                    }
+                }
+                let theta = ((j as f64 + 0.5) * THETA_STEP).to_radians();
+                func[y * N_THETA + j] = (m + bg) * theta.sin() as f32;
+                let (t0, t1) = (
+                    (j as f64 * THETA_STEP).to_radians(),
+                    ((j + 1) as f64 * THETA_STEP).to_radians(),
+                );
+                power += (at(k, j) + bg) as f64 * (t0.cos() - t1.cos()) * PSI_STEP.to_radians();
+            }
+        }
+        if !(power > 0.0) {
+            return (None, 0.0);
+        }
+        let cells = Cells {
+            dist: Distribution2D::new(&func, N_THETA, 2 * N_PSI),
+            placed: halo.placed.clone(),
+        };
+        (Some(cells), power as f32)
+    }
+
+    fn sample(&self, u: Vec2) -> (Vec3, f32) {
+        let (p, pdf_uv) = self.dist.sample(u);
+        let theta = p.x as f64 * 180.0;
+        let psi = p.y as f64 * 360.0 - 180.0;
+        let w = crate::sky::halo::table::from_sun_coordinates(
+            theta,
+            psi,
+            self.placed.sun,
+            self.placed.zenith,
+        )
+        .as_vec3();
+        let s = theta.to_radians().sin() as f32;
+        if !(s > 0.0) {
+            return (w, 0.0);
+        }
+        (w, pdf_uv / (2.0 * PI * PI * s))
+    }
+
+    fn pdf(&self, w: Vec3) -> f32 {
+        let (theta, psi) = self.placed.coordinates(w);
+        let s = theta.to_radians().sin() as f32;
+        if !(s > 0.0) {
+            return 0.0;
+        }
+        // Symmetric about ψ = 0: the positive half's cell.
+        let p = Vec2::new((theta / 180.0) as f32, ((psi + 180.0) / 360.0) as f32);
+        self.dist.pdf(p.clamp(Vec2::ZERO, Vec2::splat(0.999_999_9))) / (2.0 * PI * PI * s)
+    }
+}
+
 impl EnvironmentLight {
     pub fn new(
         background: DenseSpectrum,
@@ -84,6 +184,7 @@ impl EnvironmentLight {
                 sky: None,
                 map,
                 zones: None,
+                cells: None,
                 power_per_area,
             };
         }
@@ -94,8 +195,23 @@ impl EnvironmentLight {
                 sky,
                 map: None,
                 zones: None,
+                cells: None,
                 power_per_area,
             };
+        };
+        let table = match &s.shape {
+            SkyShape::Profile(t) => t,
+            SkyShape::Halo(h) => {
+                let (cells, power_per_area) = Cells::new(s, h, background.mean());
+                return EnvironmentLight {
+                    background,
+                    sky,
+                    map: None,
+                    zones: None,
+                    cells: cells.map(Box::new),
+                    power_per_area,
+                };
+            }
         };
         // Mean radiance over λ at each θ node, on the table's own 5 nm rows.
         let rows = ((LAMBDA_MAX - LAMBDA_MIN) / 5.0).round() as usize;
@@ -105,13 +221,13 @@ impl EnvironmentLight {
         } else {
             background.mean()
         };
-        let grid = s.table.theta_grid();
+        let grid = table.theta_grid();
         let mean: Vec<f32> = grid
             .iter()
             .map(|&t| {
                 let sum: f32 = lambdas
                     .iter()
-                    .map(|&l| s.table.eval(t, l) * s.factor.eval(l))
+                    .map(|&l| table.eval(t, l) * s.factor.eval(l))
                     .sum();
                 sum / lambdas.len() as f32 + bg
             })
@@ -145,6 +261,7 @@ impl EnvironmentLight {
                 sky,
                 map: None,
                 zones: None,
+                cells: None,
                 power_per_area: 0.0,
             };
         }
@@ -168,6 +285,7 @@ impl EnvironmentLight {
             sky,
             map: None,
             zones: Some(zones),
+            cells: None,
             power_per_area,
         }
     }
@@ -182,12 +300,23 @@ impl EnvironmentLight {
         match &self.sky {
             None => wl.eval(&self.background),
             Some(sky) => {
-                // θ once per ray; the table per lane.
-                let theta = crate::sky::antisolar_angle(dir, sky.sun_dir).to_degrees();
                 let mut s = SampledSpectrum::<N>::zero();
-                for i in 0..N {
-                    let lambda = wl.lambda[i];
-                    s.0[i] = sky.table.eval(theta, lambda) * sky.factor.eval(lambda);
+                match &sky.shape {
+                    SkyShape::Profile(table) => {
+                        // θ once per ray; the table per lane.
+                        let theta = crate::sky::antisolar_angle(dir, sky.sun_dir).to_degrees();
+                        for i in 0..N {
+                            let lambda = wl.lambda[i];
+                            s.0[i] = table.eval(theta, lambda) * sky.factor.eval(lambda);
+                        }
+                    }
+                    SkyShape::Halo(h) => {
+                        let at = h.placed.coordinates(dir);
+                        for i in 0..N {
+                            let lambda = wl.lambda[i];
+                            s.0[i] = h.eval(at, lambda) * sky.factor.eval(lambda);
+                        }
+                    }
                 }
                 if sky.replaces_background {
                     s
@@ -227,6 +356,9 @@ impl EnvironmentLight {
         if let Some(m) = &self.map {
             return m.sample(u);
         }
+        if let Some(c) = &self.cells {
+            return c.sample(u);
+        }
         match &self.zones {
             Some(z) => z.sample(u),
             None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
@@ -259,6 +391,9 @@ impl EnvironmentLight {
     pub fn pdf_li(&self, wi: Vec3) -> f32 {
         if let Some(m) = &self.map {
             return m.pdf(wi);
+        }
+        if let Some(c) = &self.cells {
+            return c.pdf(wi);
         }
         match &self.zones {
             Some(z) => z.pdf(wi),

@@ -1,6 +1,8 @@
-//! The chart of `heron sky profile --plot`: radiance against the angle from the
-//! antisolar point, one line per wavelength, each drawn in that wavelength's hue.
+//! The charts of `heron sky profile --plot` (radiance against the angle from the
+//! antisolar point, one line per wavelength, each drawn in that wavelength's hue) and of
+//! `heron halo profile --plot` (against the angle from the sun, per great circle).
 use super::{Chart, Scale, Series};
+use crate::sky::halo::profile::HaloProfile;
 use crate::sky::profile::Profile;
 use crate::spectrum::cie;
 use crate::spectrum::color::{srgb_encode, xyz_to_linear_srgb};
@@ -66,6 +68,39 @@ pub fn chart(title: &str, model: &str, p: &Profile) -> Chart {
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         y_from_zero: true,
+        series,
+    }
+}
+
+/// The chart of `heron halo profile --plot`: one line per great circle and wavelength, in the wavelength's hue,
+/// the second and later circles dashed; radiance on a log axis (the forward peak is
+/// 10⁴–10⁵ times the halos).
+pub fn halo_chart(title: &str, p: &HaloProfile) -> Chart {
+    let (np, nl) = (p.psis_deg.len(), p.lambdas.len());
+    let mut series = Vec::new();
+    for (i, psi) in p.psis_deg.iter().enumerate() {
+        for (j, &l) in p.lambdas.iter().enumerate() {
+            series.push(Series {
+                label: format!("ψ = {psi}°, {l} nm"),
+                colour: wavelength_colour(l),
+                points: p
+                    .thetas_deg
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &t)| (t, p.table[(k * np + i) * nl + j] as f64))
+                    .collect(),
+                dashed: i > 0,
+                markers: false,
+            });
+        }
+    }
+    Chart {
+        title: title.to_string(),
+        x_label: "angle from the sun (°)".into(),
+        y_label: "radiance per unit solar irradiance (sr⁻¹)".into(),
+        x_scale: Scale::Linear,
+        y_scale: Scale::Log,
+        y_from_zero: false,
         series,
     }
 }

@@ -38,6 +38,12 @@
 //! one description of a sky that scene files, `heron sky profile` and the Python module
 //! fill, with its rules and limits.
 //!
+//! Halos (`halo`): sunlight scattered by ice crystals, which depends on the direction
+//! about the sun as well as the angle from it when the crystals are oriented, so it is a
+//! table over the sphere ([`halo`]) rather than a profile in θ; it shares the unit of
+//! the physical models (radiance per unit solar irradiance per unit geometric
+//! cross-section).
+//!
 //! Polarisation: `S` means incident light polarised perpendicular to the scattering plane
 //! (Fresnel's s, Mie's S₁), `P` parallel to it (Fresnel's p, Mie's S₂); unpolarised light is
 //! their mean.
@@ -45,6 +51,7 @@ pub mod airy;
 pub mod aristotle;
 pub mod constant;
 pub mod descartes;
+pub mod halo;
 pub mod lee;
 pub mod mie;
 pub mod profile;

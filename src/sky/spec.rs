@@ -31,19 +31,24 @@ pub enum SkyModel {
     Descartes,
     Airy,
     Mie,
+    /// Ice crystals ([`super::halo`]): built by [`super::halo::HaloSpec`], not by
+    /// [`SkySpec::build`], which refuses it.
+    Halo,
 }
 
 impl SkyModel {
     /// Every model, in the order of [`SkyModel::NAMES`].
-    pub const ALL: [SkyModel; 5] = [
+    pub const ALL: [SkyModel; 6] = [
         SkyModel::Constant,
         SkyModel::Aristotle,
         SkyModel::Descartes,
         SkyModel::Airy,
         SkyModel::Mie,
+        SkyModel::Halo,
     ];
     /// The models' names, as scene files, the CLI and Python write them.
-    pub const NAMES: [&'static str; 5] = ["constant", "aristotle", "descartes", "airy", "mie"];
+    pub const NAMES: [&'static str; 6] =
+        ["constant", "aristotle", "descartes", "airy", "mie", "halo"];
 
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
@@ -57,6 +62,15 @@ impl SkyModel {
     /// Whether its profile is the scattering of water drops, radiance per unit solar
     /// irradiance (descartes, airy, mie), rather than a radiance of its own.
     pub fn is_physical(self) -> bool {
+        matches!(
+            self,
+            SkyModel::Descartes | SkyModel::Airy | SkyModel::Mie | SkyModel::Halo
+        )
+    }
+
+    /// Whether it scatters by water drops with s- or p-polarised sunlight as an option
+    /// (descartes, airy, mie).
+    fn takes_polarisation(self) -> bool {
         matches!(self, SkyModel::Descartes | SkyModel::Airy | SkyModel::Mie)
     }
 
@@ -211,7 +225,7 @@ impl SkySpec {
         applies(
             SkyKey::Polarisation,
             self.polarisation.is_some(),
-            SkyModel::is_physical,
+            SkyModel::takes_polarisation,
         )?;
         applies(
             SkyKey::DropletRadius,
@@ -301,6 +315,12 @@ impl SkySpec {
                 s.debye = self.debye;
                 Sky::Mie(s)
             }
+            SkyModel::Halo => {
+                return Err(format!(
+                    "{}: a halo sky is a table over the whole sky, not a profile about the antisolar point (`heron halo profile` draws its profiles)",
+                    name(SkyKey::Model)
+                ))
+            }
         })
     }
 
@@ -388,6 +408,10 @@ mod tests {
         assert_eq!(SkyModel::from_name("rainbow"), None);
         assert_eq!(
             SkyModel::names_where(SkyModel::is_physical),
+            "descartes, airy, mie and halo"
+        );
+        assert_eq!(
+            SkyModel::names_where(SkyModel::takes_polarisation),
             "descartes, airy and mie"
         );
         assert_eq!(SkyModel::names_where(|m| m == SkyModel::Mie), "mie");

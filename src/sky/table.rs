@@ -117,12 +117,20 @@ impl SkyTable {
     }
 }
 
-/// A sky model ready for rendering: tabulated over (θ, λ), tied to the scene's sun.
+/// What a scene's sky reads: a profile about the antisolar axis tabulated over (θ, λ),
+/// or a halo table over the whole sky.
+#[derive(Clone, Debug)]
+pub enum SkyShape {
+    Profile(SkyTable),
+    Halo(super::halo::PlacedHalo),
+}
+
+/// A sky model ready for rendering: tabulated, tied to the scene's sun.
 #[derive(Debug)]
 pub struct SceneSky {
     /// The model's name, for messages.
     pub model: String,
-    pub table: SkyTable,
+    pub shape: SkyShape,
     /// Unit direction toward the sun.
     pub sun_dir: Vec3,
     /// Per-wavelength factor on the table: the sun's irradiance times `scale` for the
@@ -151,11 +159,25 @@ impl SceneSky {
     ) -> SceneSky {
         prepare(&mut sky);
         SceneSky {
-            table: SkyTable::build(&sky),
+            shape: SkyShape::Profile(SkyTable::build(&sky)),
             model,
             sun_dir,
             factor,
             replaces_background,
+            spec: None,
+            linear: OnceLock::new(),
+        }
+    }
+
+    /// A halo sky ([`super::halo`]), traced for its sun, placed in the scene; it adds
+    /// to the background and is unpolarised.
+    pub fn halo(model: String, halo: super::halo::PlacedHalo, factor: DenseSpectrum) -> SceneSky {
+        SceneSky {
+            model,
+            sun_dir: halo.placed.sun.as_vec3(),
+            shape: SkyShape::Halo(halo),
+            factor,
+            replaces_background: false,
             spec: None,
             linear: OnceLock::new(),
         }
@@ -166,7 +188,7 @@ impl SceneSky {
     pub fn with_factor(&self, factor: DenseSpectrum) -> SceneSky {
         SceneSky {
             model: self.model.clone(),
-            table: self.table.clone(),
+            shape: self.shape.clone(),
             sun_dir: self.sun_dir,
             factor,
             replaces_background: self.replaces_background,
@@ -199,6 +221,11 @@ impl SceneSky {
     }
 
     fn build_linear(&self) -> Option<SkyTable> {
+        let SkyShape::Profile(own) = &self.shape else {
+            // The halo table is traced unpolarised (the crystals' Mueller matrices are
+            // in `optics::ice`, not yet in the table).
+            return None;
+        };
         let spec = self.spec.as_ref()?;
         if !SkyModel::from_name(&spec.model).is_some_and(SkyModel::is_physical) {
             return None;
@@ -221,8 +248,8 @@ impl SceneSky {
                 let (ts, tp) = (table("s")?, table("p")?);
                 Some(ts.combine(&tp, |s, p| 0.5 * (s - p)))
             }
-            Polarisation::S => Some(self.table.combine(&self.table, |s, _| s)),
-            Polarisation::P => Some(self.table.combine(&self.table, |p, _| -p)),
+            Polarisation::S => Some(own.combine(own, |s, _| s)),
+            Polarisation::P => Some(own.combine(own, |p, _| -p)),
         }
     }
 }

@@ -188,7 +188,10 @@ mod tests {
         let first = (0.6098 * 0.55 / 25.0f64).asin();
         assert!((diffraction_encircled(first, a, l) - 0.838).abs() < 2e-3);
         // The tail falls off as 2/(π x sin θ): 3% outside 4°, under 1% outside 40°.
-        assert!((1.0 - last - 2.0 / (std::f64::consts::PI * 285.6 * 4f64.to_radians().sin())).abs() < 5e-3);
+        assert!(
+            (1.0 - last - 2.0 / (std::f64::consts::PI * 285.6 * 4f64.to_radians().sin())).abs()
+                < 5e-3
+        );
         assert!(diffraction_encircled(40f64.to_radians(), a, l) > 0.99);
     }
 }

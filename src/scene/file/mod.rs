@@ -144,7 +144,7 @@ pub struct EnvironmentFile {
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SkyFile {
-    /// constant, aristotle, descartes, airy or mie.
+    /// constant, aristotle, descartes, airy, mie or halo.
     pub model: String,
     /// Drop radius in mm (airy, mie).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -166,6 +166,20 @@ pub struct SkyFile {
     /// Only this term p of the Debye series (mie): 2 the primary bow, 3 the secondary.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub debye: Option<u32>,
+    /// The halo sky's populations of ice crystals (`crate::sky::halo::spec`), e.g.
+    /// `[{ orientation = "plates", aspect = 0.2, tilt_deg = 0.5 }]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crystals: Option<Vec<crate::sky::halo::CrystalFile>>,
+    /// The zenith's direction (halo): the crystals' orientations are about it; default
+    /// [0, 1, 0], heron's up.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zenith: Option<[f32; 3]>,
+    /// Rays per wavelength row of the halo table (default 2^20).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rays: Option<u64>,
+    /// The seed of the halo table's random numbers (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
 }
 
 /// `[camera]`: the seed's pinhole camera, or (`type = "lens"`) a film behind a lens

@@ -4,6 +4,7 @@
 use crate::light::sun::SUN_ANGULAR_RADIUS_DEG;
 use crate::light::Light;
 use crate::scene::file::{LightFile, SkyFile};
+use crate::sky::halo::{HaloKey, HaloSky, HaloSpec, PlacedHalo};
 use crate::sky::{SceneSky, Sky, SkyKey, SkyModel, SkySpec};
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
@@ -12,24 +13,38 @@ use glam::Vec3;
 /// its (slow) tabulation.
 pub(super) struct SkyPlan {
     model: String,
-    sky: Sky,
-    spec: SkySpec,
+    sky: PlannedSky,
     sun_dir: Vec3,
     factor: DenseSpectrum,
     replaces_background: bool,
 }
 
+/// A profile model with its spec, or a halo sky with its zenith.
+enum PlannedSky {
+    Profile(Box<(Sky, SkySpec)>),
+    Halo(HaloSky, Vec3),
+}
+
 impl SkyPlan {
-    /// Tabulates the model over (θ, λ) for rendering.
+    /// Tabulates the model for rendering: over (θ, λ), or a halo's table over the sky.
     pub fn tabulate(self) -> SceneSky {
-        SceneSky::new(
-            self.model,
-            self.sky,
-            self.sun_dir,
-            self.factor,
-            self.replaces_background,
-        )
-        .with_spec(self.spec)
+        match self.sky {
+            PlannedSky::Profile(b) => {
+                let (sky, spec) = *b;
+                SceneSky::new(
+                    self.model,
+                    sky,
+                    self.sun_dir,
+                    self.factor,
+                    self.replaces_background,
+                )
+                .with_spec(spec)
+            }
+            PlannedSky::Halo(halo, zenith) => {
+                let placed = PlacedHalo::new(halo.table().clone(), self.sun_dir, zenith);
+                SceneSky::halo(self.model, placed, self.factor)
+            }
+        }
     }
 }
 
@@ -84,14 +99,26 @@ pub(super) fn plan_sky(
         debye: sf.debye,
         background: Some(background.clone()),
     };
-    let sky = spec.build(&|k| scene_key(k, i))?;
+    let halo_keys = [
+        ("sky.crystals", sf.crystals.is_some()),
+        ("sky.zenith", sf.zenith.is_some()),
+        ("sky.rays", sf.rays.is_some()),
+        ("sky.seed", sf.seed.is_some()),
+    ];
+    let sky = if sf.model == "halo" {
+        plan_halo(sf, &spec, sun, i)?
+    } else {
+        if let Some((key, _)) = halo_keys.iter().find(|k| k.1) {
+            return Err(format!("{key}: applies to halo, not {}", sf.model));
+        }
+        PlannedSky::Profile(Box::new((spec.build(&|k| scene_key(k, i))?, spec)))
+    };
     // The spec has checked the model's name.
     let physical = SkyModel::from_name(&sf.model).is_some_and(SkyModel::is_physical);
     let scale = sf.scale.map_or(1.0, |s| s.get());
     Ok(SkyPlan {
         model: sf.model.clone(),
         sky,
-        spec,
         sun_dir: -sun.direction,
         factor: if physical {
             sun.irradiance.scaled(scale)
@@ -100,4 +127,52 @@ pub(super) fn plan_sky(
         },
         replaces_background: !physical,
     })
+}
+
+/// The halo sky of `[sky] model = "halo"`: the profile models' keys refused, the
+/// zenith checked, the sun's elevation above the horizon it defines.
+fn plan_halo(
+    sf: &SkyFile,
+    spec: &SkySpec,
+    sun: &crate::light::SunLight,
+    i: usize,
+) -> Result<PlannedSky, String> {
+    let profile_keys = [
+        ("sky.droplet_radius", sf.droplet_radius.is_some()),
+        ("sky.drops", sf.drops.is_some()),
+        ("sky.orders", sf.orders.is_some()),
+        ("sky.polarisation", sf.polarisation.is_some()),
+        ("sky.debye", sf.debye.is_some()),
+    ];
+    if let Some((key, _)) = profile_keys.iter().find(|k| k.1) {
+        return Err(format!("{key}: applies to the water-drop skies, not halo"));
+    }
+    crate::sky::spec::check_sun_radius(spec.sun_radius_deg, &scene_key(SkyKey::SunRadius, i))?;
+    let z = sf.zenith.unwrap_or([0.0, 1.0, 0.0]);
+    let zenith = Vec3::from(z);
+    if !(zenith.is_finite() && zenith.length() > 1e-6) {
+        return Err(format!(
+            "sky.zenith: expected a non-zero direction, got {z:?}"
+        ));
+    }
+    let zenith = zenith.normalize();
+    let to_sun = -sun.direction.normalize();
+    let elevation = (to_sun.dot(zenith) as f64)
+        .clamp(-1.0, 1.0)
+        .asin()
+        .to_degrees();
+    let halo = HaloSpec {
+        sun_elevation_deg: elevation,
+        sun_radius_rad: spec.sun_radius_rad,
+        crystals: sf.crystals.clone().unwrap_or_default(),
+        rays: sf.rays,
+        seed: sf.seed,
+    }
+    .build(&|k| match k {
+        HaloKey::Crystals => "sky.crystals".into(),
+        HaloKey::Crystal(j, key) => format!("sky.crystals[{j}].{key}"),
+        HaloKey::SunElevation => format!("lights[{i}].direction"),
+        HaloKey::Rays => "sky.rays".into(),
+    })?;
+    Ok(PlannedSky::Halo(halo, zenith))
 }
