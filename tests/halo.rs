@@ -329,3 +329,242 @@ fn the_22_halo_is_weakly_radially_polarised() {
     // Mirror symmetry about the scattering plane: no S2 on average.
     assert!((s2 / n_halo as f64).abs() < 0.005);
 }
+
+// ----------------------------------------------------------------------------------
+// The halo sky's table (src/sky/halo)
+// ----------------------------------------------------------------------------------
+
+use heron::sky::halo::table::{from_sun_coordinates, sun_coordinates, HaloTable, ROWS};
+use heron::sky::halo::{ice_n as table_n, HaloSky};
+
+fn plates_table(h_deg: f64, rays: usize, seed: u64) -> HaloTable {
+    HaloTable::build(
+        &crystals(
+            Orientation::Plates {
+                tilt: 0.2f64.to_radians(),
+            },
+            0.3,
+        ),
+        &table_n,
+        h_deg.to_radians(),
+        0.2666f64.to_radians(),
+        rays,
+        seed,
+    )
+}
+
+#[test]
+fn halo_table_integrates_to_geometric_optics_plus_diffraction() {
+    // Geometric optics puts all the light somewhere (1, less the trapped rays) and
+    // diffraction adds the crystals' projected area once more (Rayleigh's encircled
+    // energy, 1 − 1/(πx) or so outside 90°: below 1e-3 for 50 µm crystals).
+    let t = plates_table(20.0, 50_000, 1);
+    for r in [0, ROWS / 2, ROWS - 1] {
+        let i = t.integral(r);
+        assert!((i - 2.0).abs() < 2e-3, "row {r}: ∫ = {i}");
+    }
+    assert!(t.lost < 1e-4, "{}", t.lost);
+}
+
+#[test]
+fn halo_table_puts_the_sun_dogs_where_the_closed_form_does() {
+    let h = 20f64.to_radians();
+    let t = plates_table(20.0, 200_000, 2);
+    let sun = DVec3::new(h.cos(), 0.0, h.sin());
+    for lambda in [450.0f32, 650.0] {
+        let n = ice_n(lambda);
+        let daz = min_deviation(bravais(n, h), 60.0).to_radians();
+        // Level with the sun, daz away in azimuth.
+        let dog = DVec3::new(h.cos() * daz.cos(), h.cos() * daz.sin(), h.sin());
+        let (theta, psi) = sun_coordinates(dog, sun, DVec3::Z);
+        let at = |dt: f64| t.eval(theta + dt, psi, lambda);
+        // Bright just outside the edge (the sun's disk spreads it by ±0.27°), dark 1°
+        // inside it.
+        let (outside, inside) = (at(0.3), at(-1.0));
+        println!(
+            "{lambda} nm: sun dog at θ {theta:.2}°, ψ {psi:.2}°: {outside:.3e} vs {inside:.3e}"
+        );
+        assert!(outside > 20.0 * inside, "{outside} vs {inside}");
+    }
+    // Coordinates round trip.
+    let v = from_sun_coordinates(30.0, 80.0, sun, DVec3::Z);
+    let (a, b) = sun_coordinates(v, sun, DVec3::Z);
+    assert!((a - 30.0).abs() < 1e-9 && (b - 80.0).abs() < 1e-9);
+}
+
+#[test]
+fn halo_tables_are_deterministic_and_follow_the_seed() {
+    let (a, b, c) = (
+        plates_table(35.0, 20_000, 5),
+        plates_table(35.0, 20_000, 5),
+        plates_table(35.0, 20_000, 6),
+    );
+    let mut differs = false;
+    for k in 0..2000 {
+        let (theta, psi, l) = (
+            k as f64 * 0.09,
+            (k * 37 % 180) as f64,
+            360.0 + (k % 470) as f32,
+        );
+        assert_eq!(
+            a.eval(theta, psi, l).to_bits(),
+            b.eval(theta, psi, l).to_bits()
+        );
+        differs |= a.eval(theta, psi, l) != c.eval(theta, psi, l);
+    }
+    assert!(differs);
+    // A sky caches its table by what it was traced from.
+    let sky = || HaloSky::new(crystals(Orientation::Random, 1.0), 0.3, 0.0046, 5000, 9);
+    assert!(std::sync::Arc::ptr_eq(sky().table(), sky().table()));
+}
+
+fn heron_cmd(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_heron"))
+        .args(args)
+        .output()
+        .expect("heron runs")
+}
+
+#[test]
+fn halo_profile_prints_csv_and_names_bad_flags() {
+    let out = heron_cmd(&[
+        "halo",
+        "profile",
+        "--sun-elevation",
+        "10",
+        "--crystals",
+        "random",
+        "--lambda",
+        "450,650",
+        "--psi",
+        "0,90",
+        "--from",
+        "20",
+        "--to",
+        "24",
+        "--step",
+        "0.5",
+        "--rays",
+        "100000",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("theta_deg,psi0_450nm,psi0_650nm,psi90_450nm,psi90_650nm")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 9);
+    // The 22° halo's edge: red (650 nm) rises first, by 22.0° (its minimum deviation
+    // is 21.7°), blue only past 22.3°.
+    let at = |t: f64, col: usize| rows.iter().find(|r| r[0] == t).unwrap()[col];
+    assert!(at(22.0, 2) > 3.0 * at(21.0, 2));
+    assert!(at(22.0, 2) > at(22.0, 1));
+    for (args, want) in [
+        (
+            vec!["--crystals", "needles"],
+            "--crystals (population 1) orientation: expected one of random",
+        ),
+        (
+            vec!["--crystals", "plates:aspect=100"],
+            "--crystals (population 1) aspect: expected c/a in [0.02, 50], got 100",
+        ),
+        (vec!["--crystals", "plates:size=3"], "unknown key \"size\""),
+        (
+            vec!["--crystals", "random", "--psi", "200"],
+            "--psi: expected position angles",
+        ),
+        (
+            vec!["--crystals", "random", "--sun-radius", "9"],
+            "--sun-radius: expected an angle in (0°, 5°]",
+        ),
+    ] {
+        let mut all = vec![
+            "halo",
+            "profile",
+            "--sun-elevation",
+            "10",
+            "--lambda",
+            "550",
+        ];
+        all.extend(args);
+        let out = heron_cmd(&all);
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(want), "{err}");
+        assert!(out.stdout.is_empty());
+    }
+}
+
+#[test]
+fn halo_scene_keys_are_checked_and_named() {
+    let base = r#"
+[camera]
+eye = [0.0, 1.5, 0.0]
+look_at = [0.0, 1.75, -1.0]
+resolution = [8, 8]
+[[lights]]
+type = "sun"
+direction = [0.0, -0.34, 0.94]
+irradiance = 3.0
+"#;
+    let err = |sky: &str| {
+        heron::scene::load::load_scene_from_str(
+            &format!("{base}[sky]\n{sky}"),
+            std::path::Path::new("h.toml"),
+        )
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default()
+    };
+    for (sky, want) in [
+        ("model = \"halo\"\nrays = 5000\n", "sky.crystals: expected 1 to 8 populations"),
+        (
+            "model = \"halo\"\nrays = 5000\ncrystals = [{ orientation = \"plates\", tilt_deg = 95 }]\n",
+            "sky.crystals[0].tilt_deg: expected an angle in [0°, 90°], got 95",
+        ),
+        (
+            "model = \"halo\"\ncrystals = [{ orientation = \"random\" }]\nrays = 10\n",
+            "sky.rays: expected 1000 to",
+        ),
+        (
+            "model = \"halo\"\ncrystals = [{ orientation = \"random\" }]\ndroplet_radius = 1.0\n",
+            "sky.droplet_radius: applies to the water-drop skies, not halo",
+        ),
+        (
+            "model = \"halo\"\ncrystals = [{ orientation = \"random\" }]\nzenith = [0, 0, 0]\n",
+            "sky.zenith: expected a non-zero direction",
+        ),
+        (
+            "model = \"descartes\"\ncrystals = [{ orientation = \"random\" }]\n",
+            "sky.crystals: applies to halo, not descartes",
+        ),
+        (
+            "model = \"halo\"\ncrystals = [{ orientation = \"random\", colour = 1 }]\n",
+            "unknown key \"colour\" at sky.crystals[0] (expected one of orientation, aspect, tilt_deg, size_um, weight)",
+        ),
+    ] {
+        let e = err(sky);
+        assert!(e.contains(want), "{sky}: {e}");
+    }
+    // A good one loads, and its sky is a halo placed for the sun 20° up.
+    let s = heron::scene::load::load_scene_from_str(
+        &format!("{base}[sky]\nmodel = \"halo\"\nrays = 5000\ncrystals = [{{ orientation = \"random\" }}]\n"),
+        std::path::Path::new("h.toml"),
+    )
+    .expect("loads");
+    let sky = s.sky.as_ref().expect("a sky");
+    match &sky.shape {
+        heron::sky::table::SkyShape::Halo(h) => {
+            assert!((h.table.sun_elevation.to_degrees() - 19.88).abs() < 0.05)
+        }
+        _ => panic!("a halo sky"),
+    }
+}

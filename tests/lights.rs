@@ -33,9 +33,11 @@ const SUN_TESTS: usize = 2;
 const SPHERE_TESTS: usize = 3;
 const MESH_TESTS: usize = 2;
 const ENVIRONMENT_TESTS: usize = 3;
+const HALO_TESTS: usize = 1;
 const SAMPLER_TESTS: usize = 2;
 /// Chi-square tests in this file (the Bonferroni divisor).
-const CHI2_TESTS: usize = SUN_TESTS + SPHERE_TESTS + MESH_TESTS + ENVIRONMENT_TESTS + SAMPLER_TESTS;
+const CHI2_TESTS: usize =
+    SUN_TESTS + SPHERE_TESTS + MESH_TESTS + ENVIRONMENT_TESTS + HALO_TESTS + SAMPLER_TESTS;
 
 /// A receiving point on no axis of any light below.
 const P: Vec3 = Vec3::new(0.31, -0.17, 0.23);
@@ -367,7 +369,10 @@ model = "aristotle"
 /// edges of its zones, cos θ of the table's nodes rounded to f32 as the light does.
 fn sky_breaks(scene: &heron::scene::Scene) -> Vec<f64> {
     let sky = scene.sky.as_ref().unwrap();
-    sky.table
+    let heron::sky::table::SkyShape::Profile(table) = &sky.shape else {
+        panic!("a profile sky")
+    };
+    table
         .theta_grid()
         .iter()
         .map(|&t| ((t.to_radians().cos() as f32).clamp(-1.0, 1.0) as f64).acos())
@@ -422,12 +427,57 @@ fn chi2_environment() {
     assert_all(&out);
 }
 
+/// A halo sky (src/sky/halo) is sampled by the cells of its table over (θ, ψ) about the
+/// sun, whose edges fall every 0.25° in θ (the breaks) and every 1° in ψ (which the
+/// adaptive quadrature finds). Over the 30° about the sun (the 22° halo, the sun dogs
+/// and most of the cells' density), to keep the quadrature short. A direction
+/// rounded to f32 can cross a cell edge between the sample and `pdf_li`: 1e-5 of the
+/// samples may differ.
+#[test]
+fn chi2_halo_sky() {
+    let scene = halo_scene();
+    let sky_light = &scene.lights[scene.environment.unwrap() as usize];
+    let sun = scene.sky.as_ref().unwrap().sun_dir;
+    let out = vec![li_chi2(
+        "environment with a halo sky, 30° about the sun",
+        sky_light,
+        P,
+        &Spherical::cone(sun, 30f64.to_radians())
+            .with_resolution(15, 24)
+            .with_theta_breaks((1..120).map(|j| (j as f64 * 0.25).to_radians())),
+        |_| None,
+        1e-5,
+    )];
+    assert_eq!(out.len(), HALO_TESTS);
+    assert_all(&out);
+}
+
+/// A scene with a halo sky of plates and random crystals over a blue background, its
+/// table traced with few rays (its noise does not matter to sampling).
+fn halo_scene() -> heron::scene::Scene {
+    let text = r#"
+background = [0.1, 0.17, 0.36]
+[camera]
+eye = [0.0, 1.5, 0.0]
+look_at = [0.0, 1.75, -1.0]
+resolution = [8, 8]
+[[lights]]
+type = "sun"
+direction = [0.2, -0.34, 0.92]
+irradiance = 3.0
+[sky]
+model = "halo"
+rays = 20000
+crystals = [{ orientation = "plates", aspect = 0.3, tilt_deg = 2 }, { orientation = "random" }]
+"#;
+    load_scene_from_str(text, Path::new("halo.toml")).expect("the halo scene loads")
+}
+
 /// Importance sampling must never miss light: wherever the sky has radiance, its
 /// density is positive (the zones take the larger of their ends' radiance).
 #[test]
 fn sky_density_is_positive_wherever_the_sky_shines() {
-    for radius in [None, Some(1.5)] {
-        let scene = sky_scene(radius);
+    for scene in [sky_scene(None), sky_scene(Some(1.5)), halo_scene()] {
         let light = &scene.lights[scene.environment.unwrap() as usize];
         let mut rng = Rng::new(3, 3);
         for k in 0..200_000 {

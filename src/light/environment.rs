@@ -143,7 +143,8 @@ impl Cells {
 
     fn sample(&self, u: Vec2) -> (Vec3, f32) {
         let (p, pdf_uv) = self.dist.sample(u);
-        let theta = p.x as f64 * 180.0;
+        // Off the pole at θ = 0, where the density in (θ, ψ) has no solid angle.
+        let theta = (p.x as f64).max(1e-9) * 180.0;
         let psi = p.y as f64 * 360.0 - 180.0;
         let w = crate::sky::halo::table::from_sun_coordinates(
             theta,
