@@ -218,6 +218,22 @@ def sky_profile(
     mie): a drop-size distribution as the scene files' ``[sky] drops`` table;
     debye (mie): only Debye term p."""
 
+def halo_profile(
+    sun_elevation: float,
+    crystals: list[dict[str, Any]],
+    wavelengths: _Numbers,
+    theta: _Numbers,
+    *,
+    psi: Optional[_Numbers] = None,
+    sun_radius: float = 0.2666,
+    rays: Optional[int] = None,
+    seed: Optional[int] = None,
+) -> npt.NDArray[np.float32]:
+    """The halo sky's radiance per unit solar irradiance (sr⁻¹) against the angle theta
+    (degrees) from the sun along great circles at position angles psi (default 0, 90,
+    180), as ``heron halo profile``: len(theta) × len(psi) × len(wavelengths). crystals:
+    populations as the scene files' ``[sky] crystals`` tables."""
+
 class Color(TypedDict):
     XYZ: list[float]
     xy: Optional[list[float]]

@@ -428,7 +428,7 @@ fn sky_profile_cli_rejects_bad_values_in_one_line() {
     for (args, needle) in [
         (
             "--model nope --lambda 500 --from 0 --to 1 --step 1",
-            "--model: expected one of constant, aristotle, descartes, airy, mie, got \"nope\"",
+            "--model: expected one of constant, aristotle, descartes, airy, mie, halo, got \"nope\"",
         ),
         (
             "--model descartes --lambda 500 --from 0 --to 1 --step -1",

@@ -6,6 +6,7 @@
 //!   `heron render` sets up (src/main.rs `cmd_render`), so the arrays are the numbers of
 //!   the CLI's EXR bit for bit; the GIL is released while rendering, and Ctrl-C stops the
 //!   render within a row of a tile (`RenderOptions::cancel`);
+//! - `halo_profile`: the core of `heron halo profile`.
 //! - `trace`, `sky_profile`, `color`, `ior`: the cores of `heron trace`, `heron sky
 //!   profile`, `heron color` (in memory) and the scene files' `ior` values;
 //! - `compare`: `heron compare`'s test of two images (EXR paths, render results or
@@ -125,6 +126,7 @@ fn heron(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(tools::trace, m)?)?;
     m.add_function(wrap_pyfunction!(tools::sky_profile, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::halo_profile, m)?)?;
     m.add_function(wrap_pyfunction!(tools::color, m)?)?;
     m.add_function(wrap_pyfunction!(tools::ior, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;

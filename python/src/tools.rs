@@ -193,6 +193,91 @@ pub fn sky_profile<'py>(
     })
 }
 
+/// The halo sky's radiance per unit solar irradiance (sr⁻¹) along great circles through
+/// the sun, as `heron halo profile` computes it; returns a float32 array of
+/// len(theta) × len(psi) × len(wavelengths).
+///
+/// sun_elevation: degrees above the horizon. crystals: a list of populations as the
+/// scene files' `[sky] crystals` tables, e.g. [{"orientation": "plates", "aspect": 0.2,
+/// "tilt_deg": 0.5}]. theta: degrees from the sun (0–180). psi: position angles of the
+/// great circles (degrees: 0 up toward the zenith, 90 sideways; default [0, 90, 180]).
+/// sun_radius (degrees, default 0.2666), rays (per wavelength row of the table, default
+/// 2^20) and seed (default 0) as the CLI's flags.
+#[pyfunction]
+#[pyo3(signature = (sun_elevation, crystals, wavelengths, theta, *, psi=None, sun_radius=0.2666, rays=None, seed=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn halo_profile<'py>(
+    py: Python<'py>,
+    sun_elevation: f64,
+    crystals: &Bound<'py, PyAny>,
+    wavelengths: &Bound<'py, PyAny>,
+    theta: &Bound<'py, PyAny>,
+    psi: Option<&Bound<'py, PyAny>>,
+    sun_radius: f64,
+    rays: Option<u64>,
+    seed: Option<u64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    guard(|| {
+        use heron_core::sky::halo::{profile, CrystalFile, HaloKey, HaloSpec};
+        const RENAMES: &[(&str, &str)] =
+            &[("--lambda", "wavelengths"), ("--sun-radius", "sun_radius")];
+        let list = crystals
+            .cast::<PyList>()
+            .map_err(|_| err("crystals: expected a list of dicts, one per population"))?;
+        let crystals = list
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let at = format!("crystals[{i}]");
+                to_toml(&c, &at)?
+                    .try_into::<CrystalFile>()
+                    .map_err(|e| err(format!("{at}: {}", e.message())))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let lambdas_text = numbers(wavelengths, "wavelengths")?
+            .iter()
+            .map(|&l| (l as f32).to_string())
+            .collect::<Vec<_>>()
+            .join(",");
+        let lambdas = heron_core::sky::profile::parse_lambdas(&lambdas_text)
+            .map_err(|e| lib_err(e, RENAMES))?;
+        let thetas = numbers(theta, "theta")?;
+        if let Some(t) = thetas.iter().find(|t| !(0.0..=180.0).contains(*t)) {
+            return Err(err(format!(
+                "theta: expected angles in 0–180° from the sun, got {t}"
+            )));
+        }
+        let psis = match psi {
+            None => vec![0.0, 90.0, 180.0],
+            Some(p) => numbers(p, "psi")?,
+        };
+        if let Some(p) = psis.iter().find(|p| !(-180.0..=180.0).contains(*p)) {
+            return Err(err(format!(
+                "psi: expected position angles in −180…180°, got {p}"
+            )));
+        }
+        heron_core::sky::spec::check_sun_radius(sun_radius, "sun_radius").map_err(err)?;
+        let spec = HaloSpec {
+            sun_elevation_deg: sun_elevation,
+            sun_radius_rad: sun_radius.to_radians(),
+            crystals,
+            rays,
+            seed,
+        };
+        let sky = spec
+            .build(&|k| match k {
+                HaloKey::Crystals => "crystals".into(),
+                HaloKey::Crystal(i, key) => format!("crystals[{i}].{key}"),
+                HaloKey::SunElevation => "sun_elevation".into(),
+                HaloKey::Rays => "rays".into(),
+            })
+            .map_err(err)?;
+        let shape = [thetas.len(), psis.len(), lambdas.len()];
+        let table = py.detach(|| profile::sample(sky.table(), &thetas, &psis, &lambdas));
+        Ok(table.into_pyarray(py).reshape(shape)?.into_any())
+    })
+}
+
 /// The colour of a spectral distribution, as `heron color` computes it for a CSV file:
 /// returns a dict with "XYZ" (3 floats), "xy" (2 floats, None when X + Y + Z = 0),
 /// "linear_srgb" (3 floats, IEC 61966-2-1 without chromatic adaptation), "observer" and

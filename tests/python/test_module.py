@@ -125,7 +125,8 @@ def bits(a) -> np.ndarray:
 
 def test_module_is_documented_and_typed():
     assert issubclass(heron.HeronError, ValueError)
-    public = ["load_scene", "trace", "sky_profile", "color", "ior", "lens", "Scene", "RenderResult"]
+    public = ["load_scene", "trace", "sky_profile", "halo_profile", "color", "ior", "lens", "Scene",
+              "RenderResult"]
     for name in public:
         doc = getattr(heron, name).__doc__
         assert doc and len(doc) > 40, f"heron.{name} has no docstring"
@@ -470,6 +471,40 @@ def test_sky_profile_equals_cli(model, kwargs, flags):
     assert want.max() > 0
     # The CSV prints 7 significant digits (`{:.6e}`).
     np.testing.assert_allclose(got, want, rtol=6e-7, atol=0)
+
+
+def test_halo_profile_equals_cli():
+    """heron.halo_profile reads the same table as `heron halo profile` (same crystals,
+    sun, rays and seed): equal to the CSV's 7 significant digits. 20 000 rays per row
+    keep the two tables' tracing to about a second."""
+    lambdas, psis = [450.0, 650.0], [0.0, 90.0]
+    p = run_cli("halo", "profile", "--sun-elevation", "20", "--crystals", "random",
+                "--crystals", "plates:aspect=0.3,tilt_deg=1", "--lambda", "450,650",
+                "--psi", "0,90", "--from", "15", "--to", "30", "--step", "0.5",
+                "--rays", "20000", "--seed", "3")
+    rows = np.array([[float(x) for x in line.split(",")] for line in p.stdout.splitlines()[1:]])
+    theta = rows[:, 0]
+    got = heron.halo_profile(20.0, [dict(orientation="random"),
+                                    dict(orientation="plates", aspect=0.3, tilt_deg=1)],
+                             lambdas, theta, psi=psis, rays=20000, seed=3)
+    assert got.shape == (len(theta), 2, 2) and got.dtype == np.float32
+    np.testing.assert_allclose(got.reshape(len(theta), 4), rows[:, 1:], rtol=6e-7, atol=0)
+    assert got.max() > 0.1
+
+
+def test_halo_profile_errors():
+    want = cli_error("halo", "profile", "--sun-elevation", "20", "--crystals", "plates:aspect=0",
+                     "--lambda", "500")
+    assert want.startswith("--crystals (population 1) aspect: expected c/a in [0.02, 50]")
+    assert py_error(heron.halo_profile, 20.0, [dict(orientation="plates", aspect=0)], [500], [22]) \
+        == want.replace("--crystals (population 1) ", "crystals[0].")
+    assert py_error(heron.halo_profile, 20.0, [dict(orientation="plates", colour=1)], [500], [22]) \
+        .startswith("crystals[0]: unknown field `colour`")
+    assert py_error(heron.halo_profile, 20.0, "plates", [500], [22]).startswith("crystals: expected a list")
+    assert py_error(heron.halo_profile, 20.0, [dict(orientation="random")], [300], [22]) \
+        .startswith("wavelengths: expected wavelengths in 360–830 nm")
+    assert py_error(heron.halo_profile, 20.0, [dict(orientation="random")], [500], [190]) \
+        == "theta: expected angles in 0–180° from the sun, got 190"
 
 
 def test_sky_profile_errors():
