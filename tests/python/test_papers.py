@@ -24,7 +24,7 @@ import pytest
 from heronrun import REPO, require_heron_bin
 
 PAPERS = REPO / "papers"
-SETS = ["aristotelian-rainbow", "descartes-rainbow", "lee-diagram"]
+SETS = ["aristotelian-rainbow", "descartes-rainbow", "ice-halos", "lee-diagram"]
 OUTPUT_DIRS = ("data", "figures")
 TIMEOUT_S = float(os.environ.get("HERON_PAPERS_TIMEOUT", "300"))
 
