@@ -17,9 +17,11 @@ py="${HERON_PYTHON:-$repo/.venv/bin/python}"
 
 mkdir -p "$out/data" "$out/figures"
 
-# The 22° and 46° halos of randomly oriented crystals (c/a = 1), sun 20° up, along the
-# great circle sideways from the sun (ψ = 90°; random crystals make every ψ alike).
-"$heron" halo profile --sun-elevation 20 --crystals random --lambda 450,550,650 --psi 90 \
+# The 22° and 46° halos of randomly oriented crystals (c/a = 1), sun 20° up, along seven
+# great circles through the sun (ψ = 0°, 30°, …, 180°; random crystals make every ψ
+# alike, so make_figures.py averages them: seven columns of table cells).
+"$heron" halo profile --sun-elevation 20 --crystals random --lambda 450,550,650 \
+    --psi 0,30,60,90,120,150,180 \
     --from 15 --to 55 --step 0.05 --rays 524288 > "$out/data/random_profile.csv"
 
 # Sun dogs of plates (c/a = 0.3 for a low sun, 1 above 30°, where thin plates let the ray

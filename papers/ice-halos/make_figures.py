@@ -39,16 +39,25 @@ def min_deviation(n: float, apex_deg: float) -> float:
 
 
 def edge(theta: np.ndarray, col: np.ndarray, lo: float, hi: float) -> float:
-    """The angle of the steepest rise of a profile column within [lo, hi]."""
+    """The angle of the steepest rise of a profile column within [lo, hi], after a 0.5°
+    running mean (10 samples), which keeps the table's cell-to-cell noise from posing as
+    an edge."""
     m = (theta >= lo) & (theta <= hi)
     t, v = theta[m], col[m]
-    i = int(np.argmax(np.diff(v)))
-    return float(0.5 * (t[i] + t[i + 1]))
+    k = 10
+    s = np.convolve(v, np.ones(k) / k, mode="valid")
+    ts = np.convolve(t, np.ones(k) / k, mode="valid")
+    i = int(np.argmax(np.diff(s)))
+    return float(0.5 * (ts[i] + ts[i + 1]))
 
 
 def random_halos(out: pathlib.Path, repo: pathlib.Path) -> None:
-    header, d = hf.read_csv(out / "data" / "random_profile.csv")
-    theta = d[:, 0]
+    header, raw = hf.read_csv(out / "data" / "random_profile.csv")
+    theta = raw[:, 0]
+    # Columns ψ-major (psi<ψ>_<λ>nm): the mean over the seven circles per wavelength.
+    nl = len(LAMBDAS)
+    cols = raw[:, 1:].reshape(len(theta), -1, nl)
+    d = np.column_stack([theta, cols.mean(axis=1)])
     rows = []
     fig, ax = plt.subplots(figsize=(7.0, 4.2))
     for j, lam in enumerate(LAMBDAS):
@@ -72,7 +81,8 @@ def random_halos(out: pathlib.Path, repo: pathlib.Path) -> None:
                   "min_dev_90_deg", "table_edge_90_deg"], rows,
                  digits=[".0f", ".6f", ".4f", ".3f", ".4f", ".3f"],
                  comments=["ice n(λ): Warren & Brandt 2008; edges: the steepest rise of "
-                           "heron halo profile's column (0.05° steps, solar disk 0.2666°)"])
+                           "heron halo profile's column (0.05° steps, 0.5° running mean, "
+                           "solar disk 0.2666°)"])
 
 
 def sun_dog_direction(n: float, h: float) -> tuple[float, float]:

@@ -205,7 +205,6 @@ pub fn sky_profile<'py>(
 /// 2^20) and seed (default 0) as the CLI's flags.
 #[pyfunction]
 #[pyo3(signature = (sun_elevation, crystals, wavelengths, theta, *, psi=None, sun_radius=0.2666, rays=None, seed=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn halo_profile<'py>(
     py: Python<'py>,
     sun_elevation: f64,

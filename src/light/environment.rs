@@ -102,8 +102,8 @@ impl Cells {
             / (rows + 1) as f32;
         // Mean over the table's rows times the factor's mean over λ: a sampling weight,
         // not the radiance (the product's mean would weigh rows by the sun's spectrum).
-        // Inside the forward cone the sky reads the cone's edge: the cells there take
-        // the value of the first cell outside it.
+        // Inside the forward cone the sky reads the first cell outside it (at
+        // `CAP_DEG`, its centre): the cells there take that cell's value.
         let first_outside = (FORWARD_CUT_DEG / THETA_STEP).ceil() as usize;
         let mean: Vec<f32> = (0..N_PSI)
             .flat_map(|k| (0..N_THETA).map(move |j| (k, j)))

@@ -20,7 +20,8 @@
 //!   Mueller matrices for polarised transport are computed from, `crate::bsdf::polarization`).
 //!
 //! Layer 2 ("physics", `../shared/DESIGN.md`): this module imports nothing of heron's
-//! (only `num-complex`, `glam` and `libm`); `sky` and `medium` import it, never the reverse.
+//! but `math`'s random numbers (the ice crystals' Monte Carlo; otherwise `num-complex`,
+//! `glam` and `libm`); `sky` and `medium` import it, never the reverse.
 //!
 //! What is here and what is not: [`mie::MieSphere`] (a sphere's coefficients and
 //! efficiencies) is pure optics, so it is here. The drop population a medium is made of

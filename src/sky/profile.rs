@@ -144,12 +144,14 @@ pub fn angles(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
     if from > to {
         return Err(bad(format!("--from {from} is larger than --to {to}")));
     }
-    let n = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() as usize + 1;
-    if n > MAX_ROWS {
+    // Counted in f64 first: a tiny step would saturate the cast and wrap the + 1.
+    let rows = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    if rows > MAX_ROWS as f64 {
         return Err(bad(format!(
-            "--step {step}: {n} rows, more than {MAX_ROWS}; use a larger step"
+            "--step {step}: {rows} rows, more than {MAX_ROWS}; use a larger step"
         )));
     }
+    let n = rows as usize;
     Ok((0..n)
         .map(|i| {
             let t = from + step * i as f64;

@@ -59,8 +59,9 @@ impl SkyModel {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
-    /// Whether its profile is the scattering of water drops, radiance per unit solar
-    /// irradiance (descartes, airy, mie), rather than a radiance of its own.
+    /// Whether it is the scattering of particles, radiance per unit solar irradiance
+    /// (descartes, airy, mie: water drops; halo: ice crystals), rather than a radiance of
+    /// its own.
     pub fn is_physical(self) -> bool {
         matches!(
             self,

@@ -163,23 +163,21 @@ impl HexPrism {
 mod tests {
     use super::*;
 
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
+    fn uniforms(seed: u64) -> impl FnMut() -> f64 {
+        let mut rng = crate::math::rng::Rng::new(seed, 0);
+        move || rng.uniform_f64()
     }
 
     #[test]
     fn mean_projected_area_is_a_quarter_of_the_surface() {
         // Cauchy's theorem for convex bodies, over directions uniform on the sphere.
         let p = HexPrism::new(0.7);
-        let mut s = 1u64;
+        let mut u = uniforms(1);
         let n = 200_000;
         let mut sum = 0.0;
         for _ in 0..n {
-            let z = 2.0 * lcg(&mut s) - 1.0;
-            let phi = 2.0 * std::f64::consts::PI * lcg(&mut s);
+            let z = 2.0 * u() - 1.0;
+            let phi = 2.0 * std::f64::consts::PI * u();
             let r = (1.0 - z * z).sqrt();
             sum += p.projected_area(DVec3::new(r * phi.cos(), r * phi.sin(), z));
         }
@@ -193,10 +191,10 @@ mod tests {
     #[test]
     fn entry_points_lie_on_lit_faces_and_exits_on_the_surface() {
         let p = HexPrism::new(2.5);
-        let mut s = 7u64;
+        let mut u = uniforms(7);
         let dir = DVec3::new(0.3, -0.5, -0.81).normalize();
         for _ in 0..10_000 {
-            let (x, face) = p.sample_entry(dir, &mut || lcg(&mut s));
+            let (x, face) = p.sample_entry(dir, &mut u);
             assert!(dir.dot(p.normal(face)) < 0.0);
             assert!((x.dot(p.normal(face)) - p.offsets[face]).abs() < 1e-12);
             // Inside every other plane.

@@ -116,17 +116,14 @@ pub fn c_axis(r: &DMat3) -> DVec3 {
 mod tests {
     use super::*;
 
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
+    fn uniforms(seed: u64) -> impl FnMut() -> f64 {
+        let mut rng = crate::math::rng::Rng::new(seed, 0);
+        move || rng.uniform_f64()
     }
 
     #[test]
     fn orientations_put_the_axes_where_they_belong() {
-        let mut s = 3u64;
-        let mut u = || lcg(&mut s);
+        let mut u = uniforms(3);
         for _ in 0..2000 {
             let r = Orientation::Plates { tilt: 0.0 }.sample(&mut u);
             assert!((c_axis(&r).z - 1.0).abs() < 1e-12);
@@ -148,8 +145,7 @@ mod tests {
         // [−1, 1], so each of 10 bins holds a tenth (chi-square with 9 degrees of
         // freedom, whose 0.999 quantile is 27.9: a false alarm once in a thousand seeds,
         // and this seed is fixed).
-        let mut s = 11u64;
-        let mut u = || lcg(&mut s);
+        let mut u = uniforms(11);
         let n = 100_000;
         let mut bins = [0u32; 10];
         for _ in 0..n {

@@ -14,9 +14,9 @@
 //! their diffraction and the light that passed two parallel faces undeviated. In an
 //! optically thin layer that light makes up for what the layer takes out of the direct
 //! beam, and heron's sun light is not dimmed by the sky's layer, so the rendered sky
-//! leaves that peak to the sun: inside the cone it reads the table's value on the cone's
-//! edge (a flat cap, 1e-3 sr, rather than a hole around the sun); `heron halo profile`
-//! prints the whole table.
+//! leaves that peak to the sun: inside the cone, and out to the centre of the first
+//! table cell beyond it ([`CAP_DEG`]), it reads that cell's value (a flat cap, 1e-3 sr,
+//! rather than a hole around the sun); `heron halo profile` prints the whole table.
 //!
 //! Tables are kept for the life of the process by what they were traced from (the
 //! crystals, the sun, the rays and the seed), the last [`CACHED_TABLES`] of them, so a
@@ -34,12 +34,15 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 /// The cone about the sun the rendered sky leaves to the sun light, degrees.
 pub const FORWARD_CUT_DEG: f64 = 1.0;
+/// Where the cap's value is read: the centre of the first cell outside the cone, so
+/// that no cell inside it contributes (the halo sampler weights the cap by that cell).
+pub const CAP_DEG: f64 = FORWARD_CUT_DEG + 0.5 * table::THETA_STEP;
 
 /// Tables a process keeps.
 pub const CACHED_TABLES: usize = 4;
 
-/// Rays per wavelength row by default: 2^20 (the table of one population builds in
-/// about 4 s on 2 cores; BENCHMARKS.md, "Halo sky tables").
+/// Rays per wavelength row by default: 2^20 (a table builds in about 7.5 s on 2 cores,
+/// whatever its populations; BENCHMARKS.md, "Halo sky tables").
 pub const DEFAULT_RAYS: usize = 1 << 20;
 
 /// Ice's refractive index at `lambda` nm (Warren & Brandt 2008, the catalogue's `ice`).
@@ -134,11 +137,10 @@ impl PlacedHalo {
         }
     }
 
-    /// The table's value at (θ, ψ) = `coords` (degrees) and λ, with the value on the
-    /// edge of the forward cone inside it ([`FORWARD_CUT_DEG`]).
+    /// The table's value at (θ, ψ) = `coords` (degrees) and λ, read at [`CAP_DEG`]
+    /// closer to the sun.
     #[inline]
     pub fn eval(&self, coords: (f64, f64), lambda: f32) -> f32 {
-        self.table
-            .eval(coords.0.max(FORWARD_CUT_DEG), coords.1, lambda)
+        self.table.eval(coords.0.max(CAP_DEG), coords.1, lambda)
     }
 }

@@ -85,12 +85,14 @@ fn thetas(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
             "--from, --to: expected 0 ≤ from ≤ to ≤ 180° from the sun, got {from} and {to}"
         )));
     }
-    let n = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() as usize + 1;
-    if n > MAX_ROWS {
+    // Counted in f64 first: a tiny step would saturate the cast and wrap the + 1.
+    let rows = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    if rows > MAX_ROWS as f64 {
         return Err(bad(format!(
-            "--step {step}: {n} rows, more than {MAX_ROWS}; use a larger step"
+            "--step {step}: {rows} rows, more than {MAX_ROWS}; use a larger step"
         )));
     }
+    let n = rows as usize;
     Ok((0..n)
         .map(|i| ((from + step * i as f64) * 1e9).round() / 1e9)
         .collect())

@@ -13,11 +13,12 @@
 //!   columns and Parry columns.
 //! - `tilt_deg`: the σ of the orientation's Gaussian tilt, in [0°, 90°]; default 1° (10°
 //!   for Lowitz, the spread of its rotation about the a-axis); not for random crystals.
-//! - `size_um`: the hexagon's semi-diameter a in µm, in [5, 5000] (geometric optics
-//!   needs crystals many wavelengths across; the size sets only the diffraction); default
-//!   50.
-//! - `weight`: the population's share of the layer's geometric cross-section (> 0,
-//!   normalised over the populations); default 1.
+//! - `size_um`: the hexagon's semi-diameter a in µm, in [5, 1000] (geometric optics
+//!   needs crystals many wavelengths across; the size sets only the diffraction), with
+//!   the half-length c = a·(c/a) at most 2000 µm (the tracer neglects ice's absorption,
+//!   under 1% over such paths: `crate::optics::ice::trace`); default 50.
+//! - `weight`: the population's share of the layer's geometric cross-section, in
+//!   (0, 1e6] (normalised over the populations); default 1.
 use super::{HaloSky, DEFAULT_RAYS};
 use crate::optics::ice::{Crystals, Orientation, Population};
 
@@ -148,16 +149,23 @@ impl CrystalFile {
             ));
         }
         let size_um = self.size_um.unwrap_or(50.0);
-        if !(5.0..=5000.0).contains(&size_um) {
+        if !(5.0..=1000.0).contains(&size_um) {
             return Err(format!(
-                "{}: expected a semi-diameter in [5, 5000] µm, got {size_um}",
+                "{}: expected a semi-diameter in [5, 1000] µm, got {size_um}",
                 key("size_um")
             ));
         }
-        let weight = self.weight.unwrap_or(1.0);
-        if !(weight > 0.0 && weight.is_finite()) {
+        if size_um * aspect > 2000.0 {
             return Err(format!(
-                "{}: expected a weight > 0, got {weight}",
+                "{}: the half-length size_um × aspect = {} µm is over 2000 µm (ice's absorption, which the tracer neglects, would matter)",
+                key("size_um"),
+                size_um * aspect
+            ));
+        }
+        let weight = self.weight.unwrap_or(1.0);
+        if !(weight > 0.0 && weight <= 1e6) {
+            return Err(format!(
+                "{}: expected a weight in (0, 1e6], got {weight}",
                 key("weight")
             ));
         }
@@ -259,7 +267,14 @@ mod tests {
             weight: Some(-1.0),
             ..Default::default()
         });
-        assert!(e.contains("weight > 0"), "{e}");
+        assert!(e.contains("weight in (0, 1e6]"), "{e}");
+        let e = bad(CrystalFile {
+            orientation: "columns".into(),
+            size_um: Some(500.0),
+            aspect: Some(5.0),
+            ..Default::default()
+        });
+        assert!(e.contains("half-length size_um × aspect = 2500 µm"), "{e}");
         let e = HaloSpec::default().build(&key).expect_err("refused");
         assert!(e.starts_with("Crystals: expected 1 to 8"), "{e}");
     }
