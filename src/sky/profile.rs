@@ -128,6 +128,13 @@ pub fn build_sky(req: &ProfileRequest) -> Result<Sky> {
 
 /// The θ values (degrees) of a request.
 pub fn angles(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
+    angles_from("the antisolar point", from, to, step)
+}
+
+/// The angles `--from`, `--to`, `--step` (degrees) measured from `origin`, which the
+/// messages name: `heron sky profile`'s from the antisolar point, `heron halo
+/// profile`'s from the sun.
+pub fn angles_from(origin: &str, from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
     if !(from.is_finite() && to.is_finite() && step.is_finite()) {
         return Err(bad("--from, --to, --step: expected finite numbers".into()));
     }
@@ -138,7 +145,7 @@ pub fn angles(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
     }
     if !(0.0..=180.0).contains(&from) || !(0.0..=180.0).contains(&to) {
         return Err(bad(format!(
-            "--from, --to: expected angles in 0–180° from the antisolar point, got {from} and {to}"
+            "--from, --to: expected angles in 0–180° from {origin}, got {from} and {to}"
         )));
     }
     if from > to {

@@ -6,13 +6,10 @@
 //! sun included ([`super::FORWARD_CUT_DEG`] applies to renders only).
 use super::spec::{CrystalFile, HaloKey, HaloSpec};
 use super::table::HaloTable;
-use crate::sky::profile::parse_lambdas;
+use crate::sky::profile::{angles_from, parse_lambdas};
 use crate::sky::spec::check_sun_radius;
 use crate::{HeronError, Result};
 use std::fmt::Write;
-
-/// Most rows a profile prints.
-const MAX_ROWS: usize = 100_000;
 
 /// What `heron halo profile` was asked for.
 #[derive(Clone, Debug, Default)]
@@ -74,30 +71,6 @@ fn parse_psis(s: &str) -> Result<Vec<f64>> {
         .collect()
 }
 
-fn thetas(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
-    if !(from.is_finite() && to.is_finite() && step.is_finite() && step > 0.0) {
-        return Err(bad(format!(
-            "--from, --to, --step: expected finite angles and a positive step, got {from}, {to}, {step}"
-        )));
-    }
-    if !(0.0..=180.0).contains(&from) || !(0.0..=180.0).contains(&to) || from > to {
-        return Err(bad(format!(
-            "--from, --to: expected 0 ≤ from ≤ to ≤ 180° from the sun, got {from} and {to}"
-        )));
-    }
-    // Counted in f64 first: a tiny step would saturate the cast and wrap the + 1.
-    let rows = ((to - from) / step * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
-    if rows > MAX_ROWS as f64 {
-        return Err(bad(format!(
-            "--step {step}: {rows} rows, more than {MAX_ROWS}; use a larger step"
-        )));
-    }
-    let n = rows as usize;
-    Ok((0..n)
-        .map(|i| ((from + step * i as f64) * 1e9).round() / 1e9)
-        .collect())
-}
-
 /// The spec of a request (its flags checked).
 pub fn halo_spec(req: &HaloProfileRequest) -> Result<HaloSpec> {
     check_sun_radius(req.sun_radius_deg, "--sun-radius").map_err(bad)?;
@@ -120,7 +93,7 @@ pub fn halo_spec(req: &HaloProfileRequest) -> Result<HaloSpec> {
 pub fn profile(req: &HaloProfileRequest) -> Result<HaloProfile> {
     let lambdas = parse_lambdas(&req.lambdas)?;
     let psis_deg = parse_psis(&req.psi)?;
-    let thetas_deg = thetas(req.from_deg, req.to_deg, req.step_deg)?;
+    let thetas_deg = angles_from("the sun", req.from_deg, req.to_deg, req.step_deg)?;
     let sky = halo_spec(req)?.build(&flag).map_err(bad)?;
     let table = sky.table();
     Ok(HaloProfile {

@@ -252,14 +252,6 @@ impl HaloTable {
         a + wr * (b - a)
     }
 
-    /// The mean over ψ of the value at θ (degrees): the ring's average radiance.
-    pub fn ring_mean(&self, theta_deg: f64, lambda: f32) -> f32 {
-        let sum: f32 = (0..N_PSI)
-            .map(|k| self.eval(theta_deg, (k as f64 + 0.5) * PSI_STEP, lambda))
-            .sum();
-        sum / N_PSI as f32
-    }
-
     /// The mean over the rows of cell (ψ cell `k`, θ cell `j`), for importance sampling.
     pub fn cell_mean(&self, k: usize, j: usize) -> f32 {
         (0..ROWS)
