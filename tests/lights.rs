@@ -428,9 +428,12 @@ fn chi2_environment() {
 }
 
 /// A halo sky (src/sky/halo) is sampled by the cells of its table over (θ, ψ) about the
-/// sun, whose edges fall every 0.25° in θ (the breaks) and every 1° in ψ (which the
-/// adaptive quadrature finds). Over the 30° about the sun (the 22° halo, the sun dogs
-/// and most of the cells' density), to keep the quadrature short. A direction
+/// sun, whose edges fall every 0.25° in θ and every 1° in ψ. Over the 30° about the sun
+/// (the 22° halo, the sun dogs and most of the cells' density). The quadrature of the
+/// expected counts is told the θ edges within 2° (the forward cap and the steep
+/// diffraction core) and finds the others itself, as it finds ψ's: breaks at all 120
+/// edges took 20 s and moved the expected mass by 3e-4 of itself, which 10⁶ samples
+/// cannot see (measured 2026-12-08: p = 0.51 and 0.49). A direction
 /// rounded to f32 can cross a cell edge between the sample and `pdf_li`: 1e-5 of the
 /// samples may differ.
 #[test]
@@ -444,7 +447,7 @@ fn chi2_halo_sky() {
         P,
         &Spherical::cone(sun, 30f64.to_radians())
             .with_resolution(15, 24)
-            .with_theta_breaks((1..120).map(|j| (j as f64 * 0.25).to_radians())),
+            .with_theta_breaks((1..8).map(|j| (j as f64 * 0.25).to_radians())),
         |_| None,
         1e-5,
     )];

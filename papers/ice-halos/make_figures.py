@@ -104,18 +104,26 @@ def sun_dog_direction(n: float, h: float) -> tuple[float, float]:
 
 def sun_dogs(heron: hf.Heron, out: pathlib.Path, repo: pathlib.Path) -> None:
     rows = []
+    lams = (450.0, 650.0)
     for h in ELEVATIONS:
         aspect = "0.3" if h <= 30 else "1"
-        for lam in (450.0, 650.0):
-            theta, psi = sun_dog_direction(ice_n(repo, lam), h)
-            lo = math.floor((theta - 3) * 20) / 20
-            text = heron.run("halo", "profile", "--sun-elevation", hf.fmt(h, 6),
-                             "--crystals", f"plates:aspect={aspect},tilt_deg=0.2",
-                             "--lambda", hf.fmt(lam, 6), "--psi", hf.fmt(psi, 8),
-                             "--from", hf.fmt(lo, 8), "--to", hf.fmt(lo + 6, 8),
-                             "--step", "0.05", "--rays", "262144")
-            d = np.array([[float(x) for x in ln.split(",")] for ln in text.splitlines()[1:]])
-            peak = float(d[int(np.argmax(d[:, 1])), 0])
+        # One table per elevation: both wavelengths' great circles in one call (its
+        # columns are ψ-major: psi1_450nm, psi1_650nm, psi2_450nm, …), each searched
+        # over its own 6° about the predicted sun dog.
+        dogs = [(lam, *sun_dog_direction(ice_n(repo, lam), h)) for lam in lams]
+        psis = list(dict.fromkeys(psi for _, _, psi in dogs))
+        los = [math.floor((theta - 3) * 20) / 20 for _, theta, _ in dogs]
+        text = heron.run("halo", "profile", "--sun-elevation", hf.fmt(h, 6),
+                         "--crystals", f"plates:aspect={aspect},tilt_deg=0.2",
+                         "--lambda", ",".join(hf.fmt(lam, 6) for lam in lams),
+                         "--psi", ",".join(hf.fmt(psi, 8) for psi in psis),
+                         "--from", hf.fmt(min(los), 8), "--to", hf.fmt(max(los) + 6, 8),
+                         "--step", "0.05", "--rays", "262144")
+        d = np.array([[float(x) for x in ln.split(",")] for ln in text.splitlines()[1:]])
+        for (lam, theta, psi), lo in zip(dogs, los):
+            col = 1 + psis.index(psi) * len(lams) + lams.index(lam)
+            rows_in = np.nonzero((d[:, 0] > lo - 1e-9) & (d[:, 0] < lo + 6 + 1e-9))[0]
+            peak = float(d[rows_in[int(np.argmax(d[rows_in, col]))], 0])
             rows.append((h, lam, theta, psi, peak))
     hf.write_csv(out / "data" / "sun_dogs.csv",
                  ["sun_elevation_deg", "wavelength_nm", "bravais_theta_deg", "psi_deg",

@@ -1,8 +1,9 @@
 //! Math: glam re-exports, shading frames, warps with their densities, piecewise-constant
-//! distributions and per-sample random numbers.
+//! distributions, per-sample random numbers and a cache of recent tables.
 pub mod distribution;
 pub mod fastmath;
 pub mod frame;
+pub mod recent;
 pub mod rng;
 pub mod warp;
 

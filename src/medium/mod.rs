@@ -4,9 +4,11 @@
 //! - `homogeneous`: water drops, σ_t(λ), σ_s(λ) and p(θ, λ) from heron's Lorenz–Mie code
 //!   ([`crate::optics::mie`], BHMIE with water's complex index), tabulated once per scene
 //!   (`phase_table`);
-//! - `henyey_greenstein`: constant σ_a, σ_s and the Henyey–Greenstein phase function.
+//! - `henyey_greenstein`: constant σ_a, σ_s and the Henyey–Greenstein phase function;
+//! - `ice`: hexagonal ice crystals in random orientation (diamond dust), σ_t from their
+//!   projected area and the phase function traced through them (`optics::ice`).
 //!
-//! Either is homogeneous, so that the transmittance over a distance d is exactly
+//! Each is homogeneous, so that the transmittance over a distance d is exactly
 //! T(λ) = exp(−σ_t(λ) d) and free-flight sampling with the hero's σ_t has no majorant
 //! to bound (the majorant is σ_t itself; `integrator::path`), or heterogeneous: a
 //! `density` field (`density`: height fog, a rain shaft, noise, a grid) scales its
@@ -33,12 +35,14 @@
 pub mod density;
 pub mod henyey_greenstein;
 pub mod homogeneous;
+pub mod ice;
 pub mod phase_table;
 pub mod tracking;
 
 pub use density::Density;
 pub use henyey_greenstein::HgMedium;
 pub use homogeneous::{LorenzMieMedium, MieSpec, PopulationNode};
+pub use ice::{IceMedium, IceSpec};
 
 use crate::spectrum::stokes::{any_perpendicular, mueller_from_rows};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -56,6 +60,7 @@ pub use crate::geometry::NO_MEDIUM;
 pub enum Optics {
     LorenzMie(LorenzMieMedium),
     HenyeyGreenstein(HgMedium),
+    Ice(IceMedium),
 }
 
 /// A participating medium: its optics, homogeneous, or scaled by a density field
@@ -96,6 +101,7 @@ impl Optics {
         match self {
             Optics::LorenzMie(m) => wl.eval(&m.sigma_t),
             Optics::HenyeyGreenstein(m) => wl.eval(&m.sigma_t),
+            Optics::Ice(m) => wl.eval(&m.sigma_t),
         }
     }
 
@@ -104,6 +110,7 @@ impl Optics {
         match self {
             Optics::LorenzMie(m) => wl.eval(&m.sigma_s),
             Optics::HenyeyGreenstein(m) => wl.eval(&m.sigma_s),
+            Optics::Ice(m) => wl.eval(&m.sigma_s),
         }
     }
 
@@ -112,6 +119,7 @@ impl Optics {
         match self {
             Optics::LorenzMie(m) => m.phase.eval(v, &wl.lambda),
             Optics::HenyeyGreenstein(m) => SampledSpectrum::splat(henyey_greenstein::hg(m.g, v)),
+            Optics::Ice(m) => m.phase.eval(v, &wl.lambda),
         }
     }
 
@@ -140,6 +148,7 @@ impl Optics {
                 let (v, p) = henyey_greenstein::sample_hg(m.g, u);
                 (v, SampledSpectrum::splat(p))
             }
+            Optics::Ice(m) => m.phase.sample(u_node, u, &wl.lambda),
         }
     }
 }
@@ -176,7 +185,7 @@ impl Medium {
     pub fn lorenz_mie(&self) -> Option<&LorenzMieMedium> {
         match &self.optics {
             Optics::LorenzMie(m) => Some(m),
-            Optics::HenyeyGreenstein(_) => None,
+            Optics::HenyeyGreenstein(_) | Optics::Ice(_) => None,
         }
     }
 
@@ -362,7 +371,7 @@ impl<'a> MediumPoint<'a> {
     /// by the phase function, with the frame it is written in for both beams: x̂ =
     /// d_in × d_out normalised, perpendicular to the scattering plane
     /// (`homogeneous`'s module docs). None when the medium depolarises
-    /// (Henyey–Greenstein, which has no matrix, and a Lorenz–Mie table without one):
+    /// (Henyey–Greenstein and ice, which have no matrix, and a Lorenz–Mie table without one):
     /// then only the intensity survives, diag(1, 0, 0, 0). Two populations' matrices
     /// mix as their phase functions do, each weighted by its share of p.
     #[inline(always)]

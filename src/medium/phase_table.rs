@@ -127,16 +127,31 @@ impl PhaseTable {
     /// phase function of node i at `theta[e]`, per unit solid angle.
     pub fn from_values(lambda0: f32, dlambda: f32, theta: &[f64], values: &[Vec<f64>]) -> Self {
         let vd: Vec<f64> = theta.iter().map(|&t| v_of_theta(t)).collect();
+        let masses: Vec<Vec<f64>> = values
+            .iter()
+            .map(|vals| {
+                (0..vd.len() - 1)
+                    .map(|j| 0.5 * (vals[j] + vals[j + 1]) * 2.0 * PI * (vd[j + 1] - vd[j]))
+                    .collect()
+            })
+            .collect();
+        Self::from_masses(lambda0, dlambda, theta, &masses)
+    }
+
+    /// Builds the table from each bin's mass: `masses[i][j]` is the (unnormalised)
+    /// probability that node i scatters into θ ∈ [theta[j], theta[j + 1]) (a histogram of
+    /// traced rays, which has no values at the edges to interpolate).
+    pub fn from_masses(lambda0: f32, dlambda: f32, theta: &[f64], masses: &[Vec<f64>]) -> Self {
+        let vd: Vec<f64> = theta.iter().map(|&t| v_of_theta(t)).collect();
         let m = vd.len() - 1;
-        let mut density = Vec::with_capacity(values.len());
-        let mut cdf = Vec::with_capacity(values.len());
-        let mut raw_integral = Vec::with_capacity(values.len());
-        for vals in values {
+        let mut density = Vec::with_capacity(masses.len());
+        let mut cdf = Vec::with_capacity(masses.len());
+        let mut raw_integral = Vec::with_capacity(masses.len());
+        for bins in masses {
             let mut c = Vec::with_capacity(m + 1);
             c.push(0.0f64);
             let mut acc = 0.0f64;
-            for j in 0..m {
-                let mass = 0.5 * (vals[j] + vals[j + 1]) * 2.0 * PI * (vd[j + 1] - vd[j]);
+            for &mass in &bins[..m] {
                 acc += mass;
                 c.push(acc);
             }
@@ -169,7 +184,7 @@ impl PhaseTable {
             density: (0..m)
                 .flat_map(|j| density.iter().map(move |d: &Vec<f32>| d[j]))
                 .collect(),
-            nodes: values.len(),
+            nodes: masses.len(),
             cdf,
             raw_integral,
             matrix: Vec::new(),

@@ -791,7 +791,9 @@ pub struct MeshFile {
 /// the Lorenz–Mie wavelength nodes, default 10) and `forward_cutoff` (degrees, default
 /// 0: scattering within it of forward counts as unscattered, `medium::homogeneous`). `type = "henyey-greenstein"`:
 /// `sigma_a`, `sigma_s` (per scene unit; each a number, `[r, g, b]` or samples) and `g`
-/// in (−1, 1). The keys are checked
+/// in (−1, 1). `type = "ice"`: randomly oriented ice crystals (`medium::ice`), the
+/// `crystals` tables of a halo sky with `number_density` (crystals per m³), and
+/// optional `rays`, `seed` and `forward_cutoff`. The keys are checked
 /// against the type in `load/media.rs`.
 #[derive(Clone, Debug, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -822,6 +824,15 @@ pub struct MediumFile {
     pub sigma_s: Option<Coefficient>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub g: Option<f32>,
+    /// Ice crystals (`type = "ice"`): the populations, as a halo sky's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crystals: Option<Vec<crate::sky::halo::CrystalFile>>,
+    /// Rays per wavelength node of an ice medium's phase function.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rays: Option<u64>,
+    /// The seed of an ice medium's traced rays.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
     /// A density field scaling the coefficients (a heterogeneous medium); default none
     /// (homogeneous).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -839,12 +850,18 @@ pub enum MediumType {
     Mie,
     /// Given σ_a, σ_s and the Henyey–Greenstein g.
     HenyeyGreenstein,
+    /// Ice crystals in random orientation, traced by geometric optics.
+    Ice,
 }
 
 impl MediumType {
     /// The `type` values, in declaration order.
-    pub const NAMES: &'static [&'static str] = &["mie", "henyey-greenstein"];
-    const ALL: [MediumType; 2] = [MediumType::Mie, MediumType::HenyeyGreenstein];
+    pub const NAMES: &'static [&'static str] = &["mie", "henyey-greenstein", "ice"];
+    const ALL: [MediumType; 3] = [
+        MediumType::Mie,
+        MediumType::HenyeyGreenstein,
+        MediumType::Ice,
+    ];
 
     /// The type named `name`, if any.
     pub fn from_name(name: &str) -> Option<MediumType> {

@@ -318,6 +318,9 @@ pub fn hg_medium(
         sigma_a: Some(sigma_a),
         sigma_s: Some(sigma_s),
         g: Some(g as f32),
+        crystals: None,
+        rays: None,
+        seed: None,
         density: None,
         aloft: None,
     }

@@ -1,5 +1,5 @@
 //! Media: each shape's `medium` table to a [`Medium`] (water drops by Lorenz–Mie theory,
-//! or Henyey–Greenstein), checked against its type, and given to closed shapes whose
+//! Henyey–Greenstein, or ice crystals), checked against its type, and given to closed shapes whose
 //! surface lets light in; each distinct medium is tabulated once.
 use super::materials::Materials;
 use super::shapes::{grow_box, EMPTY_BOX};
@@ -7,8 +7,10 @@ use super::SkyTables;
 use crate::bsdf::Material;
 use crate::geometry::Shape;
 use crate::medium::density::{grid::Edge, Density, Field, Grid, HeightFog, Noise, RainShaft};
-use crate::medium::{Aloft, HgMedium, LorenzMieMedium, Medium, Optics};
+use crate::medium::{Aloft, HgMedium, IceMedium, IceSpec, LorenzMieMedium, Medium, Optics};
+use crate::optics::ice::Orientation;
 use crate::scene::file::{DensityFile, Direction3, MediumFile, MediumType, ShapeFile};
+use crate::sky::halo::HaloKey;
 use crate::spectrum::DenseSpectrum;
 use glam::Vec3;
 use std::path::Path;
@@ -44,6 +46,7 @@ pub(super) enum OpticsPlan {
         sigma_s: DenseSpectrum,
         g: f32,
     },
+    Ice(IceSpec),
 }
 
 impl OpticsPlan {
@@ -62,6 +65,7 @@ impl OpticsPlan {
                 sigma_s.clone(),
                 *g,
             ))),
+            OpticsPlan::Ice(spec) => Medium::homogeneous(Optics::Ice(IceMedium::new(spec.clone()))),
         }
     }
 }
@@ -107,6 +111,7 @@ fn plan_optics(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, Stri
     match MediumType::from_name(&m.kind) {
         Some(MediumType::Mie) => plan_mie(at, m),
         Some(MediumType::HenyeyGreenstein) => plan_hg(at, m),
+        Some(MediumType::Ice) => plan_ice(at, m),
         None => Err(format!(
             "{at}.type: expected one of {}, got {:?}",
             MediumType::NAMES.join(", "),
@@ -137,6 +142,7 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String>
             "{at}.{k}: applies to type = \"henyey-greenstein\", not to type = \"mie\" (whose coefficients come from Lorenz-Mie theory)"
         ));
     }
+    refuse_ice_keys(at, m, "mie")?;
     // The drops: one radius, or a distribution's quadrature nodes (number
     // fractions summing to 1).
     let (nodes, dist) = match (m.radius_mm, &m.drops) {
@@ -252,6 +258,7 @@ fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> 
             "{at}.{k}: applies to type = \"mie\", not to type = \"henyey-greenstein\""
         ));
     }
+    refuse_ice_keys(at, m, "henyey-greenstein")?;
     let g = m.g.unwrap_or(0.0);
     if !(g.is_finite() && g.abs() < 1.0) {
         return Err(format!(
@@ -284,11 +291,91 @@ fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> 
     })
 }
 
+/// The ice medium's own keys, refused on a medium of another `kind`.
+fn refuse_ice_keys(at: &str, m: &MediumFile, kind: &str) -> std::result::Result<(), String> {
+    match given("crystals", m.crystals.is_some())
+        .or(given("rays", m.rays.is_some()))
+        .or(given("seed", m.seed.is_some()))
+    {
+        Some(k) => Err(format!(
+            "{at}.{k}: applies to type = \"ice\", not to type = \"{kind}\""
+        )),
+        None => Ok(()),
+    }
+}
+
+/// A `type = "ice"` medium: the `crystals` populations of a halo sky (each `weight`
+/// its share of the crystals by number), all in random orientation, `number_density`
+/// crystals per m³ in all, and optional `rays`, `seed` and `forward_cutoff`.
+fn plan_ice(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> {
+    if let Some(k) = given("radius_mm", m.radius_mm.is_some())
+        .or(given("drops", m.drops.is_some()))
+        .or(given(
+            "liquid_water_content",
+            m.liquid_water_content.is_some(),
+        ))
+        .or(given("absorption", m.absorption.is_some()))
+        .or(given("lambda_step", m.lambda_step.is_some()))
+    {
+        return Err(format!(
+            "{at}.{k}: applies to type = \"mie\", not to type = \"ice\""
+        ));
+    }
+    if let Some(k) = given("sigma_a", m.sigma_a.is_some())
+        .or(given("sigma_s", m.sigma_s.is_some()))
+        .or(given("g", m.g.is_some()))
+    {
+        return Err(format!(
+            "{at}.{k}: applies to type = \"henyey-greenstein\", not to type = \"ice\" (whose coefficients come from the crystals' projected areas)"
+        ));
+    }
+    let name = |k: HaloKey| match k {
+        HaloKey::Crystals => format!("{at}.crystals"),
+        HaloKey::Crystal(j, key) => format!("{at}.crystals[{j}].{key}"),
+        HaloKey::Rays => format!("{at}.rays"),
+        HaloKey::SunElevation => at.to_string(),
+    };
+    let Some(crystals) = &m.crystals else {
+        return Err(format!(
+            "{at}.crystals: missing required key (expected the populations of ice crystals, e.g. [{{ orientation = \"random\", aspect = 0.5, size_um = 60 }}])"
+        ));
+    };
+    let populations = crate::sky::halo::spec::populations(crystals, &name)?;
+    if let Some(j) = populations
+        .iter()
+        .position(|p| p.orientation != Orientation::Random)
+    {
+        return Err(format!(
+            "{}: an ice medium takes orientation = \"random\", got {:?} (oriented crystals, whose phase function depends on the light's direction, render as a halo sky: [sky] model = \"halo\")",
+            name(HaloKey::Crystal(j, "orientation")),
+            crystals[j].orientation
+        ));
+    }
+    let Some(density) = m.number_density else {
+        return Err(format!(
+            "{at}.number_density: missing required key (expected crystals per m³)"
+        ));
+    };
+    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.get() as f64);
+    if cutoff > 10.0 {
+        return Err(format!(
+            "{at}.forward_cutoff: expected degrees in [0, 10] (the forward peak counted as unscattered), got {cutoff}"
+        ));
+    }
+    Ok(OpticsPlan::Ice(IceSpec {
+        populations,
+        number_density: density.get() as f64,
+        rays: crate::sky::halo::spec::rays(m.rays, crate::medium::ice::DEFAULT_RAYS, &name)?,
+        seed: m.seed.unwrap_or(0),
+        forward_cutoff_deg: cutoff,
+    }))
+}
+
 /// Gives each shape its entry's medium (`plans`, by `shape_entry`) and returns the media.
 /// A medium sits in a closed shape whose surface lets light in: no material (an
 /// index-matched boundary, `Shape::interface`) or a smooth or rough dielectric (a glass of
 /// milk); one medium per entry, tabulated once per distinct medium. With
-/// [`SkyTables::Skip`] (the fuzzing harness, which never renders) Lorenz–Mie media are
+/// [`SkyTables::Skip`] (the fuzzing harness, which never renders) Lorenz–Mie and ice media are
 /// checked but not tabulated, which takes seconds: their shapes are left without one.
 pub(super) fn assign_media(
     entries: &[ShapeFile],
@@ -339,7 +426,9 @@ pub(super) fn assign_media(
                 ))
             }
         }
-        if sky_tables == SkyTables::Skip && matches!(plan.optics, OpticsPlan::Mie(_)) {
+        if sky_tables == SkyTables::Skip
+            && matches!(plan.optics, OpticsPlan::Mie(_) | OpticsPlan::Ice(_))
+        {
             continue;
         }
         let id = match medium_plans.iter().position(|p| *p == plan) {
@@ -418,6 +507,9 @@ fn plan_aloft(
         sigma_a: None,
         sigma_s: None,
         g: None,
+        crystals: None,
+        rays: None,
+        seed: None,
         density: None,
         aloft: None,
     };

@@ -28,9 +28,10 @@ pub mod table;
 pub use spec::{CrystalFile, HaloKey, HaloSpec};
 pub use table::HaloTable;
 
+use crate::math::recent::Recent;
 use crate::optics::ice::Crystals;
 use glam::Vec3;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
 /// The cone about the sun the rendered sky leaves to the sun light, degrees.
 pub const FORWARD_CUT_DEG: f64 = 1.0;
@@ -95,29 +96,17 @@ impl HaloSky {
                 self.rays,
                 self.seed
             );
-            static CACHE: Mutex<Vec<(String, Arc<HaloTable>)>> = Mutex::new(Vec::new());
-            if let Some(t) = CACHE
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .iter()
-                .find(|(k, _)| *k == key)
-            {
-                return t.1.clone();
-            }
-            let t = Arc::new(HaloTable::build(
-                &self.crystals,
-                &ice_n,
-                self.sun_elevation,
-                self.sun_radius,
-                self.rays,
-                self.seed,
-            ));
-            let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-            if cache.len() == CACHED_TABLES {
-                cache.remove(0);
-            }
-            cache.push((key, t.clone()));
-            t
+            static CACHE: Recent<HaloTable> = Recent::new(CACHED_TABLES);
+            CACHE.get_or_build(key, || {
+                HaloTable::build(
+                    &self.crystals,
+                    &ice_n,
+                    self.sun_elevation,
+                    self.sun_radius,
+                    self.rays,
+                    self.seed,
+                )
+            })
         })
     }
 }

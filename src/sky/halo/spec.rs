@@ -17,8 +17,10 @@
 //!   needs crystals many wavelengths across; the size sets only the diffraction), with
 //!   the half-length c = a·(c/a) at most 2000 µm (the tracer neglects ice's absorption,
 //!   under 1% over such paths: `crate::optics::ice::trace`); default 50.
-//! - `weight`: the population's share of the layer's geometric cross-section, in
-//!   (0, 1e6] (normalised over the populations); default 1.
+//! - `weight`: in a sky, the population's share of the layer's geometric cross-section;
+//!   in an ice medium (`crate::medium::ice`), its share of the crystals by number (the
+//!   medium's `number_density` counts them all); in (0, 1e6], normalised over the
+//!   populations; default 1.
 use super::{HaloSky, DEFAULT_RAYS};
 use crate::optics::ice::{Crystals, Orientation, Population};
 
@@ -181,19 +183,7 @@ impl CrystalFile {
 impl HaloSpec {
     /// Checks the spec and makes the sky (its table is traced on first use).
     pub fn build(&self, name: &dyn Fn(HaloKey) -> String) -> Result<HaloSky, String> {
-        if self.crystals.is_empty() || self.crystals.len() > MAX_POPULATIONS {
-            return Err(format!(
-                "{}: expected 1 to {MAX_POPULATIONS} populations of crystals, got {}",
-                name(HaloKey::Crystals),
-                self.crystals.len()
-            ));
-        }
-        let populations = self
-            .crystals
-            .iter()
-            .enumerate()
-            .map(|(i, c)| c.population(i, name))
-            .collect::<Result<Vec<_>, _>>()?;
+        let populations = populations(&self.crystals, name)?;
         let h = self.sun_elevation_deg;
         if !(-90.0..=90.0).contains(&h) {
             return Err(format!(
@@ -201,21 +191,51 @@ impl HaloSpec {
                 name(HaloKey::SunElevation)
             ));
         }
-        let rays = self.rays.unwrap_or(DEFAULT_RAYS as u64);
-        if !(MIN_RAYS..=MAX_RAYS).contains(&rays) {
-            return Err(format!(
-                "{}: expected {MIN_RAYS} to {MAX_RAYS} rays per wavelength, got {rays}",
-                name(HaloKey::Rays)
-            ));
-        }
         Ok(HaloSky::new(
             Crystals::new(populations),
             h.to_radians(),
             self.sun_radius_rad,
-            rays as usize,
+            rays(self.rays, DEFAULT_RAYS, name)?,
             self.seed.unwrap_or(0),
         ))
     }
+}
+
+/// The populations of `crystals`, checked: 1 to [`MAX_POPULATIONS`], each by
+/// [`CrystalFile`]'s rules (a halo sky's or an ice medium's).
+pub fn populations(
+    crystals: &[CrystalFile],
+    name: &dyn Fn(HaloKey) -> String,
+) -> Result<Vec<Population>, String> {
+    if crystals.is_empty() || crystals.len() > MAX_POPULATIONS {
+        return Err(format!(
+            "{}: expected 1 to {MAX_POPULATIONS} populations of crystals, got {}",
+            name(HaloKey::Crystals),
+            crystals.len()
+        ));
+    }
+    crystals
+        .iter()
+        .enumerate()
+        .map(|(i, c)| c.population(i, name))
+        .collect()
+}
+
+/// Rays per wavelength, `default` when not given, checked against [`MIN_RAYS`] and
+/// [`MAX_RAYS`].
+pub fn rays(
+    rays: Option<u64>,
+    default: usize,
+    name: &dyn Fn(HaloKey) -> String,
+) -> Result<usize, String> {
+    let rays = rays.unwrap_or(default as u64);
+    if !(MIN_RAYS..=MAX_RAYS).contains(&rays) {
+        return Err(format!(
+            "{}: expected {MIN_RAYS} to {MAX_RAYS} rays per wavelength, got {rays}",
+            name(HaloKey::Rays)
+        ));
+    }
+    Ok(rays as usize)
 }
 
 #[cfg(test)]
