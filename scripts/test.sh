@@ -21,9 +21,10 @@ fi
 phase "set-up"
 scripts/setup.sh --deps
 
-# No separate `cargo build --release`: `cargo test --release` builds the binary too (the
-# integration tests run it), and with the dev-dependencies' features unified its build
-# replaced the first one's, three minutes of CI for a binary nothing used.
+# No separate `cargo build --release` first: `cargo test --release` builds the binary the
+# integration and Python tests run. Cargo.toml asks for the dependency features that the
+# dev-dependencies turn on, so the two builds are one and the tarball's `cargo build
+# --release` (tests/python/test_dist.py) finds it up to date.
 phase "cargo test"
 cargo test --release --locked
 

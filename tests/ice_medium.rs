@@ -117,6 +117,12 @@ fn extinction_is_twice_the_mean_projected_area() {
     })
     .sigma_t_full;
     assert!((mix / (0.75 * one + 0.25 * other) - 1.0).abs() < 1e-9);
+    // The number density scales σ and nothing else.
+    let twice = IceMedium::new(IceSpec {
+        number_density: 2e6,
+        ..spec(4096, 0.0)
+    });
+    assert_eq!(twice.sigma_t_full, 2.0 * one);
 }
 
 #[test]
@@ -175,10 +181,10 @@ fn halos_begin_at_the_minimum_deviations() {
                 outside > contrast * inside,
                 "{lambda} nm, A = {apex}°: {outside} vs {inside} inside"
             );
-            edges.push(d);
+            edges.push(edge);
         }
     }
-    // Red (660 nm) inside blue (440 nm), for both halos.
+    // Red (660 nm) inside blue (440 nm), for both halos, as found in the table.
     assert!(edges[2] < edges[0] && edges[3] < edges[1], "{edges:?}");
 }
 
@@ -282,6 +288,10 @@ fn bad_ice_keys_are_named() {
         (
             r#"{ type = "mie", radius_mm = 0.01, number_density = 1e5, crystals = [{ orientation = "random" }] }"#,
             "shapes[0].medium.crystals: applies to type = \"ice\", not to type = \"mie\"",
+        ),
+        (
+            r#"{ type = "henyey-greenstein", sigma_s = 1.0, forward_cutoff = 1 }"#,
+            "shapes[0].medium.forward_cutoff: applies to type = \"mie\" or \"ice\", not to type = \"henyey-greenstein\"",
         ),
         (
             r#"{ type = "henyey-greenstein", sigma_s = 1.0, rays = 5000 }"#,

