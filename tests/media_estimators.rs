@@ -193,7 +193,7 @@ fn white_furnace_stays_at_one_with_the_sun_guide() {
     );
     // Randomly oriented ice crystals (issue 40; σ_t = 2 per unit before the cutoff, as
     // in tests/media.rs) whose forward peak within 1° (diffraction and the rays through
-    // parallel faces, about 60% of the scattering) is counted as unscattered: σ_s' =
+    // parallel faces, about 64% of the scattering) is counted as unscattered: σ_s' =
     // σ_t' per wavelength, the cut phase function sampled and evaluated alike.
     let ice = load_in(
         &dir,

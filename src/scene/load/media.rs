@@ -221,12 +221,7 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String>
             "{at}.lambda_step: expected nm between wavelength nodes in [1, 50], got {step}"
         ));
     }
-    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.get() as f64);
-    if cutoff > 10.0 {
-        return Err(format!(
-            "{at}.forward_cutoff: expected degrees in [0, 10] (the diffraction peak counted as unscattered), got {cutoff}"
-        ));
-    }
+    let cutoff = forward_cutoff(at, m)?;
     Ok(OpticsPlan::Mie(crate::medium::MieSpec {
         population: nodes
             .iter()
@@ -239,6 +234,17 @@ fn plan_mie(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String>
         lambda_step_nm: step,
         forward_cutoff_deg: cutoff,
     }))
+}
+
+/// A medium's `forward_cutoff` in degrees (default 0), at most 10.
+fn forward_cutoff(at: &str, m: &MediumFile) -> std::result::Result<f64, String> {
+    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.get() as f64);
+    if cutoff > 10.0 {
+        return Err(format!(
+            "{at}.forward_cutoff: expected degrees in [0, 10] (the forward peak counted as unscattered), got {cutoff}"
+        ));
+    }
+    Ok(cutoff)
 }
 
 /// A `type = "henyey-greenstein"` medium: σ_a, σ_s and g given.
@@ -360,12 +366,7 @@ fn plan_ice(at: &str, m: &MediumFile) -> std::result::Result<OpticsPlan, String>
             "{at}.number_density: missing required key (expected crystals per m³)"
         ));
     };
-    let cutoff = m.forward_cutoff.map_or(0.0, |c| c.get() as f64);
-    if cutoff > 10.0 {
-        return Err(format!(
-            "{at}.forward_cutoff: expected degrees in [0, 10] (the forward peak counted as unscattered), got {cutoff}"
-        ));
-    }
+    let cutoff = forward_cutoff(at, m)?;
     Ok(OpticsPlan::Ice(IceSpec {
         populations,
         number_density: density.get() as f64,
